@@ -1,0 +1,486 @@
+//! The records a card log holds, as plain values.
+//!
+//! Fields are the quantised integers stored on the card; names carry units and
+//! scales (`steer_cdeg` is hundredths of a degree). Conversions to physical
+//! units live next to each type so the encoder, the decoder and the sensor
+//! code agree on one definition. The byte layout is in `firmware/FORMAT.md`.
+
+/// Accelerometer scale: counts per g (±16 g full scale in an `i16`).
+pub const ACCEL_COUNTS_PER_G: f32 = 2048.0;
+/// Gyroscope scale: counts per degree per second (±1024 deg/s in an `i16`).
+pub const GYRO_COUNTS_PER_DPS: f32 = 32.0;
+/// Steering scale: counts per degree (hundredths of a degree).
+pub const STEER_COUNTS_PER_DEG: f32 = 100.0;
+/// `Frame::wheel_edge_age_us` value meaning "no edge in the last 65.534 ms".
+pub const EDGE_AGE_NONE: u16 = u16::MAX;
+
+/// Round and saturate a physical value into an `i16` field.
+#[must_use]
+pub fn quantise_i16(value: f32, counts_per_unit: f32) -> i16 {
+    // `as` saturates and maps NaN to 0, which is what a log wants.
+    libm_round(value * counts_per_unit) as i16
+}
+
+/// Round and saturate a physical value into a `u16` field.
+#[must_use]
+pub fn quantise_u16(value: f32, counts_per_unit: f32) -> u16 {
+    libm_round(value * counts_per_unit) as u16
+}
+
+/// Round and saturate a physical value into an `i32` field.
+#[must_use]
+pub fn quantise_i32(value: f64, counts_per_unit: f64) -> i32 {
+    let x = value * counts_per_unit;
+    // Round half away from zero without `std`.
+    (if x >= 0.0 { x + 0.5 } else { x - 0.5 }) as i32
+}
+
+fn libm_round(x: f32) -> f32 {
+    // `f32::round` needs std; truncation after the half-offset is exact here
+    // because `as` casts truncate toward zero.
+    if x >= 0.0 {
+        x + 0.5
+    } else {
+        x - 0.5
+    }
+}
+
+/// Status bits of a 100 Hz frame.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct FrameStatus(pub u8);
+
+impl FrameStatus {
+    /// The IMU produced no new sample since the previous frame.
+    pub const IMU_STALE: u8 = 1 << 0;
+    /// The steering ADC produced no new value since the previous frame.
+    pub const STEER_STALE: u8 = 1 << 1;
+    /// The steering value hit the ADC's range (pot at an end stop or unplugged).
+    pub const STEER_SATURATED: u8 = 1 << 2;
+    /// No wheel edge within the stall timeout: speed is reported as zero.
+    pub const WHEEL_STOPPED: u8 = 1 << 3;
+    /// No GPS fix within the last second.
+    pub const GPS_STALE: u8 = 1 << 4;
+    /// The IMU is missing or stuck (values not changing).
+    pub const IMU_FAULT: u8 = 1 << 5;
+    /// The wobble alert is active in this frame.
+    pub const ALERT: u8 = 1 << 6;
+    /// The rider's marker button is held in this frame.
+    pub const MARKER: u8 = 1 << 7;
+
+    /// Whether every bit of `mask` is set.
+    #[must_use]
+    pub const fn has(self, mask: u8) -> bool {
+        self.0 & mask == mask
+    }
+}
+
+/// One 100 Hz sample of every channel.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Frame {
+    /// Microseconds since boot.
+    pub t_us: u64,
+    /// Acceleration x/y/z in the bicycle frame, [`ACCEL_COUNTS_PER_G`].
+    pub accel: [i16; 3],
+    /// Angular rate x/y/z in the bicycle frame, [`GYRO_COUNTS_PER_DPS`].
+    pub gyro: [i16; 3],
+    /// Steering angle, hundredths of a degree, positive to the left.
+    pub steer_cdeg: i16,
+    /// Cumulative wheel pulse count since boot, wrapping at 2^16.
+    pub wheel_count: u16,
+    /// Age of the last wheel edge at `t_us`, microseconds ([`EDGE_AGE_NONE`] if older).
+    pub wheel_edge_age_us: u16,
+    /// Wheel speed, millimetres per second.
+    pub speed_mm_s: u16,
+    /// Status bits.
+    pub status: FrameStatus,
+}
+
+impl Frame {
+    /// Acceleration in g.
+    #[must_use]
+    pub fn accel_g(&self) -> [f32; 3] {
+        self.accel.map(|c| f32::from(c) / ACCEL_COUNTS_PER_G)
+    }
+    /// Angular rate in degrees per second.
+    #[must_use]
+    pub fn gyro_dps(&self) -> [f32; 3] {
+        self.gyro.map(|c| f32::from(c) / GYRO_COUNTS_PER_DPS)
+    }
+    /// Steering angle in degrees.
+    #[must_use]
+    pub fn steer_deg(&self) -> f32 {
+        f32::from(self.steer_cdeg) / STEER_COUNTS_PER_DEG
+    }
+    /// Wheel speed in metres per second.
+    #[must_use]
+    pub fn speed_mps(&self) -> f32 {
+        f32::from(self.speed_mm_s) / 1000.0
+    }
+}
+
+/// GPS fix dimension.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum FixMode {
+    /// No fix (position fields, if present, are not trustworthy).
+    #[default]
+    None,
+    /// Two-dimensional fix.
+    Fix2d,
+    /// Three-dimensional fix.
+    Fix3d,
+}
+
+impl FixMode {
+    /// The name used in CSV and JSON output.
+    #[must_use]
+    pub const fn as_str(self) -> &'static str {
+        match self {
+            Self::None => "none",
+            Self::Fix2d => "2d",
+            Self::Fix3d => "3d",
+        }
+    }
+}
+
+/// UTC date and time of day, millisecond resolution.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, PartialOrd, Ord, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct UtcTime {
+    /// Days since 2000-01-01.
+    pub days_since_2000: u16,
+    /// Milliseconds since midnight UTC (a leap second may reach 86 400 999).
+    pub ms_of_day: u32,
+}
+
+impl UtcTime {
+    /// Milliseconds since the Unix epoch.
+    #[must_use]
+    pub fn unix_ms(self) -> u64 {
+        const DAYS_1970_TO_2000: u64 = 10_957;
+        (DAYS_1970_TO_2000 + u64::from(self.days_since_2000)) * 86_400_000
+            + u64::from(self.ms_of_day)
+    }
+
+    /// Civil date (year, month 1-12, day 1-31) of `days_since_2000`.
+    #[must_use]
+    pub fn date(self) -> (i32, u32, u32) {
+        // Howard Hinnant's days-to-civil algorithm, shifted to the 2000 epoch.
+        let z = i64::from(self.days_since_2000) + 10_957 + 719_468;
+        let era = z.div_euclid(146_097);
+        let doe = z - era * 146_097;
+        let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
+        let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+        let mp = (5 * doy + 2) / 153;
+        let day = (doy - (153 * mp + 2) / 5 + 1) as u32;
+        let month = if mp < 10 { mp + 3 } else { mp - 9 } as u32;
+        let year = (yoe + era * 400 + i64::from(month <= 2)) as i32;
+        (year, month, day)
+    }
+
+    /// Days since 2000-01-01 of a civil date, `None` outside 2000..=2179.
+    #[must_use]
+    pub fn days_from_date(year: i32, month: u32, day: u32) -> Option<u16> {
+        if !(1..=12).contains(&month) || !(1..=31).contains(&day) {
+            return None;
+        }
+        let y = i64::from(year) - i64::from(month <= 2);
+        let era = y.div_euclid(400);
+        let yoe = y - era * 400;
+        let m = i64::from(month);
+        let doy = (153 * (if m > 2 { m - 3 } else { m + 9 }) + 2) / 5 + i64::from(day) - 1;
+        let doe = yoe * 365 + yoe / 4 - yoe / 100 + doy;
+        let days = era * 146_097 + doe - 719_468 - 10_957;
+        u16::try_from(days).ok()
+    }
+}
+
+/// One GPS epoch, merged from the sentences the receiver sent for it.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct GpsFix {
+    /// Local time (µs since boot) at which the epoch's first sentence began.
+    pub t_us: u64,
+    /// UTC of the fix, if the receiver sent one.
+    pub utc: Option<UtcTime>,
+    /// Latitude, 1e-7 degrees, north positive.
+    pub lat_e7: Option<i32>,
+    /// Longitude, 1e-7 degrees, east positive.
+    pub lon_e7: Option<i32>,
+    /// Speed over ground, centimetres per second.
+    pub speed_cm_s: Option<u16>,
+    /// Course over ground, hundredths of a degree from true north.
+    pub course_cdeg: Option<u16>,
+    /// Altitude above mean sea level, centimetres.
+    pub alt_cm: Option<i32>,
+    /// Fix dimension.
+    pub fix: FixMode,
+    /// Satellites used in the fix.
+    pub sats: Option<u8>,
+    /// Horizontal dilution of precision, tenths (saturates at 25.5).
+    pub hdop_d: Option<u8>,
+}
+
+/// A (local time, UTC) pair, written when the GPS time first becomes valid and
+/// then periodically, so every sample can be given an absolute time.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct UtcSync {
+    /// Local time, µs since boot.
+    pub t_us: u64,
+    /// UTC at that instant, milliseconds since the Unix epoch.
+    pub unix_ms: u64,
+}
+
+/// The wobble alert switching on or off.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Alert {
+    /// Local time, µs since boot.
+    pub t_us: u64,
+    /// `true` when the alert switches on.
+    pub on: bool,
+    /// Dominant frequency, hundredths of a hertz (0 when switching off).
+    pub freq_chz: u16,
+    /// Steering oscillation amplitude, hundredths of a degree (0 when off).
+    pub amp_cdeg: u16,
+}
+
+/// The rider pressed the marker button.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Marker {
+    /// Local time, µs since boot.
+    pub t_us: u64,
+    /// Running marker number since boot.
+    pub id: u16,
+}
+
+/// Why frames were dropped before reaching the card.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum DropoutReason {
+    /// The queue to the SD writer was full (card stalled longer than designed).
+    QueueFull,
+    /// No card, or the card failed: frames were sampled but could not be written.
+    CardUnavailable,
+    /// The sampler missed its tick (overrun).
+    SamplerOverrun,
+    /// A reason this reader does not know (from a newer writer).
+    Other(u8),
+}
+
+impl DropoutReason {
+    /// The byte stored on the card.
+    #[must_use]
+    pub const fn code(self) -> u8 {
+        match self {
+            Self::QueueFull => 1,
+            Self::CardUnavailable => 2,
+            Self::SamplerOverrun => 3,
+            Self::Other(c) => c,
+        }
+    }
+    /// Inverse of [`Self::code`].
+    #[must_use]
+    pub const fn from_code(code: u8) -> Self {
+        match code {
+            1 => Self::QueueFull,
+            2 => Self::CardUnavailable,
+            3 => Self::SamplerOverrun,
+            c => Self::Other(c),
+        }
+    }
+    /// Short name for reports.
+    #[must_use]
+    pub const fn as_str(self) -> &'static str {
+        match self {
+            Self::QueueFull => "queue_full",
+            Self::CardUnavailable => "card_unavailable",
+            Self::SamplerOverrun => "sampler_overrun",
+            Self::Other(_) => "other",
+        }
+    }
+}
+
+/// Frames that were sampled but never reached the card.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Dropout {
+    /// Local time of the first lost frame, µs since boot.
+    pub t_us: u64,
+    /// How many 100 Hz frames were lost.
+    pub frames_lost: u32,
+    /// Why.
+    pub reason: DropoutReason,
+}
+
+/// The component a fault came from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum FaultSource {
+    /// The IMU.
+    Imu,
+    /// The steering potentiometer / ADC.
+    Steering,
+    /// The wheel-speed sensor.
+    Wheel,
+    /// The GPS receiver or its NMEA stream.
+    Gps,
+    /// The SD card or file system.
+    Card,
+    /// The configuration file.
+    Config,
+    /// The logger itself (watchdog reset, overrun).
+    System,
+    /// A source this reader does not know (from a newer writer).
+    Other(u8),
+}
+
+impl FaultSource {
+    /// The byte stored on the card.
+    #[must_use]
+    pub const fn code(self) -> u8 {
+        match self {
+            Self::Imu => 1,
+            Self::Steering => 2,
+            Self::Wheel => 3,
+            Self::Gps => 4,
+            Self::Card => 5,
+            Self::Config => 6,
+            Self::System => 7,
+            Self::Other(c) => c,
+        }
+    }
+    /// Inverse of [`Self::code`].
+    #[must_use]
+    pub const fn from_code(code: u8) -> Self {
+        match code {
+            1 => Self::Imu,
+            2 => Self::Steering,
+            3 => Self::Wheel,
+            4 => Self::Gps,
+            5 => Self::Card,
+            6 => Self::Config,
+            7 => Self::System,
+            c => Self::Other(c),
+        }
+    }
+    /// Short name for reports.
+    #[must_use]
+    pub const fn as_str(self) -> &'static str {
+        match self {
+            Self::Imu => "imu",
+            Self::Steering => "steering",
+            Self::Wheel => "wheel",
+            Self::Gps => "gps",
+            Self::Card => "card",
+            Self::Config => "config",
+            Self::System => "system",
+            Self::Other(_) => "other",
+        }
+    }
+}
+
+/// A sensor or card fault, counted. Codes per source are listed in `FORMAT.md`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Fault {
+    /// Local time, µs since boot.
+    pub t_us: u64,
+    /// Where it happened.
+    pub source: FaultSource,
+    /// What happened, per source.
+    pub code: u8,
+    /// How many times since the previous fault record of the same kind.
+    pub count: u16,
+}
+
+/// Identity of the logger and firmware that wrote a log (file header).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct LogInfo<'a> {
+    /// Local time, µs since boot, when the log was opened.
+    pub t_us: u64,
+    /// Firmware version string.
+    pub firmware: &'a str,
+    /// Unique device id (the MCU's 96-bit UID on the board).
+    pub device_id: [u8; 12],
+    /// Nominal frame rate.
+    pub sample_rate_hz: u16,
+    /// Run number on this card (`RUN00001.WBL` is 1).
+    pub run: u32,
+}
+
+/// One channel of the frame, for self-description.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct ChannelDef<'a> {
+    /// Local time, µs since boot (the header's time).
+    pub t_us: u64,
+    /// Position of the field in the frame record.
+    pub index: u8,
+    /// Channel name, as in the CSV header without the unit.
+    pub name: &'a str,
+    /// Physical unit.
+    pub unit: &'a str,
+    /// Physical value = stored integer / `counts_per_unit`.
+    pub counts_per_unit: f32,
+}
+
+/// One `key=value` line of the configuration in force.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct ConfigLine<'a> {
+    /// Local time, µs since boot (the header's time).
+    pub t_us: u64,
+    /// The line, without newline.
+    pub text: &'a str,
+}
+
+/// Anything a card log holds.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Record<'a> {
+    /// 100 Hz sample frame.
+    Frame(Frame),
+    /// GPS fix.
+    Gps(GpsFix),
+    /// Local time / UTC pair.
+    UtcSync(UtcSync),
+    /// Wobble alert on or off.
+    Alert(Alert),
+    /// Rider marker.
+    Marker(Marker),
+    /// Frames lost before reaching the card.
+    Dropout(Dropout),
+    /// Counted sensor or card fault.
+    Fault(Fault),
+    /// Header: logger and firmware identity.
+    LogInfo(LogInfo<'a>),
+    /// Header: channel definition.
+    Channel(ChannelDef<'a>),
+    /// Header: configuration line.
+    Config(ConfigLine<'a>),
+}
+
+impl Record<'_> {
+    /// Local time of the record, µs since boot.
+    #[must_use]
+    pub fn t_us(&self) -> u64 {
+        match self {
+            Self::Frame(r) => r.t_us,
+            Self::Gps(r) => r.t_us,
+            Self::UtcSync(r) => r.t_us,
+            Self::Alert(r) => r.t_us,
+            Self::Marker(r) => r.t_us,
+            Self::Dropout(r) => r.t_us,
+            Self::Fault(r) => r.t_us,
+            Self::LogInfo(r) => r.t_us,
+            Self::Channel(r) => r.t_us,
+            Self::Config(r) => r.t_us,
+        }
+    }
+}

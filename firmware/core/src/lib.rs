@@ -1,0 +1,10 @@
+//! HAL-free core of the wobble logger.
+//!
+//! Everything that is logic lives here and runs unchanged on the STM32F405,
+//! in the QEMU image and on the host: the card format (encoder and decoder),
+//! sensor ingestion, the wobble detector and the logger state machine. No HAL
+//! types appear in this crate; boards plug peripherals in through traits.
+#![cfg_attr(not(any(test, feature = "std")), no_std)]
+#![warn(missing_docs)]
+
+pub mod format;
