@@ -1,1 +1,38 @@
-fn main() {}
+//! `wobblog`: the wobble logger's host tool.
+
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+
+use wobblog::cmd;
+
+/// Decode, inspect and analyse wobble-logger card logs.
+#[derive(Parser)]
+#[command(name = "wobblog", version, about)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    Info(cmd::info::Args),
+    Decode(cmd::decode::Args),
+    Encode(cmd::encode::Args),
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Info(args) => cmd::info::run(&args),
+        Command::Decode(args) => cmd::decode::run(&args),
+        Command::Encode(args) => cmd::encode::run(&args),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(err) => {
+            eprintln!("wobblog: {err}");
+            ExitCode::from(err.exit_code())
+        }
+    }
+}

@@ -1,0 +1,5 @@
+//! One module per `wobblog` subcommand: its clap arguments and its `run`.
+
+pub mod decode;
+pub mod encode;
+pub mod info;

@@ -1,0 +1,38 @@
+//! The CLI's error type and its mapping to exit codes.
+
+use std::path::{Path, PathBuf};
+
+/// A failure that ends a `wobblog` command.
+#[derive(Debug, thiserror::Error)]
+pub enum CliError {
+    /// Bad arguments or options (exit code 2).
+    #[error("{0}")]
+    Usage(String),
+    /// A file could not be read, written or understood (exit code 1).
+    #[error("{path}: {message}")]
+    File {
+        /// The file concerned.
+        path: PathBuf,
+        /// What is wrong with it.
+        message: String,
+    },
+}
+
+impl CliError {
+    /// A runtime failure about `path`.
+    pub fn file(path: &Path, message: impl std::fmt::Display) -> Self {
+        Self::File {
+            path: path.to_path_buf(),
+            message: message.to_string(),
+        }
+    }
+
+    /// The process exit code for this error.
+    #[must_use]
+    pub fn exit_code(&self) -> u8 {
+        match self {
+            Self::Usage(_) => 2,
+            Self::File { .. } => 1,
+        }
+    }
+}

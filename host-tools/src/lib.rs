@@ -1,0 +1,8 @@
+//! Library behind the `wobblog` CLI: reading card logs into rows, exports and
+//! analyses, reusing the firmware's core crate for everything the logger does.
+#![warn(missing_docs)]
+
+pub mod cmd;
+pub mod error;
+
+pub use error::CliError;
