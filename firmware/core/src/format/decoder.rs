@@ -1,0 +1,281 @@
+//! Streaming decoder: finds valid blocks in a byte stream, resynchronises
+//! after damage, and reports exactly what was lost.
+//!
+//! Blocks are expected at 512-byte steps. When the bytes at the expected
+//! place are not a valid block (bad CRC, garbage, a missing stretch), the
+//! decoder searches byte by byte for the next sync marker whose block passes
+//! its CRC. What was lost is computed from the headers on either side: the
+//! sequence numbers give the blocks, the frame counters give the frames, the
+//! time bases give the time span. Memory use is fixed; the caller feeds
+//! chunks of any size.
+
+use super::block::{Block, BlockError, BlockHeader, BLOCK_LEN, MAGIC};
+use super::codec::{RecordError, Records};
+use super::record::Record;
+
+/// A stretch of missing data between two valid blocks.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Gap {
+    /// Sequence number of the first missing block.
+    pub first_seq: u32,
+    /// Number of missing blocks.
+    pub blocks: u32,
+    /// Number of frames those blocks held.
+    pub frames: u32,
+    /// Time of the last frame before the gap (`None` at the start of a file).
+    pub from_us: Option<u64>,
+    /// Time base of the first block after the gap.
+    pub to_us: u64,
+}
+
+/// Why bytes were skipped.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum SkipCause {
+    /// A block marker was there but the block failed its CRC.
+    Damaged,
+    /// A valid block written by an incompatible major version.
+    UnsupportedVersion(u8),
+    /// A block whose CRC matched but whose header is inconsistent.
+    BadHeader,
+    /// Bytes that are not a block at all.
+    Garbage,
+    /// The file ends inside a block.
+    TruncatedTail,
+}
+
+/// Something the decoder found, in file order.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Event<'a> {
+    /// A record of a valid block.
+    Record(Record<'a>),
+    /// Blocks missing before the next valid block.
+    Gap(Gap),
+    /// Bytes that were not part of any valid block.
+    Skipped {
+        /// File offset of the first skipped byte.
+        offset: u64,
+        /// Number of bytes skipped.
+        len: u64,
+        /// Why.
+        cause: SkipCause,
+    },
+    /// A block passed its CRC but a record in it could not be read; the
+    /// rest of that block is lost.
+    BadRecord {
+        /// Sequence number of the block.
+        seq: u32,
+        /// What was wrong.
+        error: RecordError,
+    },
+    /// Consecutive frames whose times go backwards.
+    TimeJump {
+        /// Time of the previous frame.
+        from_us: u64,
+        /// Time of this frame.
+        to_us: u64,
+    },
+}
+
+/// Running totals of a decode.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct DecodeStats {
+    /// Valid blocks decoded.
+    pub blocks: u64,
+    /// Records decoded.
+    pub records: u64,
+    /// Frames decoded.
+    pub frames: u64,
+    /// Blocks missing (sum over gaps).
+    pub blocks_lost: u64,
+    /// Frames in missing blocks (sum over gaps).
+    pub frames_lost: u64,
+    /// Places where a damaged block (marker present, CRC wrong) was skipped.
+    pub damaged_blocks: u64,
+    /// Bytes that were not part of a valid block.
+    pub bytes_skipped: u64,
+    /// Records in valid blocks that could not be read.
+    pub bad_records: u64,
+    /// Length-prefixed records of unknown kinds skipped.
+    pub unknown_records: u64,
+    /// Frames whose time went backwards.
+    pub time_jumps: u64,
+    /// Blocks whose sequence number did not follow (stale or reordered data).
+    pub out_of_order_blocks: u64,
+}
+
+/// What the decoder remembers of the last valid block.
+#[derive(Clone, Copy, Debug)]
+struct Last {
+    seq: u32,
+    frames_end: u32,
+}
+
+/// The streaming decoder.
+#[derive(Clone, Debug, Default)]
+pub struct Decoder {
+    stats: DecodeStats,
+    last: Option<Last>,
+    last_frame_us: Option<u64>,
+    /// Offset in the stream of the next byte the decoder will look at.
+    offset: u64,
+}
+
+impl Decoder {
+    /// A decoder at the start of a file.
+    #[must_use]
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Totals so far.
+    #[must_use]
+    pub fn stats(&self) -> &DecodeStats {
+        &self.stats
+    }
+
+    /// Decodes what it can of `chunk`, the bytes of the stream from the first
+    /// byte not yet consumed. Returns how many bytes it consumed; the caller
+    /// passes the rest again, followed by more data. With `at_end` the chunk
+    /// is the end of the stream and everything is consumed.
+    pub fn feed<'c>(
+        &mut self,
+        chunk: &'c [u8],
+        at_end: bool,
+        visit: &mut impl FnMut(Event<'c>),
+    ) -> usize {
+        let mut pos = 0;
+        // A stretch of bytes being skipped, reported once it ends.
+        let mut skip: Option<(usize, SkipCause)> = None;
+        while chunk.len() - pos >= BLOCK_LEN {
+            let block = as_block(&chunk[pos..]);
+            match BlockHeader::parse(block) {
+                Ok(header) => {
+                    self.flush_skip(&mut skip, chunk, pos, visit);
+                    self.block(&header, block, visit);
+                    pos += BLOCK_LEN;
+                }
+                Err(err) => {
+                    if skip.is_none() {
+                        skip = Some((pos, cause_of(err)));
+                        if err == BlockError::BadCrc {
+                            self.stats.damaged_blocks += 1;
+                        }
+                    }
+                    pos = next_marker(chunk, pos + 1);
+                }
+            }
+        }
+        if at_end && pos < chunk.len() {
+            skip.get_or_insert((pos, SkipCause::TruncatedTail));
+            pos = chunk.len();
+        }
+        self.flush_skip(&mut skip, chunk, pos, visit);
+        self.offset += pos as u64;
+        pos
+    }
+
+    fn flush_skip<'c>(
+        &mut self,
+        skip: &mut Option<(usize, SkipCause)>,
+        chunk: &'c [u8],
+        end: usize,
+        visit: &mut impl FnMut(Event<'c>),
+    ) {
+        let Some((start, cause)) = skip.take() else { return };
+        let len = (end.min(chunk.len()) - start) as u64;
+        if len == 0 {
+            return;
+        }
+        self.stats.bytes_skipped += len;
+        visit(Event::Skipped { offset: self.offset + start as u64, len, cause });
+    }
+
+    fn block<'c>(&mut self, header: &BlockHeader, block: &'c Block, visit: &mut impl FnMut(Event<'c>)) {
+        self.stats.blocks += 1;
+        self.account_gap(header, visit);
+        let mut frames = 0u32;
+        let mut records = Records::new(header.payload(block), header.t0_us);
+        for item in records.by_ref() {
+            match item {
+                Ok(record) => {
+                    self.stats.records += 1;
+                    if let Record::Frame(f) = &record {
+                        frames += 1;
+                        if let Some(prev) = self.last_frame_us.filter(|&p| f.t_us < p) {
+                            self.stats.time_jumps += 1;
+                            visit(Event::TimeJump { from_us: prev, to_us: f.t_us });
+                        }
+                        self.last_frame_us = Some(f.t_us);
+                    }
+                    visit(Event::Record(record));
+                }
+                Err(error) => {
+                    self.stats.bad_records += 1;
+                    visit(Event::BadRecord { seq: header.seq, error });
+                }
+            }
+        }
+        self.stats.frames += u64::from(frames);
+        self.stats.unknown_records += u64::from(records.skipped_unknown());
+        self.last = Some(Last { seq: header.seq, frames_end: header.first_frame.wrapping_add(frames) });
+    }
+
+    /// Compares a new block's header with the previous valid block's.
+    fn account_gap<'c>(&mut self, header: &BlockHeader, visit: &mut impl FnMut(Event<'c>)) {
+        let (expected_seq, frames_end) = match self.last {
+            Some(last) => (last.seq.wrapping_add(1), last.frames_end),
+            None => (0, 0),
+        };
+        if header.seq == expected_seq {
+            return;
+        }
+        if header.seq < expected_seq {
+            // Not a loss we can size: stale data or a restarted writer.
+            self.stats.out_of_order_blocks += 1;
+            return;
+        }
+        let gap = Gap {
+            first_seq: expected_seq,
+            blocks: header.seq - expected_seq,
+            frames: header.first_frame.saturating_sub(frames_end),
+            from_us: self.last_frame_us,
+            to_us: header.t0_us,
+        };
+        self.stats.blocks_lost += u64::from(gap.blocks);
+        self.stats.frames_lost += u64::from(gap.frames);
+        visit(Event::Gap(gap));
+    }
+}
+
+fn cause_of(err: BlockError) -> SkipCause {
+    match err {
+        BlockError::BadMagic => SkipCause::Garbage,
+        BlockError::BadCrc => SkipCause::Damaged,
+        BlockError::UnsupportedVersion(v) => SkipCause::UnsupportedVersion(v),
+        BlockError::BadLength(_) => SkipCause::BadHeader,
+    }
+}
+
+/// Position of the next sync marker at or after `from`, or the point from
+/// which fewer than a block's bytes remain (the caller then needs more data).
+fn next_marker(chunk: &[u8], from: usize) -> usize {
+    let limit = chunk.len().saturating_sub(BLOCK_LEN - 1);
+    if from >= limit {
+        return limit.max(from.min(chunk.len()));
+    }
+    // The marker's first byte is rare in records; memchr-like scanning on it
+    // keeps resynchronisation fast through long garbage.
+    let window = &chunk[from..limit + MAGIC.len() - 1];
+    window
+        .windows(MAGIC.len())
+        .position(|w| w == MAGIC)
+        .map_or(limit, |i| from + i)
+}
+
+fn as_block(bytes: &[u8]) -> &Block {
+    // The caller checked there are at least BLOCK_LEN bytes.
+    bytes[..BLOCK_LEN].try_into().unwrap_or(&[0; BLOCK_LEN])
+}
