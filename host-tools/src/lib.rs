@@ -4,5 +4,11 @@
 
 pub mod cmd;
 pub mod error;
+pub mod export;
+pub mod losses;
+pub mod reader;
+pub mod rows;
+pub mod summary;
+pub mod time;
 
 pub use error::CliError;

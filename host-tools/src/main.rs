@@ -16,8 +16,11 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
+    /// Summarise a log: duration, samples, dropouts, lost blocks, GPS coverage, alerts.
     Info(cmd::info::Args),
+    /// Decode a log into one row per 100 Hz frame (CSV or JSON lines).
     Decode(cmd::decode::Args),
+    /// Build a log from a CSV through the firmware's encoder (tests and demos).
     Encode(cmd::encode::Args),
 }
 

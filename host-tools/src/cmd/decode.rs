@@ -1,12 +1,74 @@
-//! `wobblog decode`.
+//! `wobblog decode`: one row per 100 Hz frame, as CSV or JSON lines.
 
+use std::fs::File;
+use std::io::{BufWriter, Write};
+use std::path::{Path, PathBuf};
+
+use crate::export::{Format, RowWriter};
+use crate::losses::Losses;
+use crate::reader::read_log;
+use crate::rows::RowAssembler;
 use crate::CliError;
 
 /// Arguments of `wobblog decode`.
 #[derive(clap::Args)]
-pub struct Args {}
+pub struct Args {
+    /// The card log (`RUNnnnnn.WBL`).
+    pub log: PathBuf,
+    /// Output format.
+    #[arg(long, value_enum, default_value_t = Format::Csv)]
+    pub format: Format,
+    /// Output file; standard output if absent.
+    #[arg(short, long)]
+    pub output: Option<PathBuf>,
+}
 
 /// Runs `wobblog decode`.
-pub fn run(_args: &Args) -> Result<(), CliError> {
-    Err(CliError::Usage("not yet".into()))
+pub fn run(args: &Args) -> Result<(), CliError> {
+    let out: Box<dyn Write> = match &args.output {
+        Some(path) => Box::new(File::create(path).map_err(|e| CliError::file(path, e))?),
+        None => Box::new(std::io::stdout().lock()),
+    };
+    let out_name = args.output.as_deref().unwrap_or(Path::new("<stdout>"));
+    let losses = decode_to(
+        &args.log,
+        args.format,
+        BufWriter::with_capacity(1 << 16, out),
+        out_name,
+    )?;
+    for line in losses.describe() {
+        eprintln!("wobblog: {}: warning: {line}", args.log.display());
+    }
+    Ok(())
+}
+
+/// Decodes `log` into `out`; returns what could not be recovered.
+pub fn decode_to(
+    log: &Path,
+    format: Format,
+    out: impl Write,
+    out_name: &Path,
+) -> Result<Losses, CliError> {
+    let write_err = |e: &dyn std::fmt::Display| CliError::file(out_name, e);
+    let mut writer = RowWriter::new(format, out);
+    let mut rows = RowAssembler::new();
+    let mut losses = Losses::default();
+    let mut failure: Option<std::io::Error> = None;
+    let mut emit = |row: &crate::rows::Row| {
+        if failure.is_none() {
+            failure = writer.write(row).err();
+        }
+    };
+    read_log(log, |event| {
+        losses.observe(&event);
+        if let wobble_core::format::Event::Record(record) = event {
+            rows.push(&record, &mut emit);
+        }
+    })?;
+    rows.finish(&mut emit);
+    if let Some(e) = failure {
+        return Err(write_err(&e));
+    }
+    writer.flush().map_err(|e| write_err(&e))?;
+    Ok(losses)
 }

@@ -1,12 +1,202 @@
-//! `wobblog encode`.
+//! `wobblog encode`: build a card log from a CSV, through the firmware's encoder.
 
+use std::fs::File;
+use std::io::{BufWriter, Write};
+use std::path::{Path, PathBuf};
+
+use wobble_core::format::header::header_records;
+use wobble_core::format::{
+    quantise_i16, quantise_i32, quantise_u16, BlockEncoder, FixMode, Frame, GpsFix, LogInfo,
+    Record, ACCEL_COUNTS_PER_G, EDGE_AGE_NONE, GYRO_COUNTS_PER_DPS, STEER_COUNTS_PER_DEG,
+};
+
+use crate::export::CSV_COLUMNS;
 use crate::CliError;
 
 /// Arguments of `wobblog encode`.
 #[derive(clap::Args)]
-pub struct Args {}
+pub struct Args {
+    /// Input CSV with a header line; columns as `wobblog decode` writes them
+    /// (`t_s` required, missing channels are zero, other columns ignored).
+    #[arg(long)]
+    pub csv: PathBuf,
+    /// The card log to write.
+    #[arg(short, long)]
+    pub output: PathBuf,
+}
+
+/// A GPS fix is repeated at least this often while the CSV's GPS columns
+/// stay the same, so decoded rows keep their fix.
+const GPS_REPEAT_US: u64 = 500_000;
 
 /// Runs `wobblog encode`.
-pub fn run(_args: &Args) -> Result<(), CliError> {
-    Err(CliError::Usage("not yet".into()))
+pub fn run(args: &Args) -> Result<(), CliError> {
+    let input = File::open(&args.csv).map_err(|e| CliError::file(&args.csv, e))?;
+    let output = File::create(&args.output).map_err(|e| CliError::file(&args.output, e))?;
+    encode(input, &args.csv, BufWriter::new(output), &args.output)
+}
+
+/// Index of each known column in the CSV, if present.
+struct Columns([Option<usize>; CSV_COLUMNS.len()]);
+
+impl Columns {
+    fn new(header: &csv::StringRecord) -> Self {
+        Self(CSV_COLUMNS.map(|name| header.iter().position(|h| h.trim() == name)))
+    }
+}
+
+/// Encodes CSV rows from `input` into a log written to `output`.
+pub fn encode(
+    input: impl std::io::Read,
+    in_name: &Path,
+    mut output: impl Write,
+    out_name: &Path,
+) -> Result<(), CliError> {
+    let mut reader = csv::ReaderBuilder::new()
+        .trim(csv::Trim::All)
+        .from_reader(input);
+    let header = reader
+        .headers()
+        .map_err(|e| CliError::file(in_name, e))?
+        .clone();
+    let columns = Columns::new(&header);
+    if columns.0[0].is_none() {
+        return Err(CliError::file(
+            in_name,
+            "no `t_s` column in the header line",
+        ));
+    }
+    let mut encoder = BlockEncoder::new();
+    let mut write = |block: Option<&[u8; 512]>| -> Result<(), CliError> {
+        block.map_or(Ok(()), |b| {
+            output.write_all(b).map_err(|e| CliError::file(out_name, e))
+        })
+    };
+    let mut last_gps: Option<(u64, GpsFix)> = None;
+    let mut record = csv::StringRecord::new();
+    let mut rows = 0u64;
+    while reader
+        .read_record(&mut record)
+        .map_err(|e| CliError::file(in_name, e))?
+    {
+        let line = record.position().map_or(0, |p| p.line());
+        let row = parse_row(&columns, &record)
+            .map_err(|e| CliError::file(in_name, format!("line {line}: {e}")))?;
+        if rows == 0 {
+            let info = LogInfo {
+                t_us: row.frame.t_us,
+                firmware: concat!("wobblog-encode ", env!("CARGO_PKG_VERSION")),
+                device_id: [0; 12],
+                sample_rate_hz: 100,
+                run: 0,
+            };
+            for rec in header_records(info, []) {
+                write(encoder.push(&rec).map_err(|e| CliError::file(in_name, e))?)?;
+            }
+        }
+        rows += 1;
+        write(
+            encoder
+                .push(&Record::Frame(row.frame))
+                .map_err(|e| CliError::file(in_name, e))?,
+        )?;
+        if let Some(fix) = gps_update(&last_gps, row.gps, row.frame.t_us) {
+            write(
+                encoder
+                    .push(&Record::Gps(fix))
+                    .map_err(|e| CliError::file(in_name, e))?,
+            )?;
+            last_gps = Some((row.frame.t_us, fix));
+        }
+    }
+    if rows == 0 {
+        return Err(CliError::file(in_name, "no data rows"));
+    }
+    write(encoder.finish())?;
+    output.flush().map_err(|e| CliError::file(out_name, e))
+}
+
+/// One parsed CSV row.
+struct Row {
+    frame: Frame,
+    gps: Option<GpsFix>,
+}
+
+fn parse_row(columns: &Columns, record: &csv::StringRecord) -> Result<Row, String> {
+    let field = |i: usize| {
+        columns.0[i]
+            .and_then(|c| record.get(c))
+            .filter(|f| !f.is_empty())
+    };
+    let number = |i: usize| -> Result<f64, String> {
+        field(i).map_or(Ok(0.0), |f| {
+            f.parse::<f64>()
+                .map_err(|_| format!("{}: not a number: {f:?}", CSV_COLUMNS[i]))
+        })
+    };
+    let t_s = number(0)?;
+    if !(0.0..=1.8e13).contains(&t_s) {
+        return Err(format!("t_s: {t_s} is not a time since boot in seconds"));
+    }
+    let t_us = (t_s * 1e6).round() as u64;
+    let q = |i: usize, scale: f32| number(i).map(|v| quantise_i16(v as f32, scale));
+    let frame = Frame {
+        t_us,
+        accel: [
+            q(1, ACCEL_COUNTS_PER_G)?,
+            q(2, ACCEL_COUNTS_PER_G)?,
+            q(3, ACCEL_COUNTS_PER_G)?,
+        ],
+        gyro: [
+            q(4, GYRO_COUNTS_PER_DPS)?,
+            q(5, GYRO_COUNTS_PER_DPS)?,
+            q(6, GYRO_COUNTS_PER_DPS)?,
+        ],
+        steer_cdeg: q(7, STEER_COUNTS_PER_DEG)?,
+        wheel_count: 0,
+        wheel_edge_age_us: EDGE_AGE_NONE,
+        speed_mm_s: quantise_u16(number(8)? as f32, 1000.0),
+        status: Default::default(),
+    };
+    let gps = match (field(9), field(10)) {
+        (Some(_), Some(_)) => {
+            let fix = match field(12) {
+                Some("3d") => FixMode::Fix3d,
+                Some("2d") => FixMode::Fix2d,
+                Some("none") => FixMode::None,
+                other => return Err(format!("gps_fix: expected 2d, 3d or none, found {other:?}")),
+            };
+            Some(GpsFix {
+                t_us,
+                lat_e7: Some(quantise_i32(number(9)?, 1e7)),
+                lon_e7: Some(quantise_i32(number(10)?, 1e7)),
+                speed_cm_s: field(11)
+                    .map(|_| number(11))
+                    .transpose()?
+                    .map(|v| quantise_u16(v as f32, 100.0)),
+                fix,
+                ..GpsFix::default()
+            })
+        }
+        (None, None) => None,
+        _ => return Err("gps_lat_deg and gps_lon_deg must both be given or both empty".into()),
+    };
+    Ok(Row { frame, gps })
+}
+
+/// The GPS record to write at `t_us`, if any: when the fix changes, when it
+/// has been unchanged for [`GPS_REPEAT_US`], and a no-fix record when it ends.
+fn gps_update(last: &Option<(u64, GpsFix)>, now: Option<GpsFix>, t_us: u64) -> Option<GpsFix> {
+    let same = |a: &GpsFix, b: &GpsFix| {
+        (a.lat_e7, a.lon_e7, a.speed_cm_s, a.fix) == (b.lat_e7, b.lon_e7, b.speed_cm_s, b.fix)
+    };
+    match (last, now) {
+        (Some((t, prev)), Some(fix)) if same(prev, &fix) && t_us < t + GPS_REPEAT_US => None,
+        (_, Some(fix)) => Some(fix),
+        (Some((_, prev)), None) if prev.fix != FixMode::None => Some(GpsFix {
+            t_us,
+            ..GpsFix::default()
+        }),
+        _ => None,
+    }
 }

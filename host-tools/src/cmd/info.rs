@@ -1,12 +1,109 @@
-//! `wobblog info`.
+//! `wobblog info`: what a log holds and what it lost.
 
+use std::path::PathBuf;
+
+use crate::reader::read_log;
+use crate::summary::{Summary, SummaryBuilder};
 use crate::CliError;
 
 /// Arguments of `wobblog info`.
 #[derive(clap::Args)]
-pub struct Args {}
+pub struct Args {
+    /// The card log (`RUNnnnnn.WBL`).
+    pub log: PathBuf,
+    /// Print one JSON object instead of text.
+    #[arg(long)]
+    pub json: bool,
+}
 
 /// Runs `wobblog info`.
-pub fn run(_args: &Args) -> Result<(), CliError> {
-    Err(CliError::Usage("not yet".into()))
+pub fn run(args: &Args) -> Result<(), CliError> {
+    let summary = summarise(&args.log)?;
+    if args.json {
+        let text =
+            serde_json::to_string_pretty(&summary).map_err(|e| CliError::file(&args.log, e))?;
+        println!("{text}");
+    } else {
+        print!("{}", render(&args.log, &summary));
+    }
+    Ok(())
+}
+
+/// Decodes the log at `path` into a summary.
+pub fn summarise(path: &std::path::Path) -> Result<Summary, CliError> {
+    let mut builder = SummaryBuilder::new();
+    let stats = read_log(path, |event| builder.observe(&event))?;
+    Ok(builder.finish(&stats))
+}
+
+fn render(path: &std::path::Path, s: &Summary) -> String {
+    use std::fmt::Write;
+    let mut o = String::new();
+    let opt = |v: &Option<String>| v.clone().unwrap_or_else(|| "unknown".into());
+    let _ = writeln!(o, "log:          {}", path.display());
+    let _ = writeln!(
+        o,
+        "firmware:     {}  device {}  run {}",
+        opt(&s.firmware),
+        opt(&s.device_id),
+        s.run.map_or("?".into(), |r| r.to_string())
+    );
+    let span = match (s.start_s, s.end_s) {
+        (Some(a), Some(b)) => format!("{a:.3} s to {b:.3} s since boot"),
+        _ => "no frames".into(),
+    };
+    let _ = writeln!(o, "duration:     {:.2} s ({span})", s.duration_s);
+    let _ = writeln!(
+        o,
+        "samples:      {} at {} Hz",
+        s.samples,
+        s.sample_rate_hz.unwrap_or(100)
+    );
+    let dropouts: Vec<String> = s.dropouts.iter().map(|(k, v)| format!("{v} {k}")).collect();
+    let _ = writeln!(
+        o,
+        "dropouts:     {} frames dropped by the logger{}",
+        s.frames_dropped,
+        if dropouts.is_empty() {
+            String::new()
+        } else {
+            format!(" ({})", dropouts.join(", "))
+        }
+    );
+    let _ = writeln!(
+        o,
+        "lost blocks:  {} ({} frames), {} damaged, {} bytes skipped",
+        s.lost_blocks, s.frames_lost, s.damaged_blocks, s.bytes_skipped
+    );
+    let _ = writeln!(
+        o,
+        "gps:          {} fixes, {:.1} % of samples with a position, first UTC {}",
+        s.gps_fixes,
+        s.gps_coverage_pct,
+        opt(&s.first_utc)
+    );
+    let _ = writeln!(o, "alerts:       {}", s.alerts.len());
+    for a in &s.alerts {
+        let off = a.off_s.map_or("end of log".into(), |t| format!("{t:.2} s"));
+        let _ = writeln!(
+            o,
+            "  {:.2} s to {off}: {:.2} Hz, {:.2} deg",
+            a.on_s, a.freq_hz, a.amp_deg
+        );
+    }
+    let _ = writeln!(o, "markers:      {}", s.markers.len());
+    let faults: Vec<String> = s.faults.iter().map(|(k, v)| format!("{k} {v}")).collect();
+    let _ = writeln!(
+        o,
+        "faults:       {}",
+        if faults.is_empty() {
+            "none".into()
+        } else {
+            faults.join(", ")
+        }
+    );
+    for line in s.losses.describe() {
+        let _ = writeln!(o, "  {line}");
+    }
+    o
 }

@@ -124,14 +124,19 @@ impl Writer<'_> {
 /// Returns the bytes used, `Ok(None)` if `out` is too short, or an error if
 /// the record can never be encoded. A frame must not precede the cursor (the
 /// encoder starts a new block for that).
-pub fn encode(rec: &Record<'_>, cursor_us: u64, out: &mut [u8]) -> Result<Option<usize>, EncodeError> {
+pub fn encode(
+    rec: &Record<'_>,
+    cursor_us: u64,
+    out: &mut [u8],
+) -> Result<Option<usize>, EncodeError> {
     let t = rec.t_us();
     let sdelta = i64::try_from(i128::from(t) - i128::from(cursor_us))
         .map_err(|_| EncodeError::TimeOutOfRange)?;
     let mut w = Writer { out, len: 0 };
     let fits = match rec {
         Record::Frame(f) => {
-            let delta = i64::try_from(t.saturating_sub(cursor_us)).map_err(|_| EncodeError::TimeOutOfRange)?;
+            let delta = i64::try_from(t.saturating_sub(cursor_us))
+                .map_err(|_| EncodeError::TimeOutOfRange)?;
             encode_frame(&mut w, f, delta)
         }
         Record::Gps(g) => encode_gps(&mut w, g, sdelta),
@@ -152,21 +157,36 @@ pub fn encode(rec: &Record<'_>, cursor_us: u64, out: &mut [u8]) -> Result<Option
         }
         Record::Fault(x) => {
             let c = x.count.to_le_bytes();
-            fixed(&mut w, TAG_FAULT, sdelta, &[x.source.code(), x.code, c[0], c[1]])
+            fixed(
+                &mut w,
+                TAG_FAULT,
+                sdelta,
+                &[x.source.code(), x.code, c[0], c[1]],
+            )
         }
         Record::LogInfo(i) => {
             let mut head = [0u8; 18];
             head[..2].copy_from_slice(&i.sample_rate_hz.to_le_bytes());
             head[2..6].copy_from_slice(&i.run.to_le_bytes());
             head[6..].copy_from_slice(&i.device_id);
-            sized(&mut w, TAG_LOG_INFO, sdelta, &[&head, i.firmware.as_bytes()])?
+            sized(
+                &mut w,
+                TAG_LOG_INFO,
+                sdelta,
+                &[&head, i.firmware.as_bytes()],
+            )?
         }
         Record::Channel(c) => {
             let name = c.name.as_bytes();
             let name_len = u8::try_from(name.len()).map_err(|_| EncodeError::TooLong)?;
             let s = c.counts_per_unit.to_le_bytes();
             let head = [c.index, s[0], s[1], s[2], s[3], name_len];
-            sized(&mut w, TAG_CHANNEL, sdelta, &[&head, name, c.unit.as_bytes()])?
+            sized(
+                &mut w,
+                TAG_CHANNEL,
+                sdelta,
+                &[&head, name, c.unit.as_bytes()],
+            )?
         }
         Record::Config(c) => sized(&mut w, TAG_CONFIG, sdelta, &[c.text.as_bytes()])?,
     };
@@ -236,7 +256,12 @@ fn fixed(w: &mut Writer<'_>, tag: u8, sdelta: i64, body: &[u8]) -> Option<()> {
 
 /// A length-prefixed record: tag, body length, then the body (signed time
 /// delta followed by `parts`).
-fn sized(w: &mut Writer<'_>, tag: u8, sdelta: i64, parts: &[&[u8]]) -> Result<Option<()>, EncodeError> {
+fn sized(
+    w: &mut Writer<'_>,
+    tag: u8,
+    sdelta: i64,
+    parts: &[&[u8]],
+) -> Result<Option<()>, EncodeError> {
     let mut delta = [0u8; varint::MAX_LEN];
     let delta_len = varint::write_u64(varint::zigzag(sdelta), &mut delta).unwrap_or(0);
     let body_len = delta_len + parts.iter().map(|p| p.len()).sum::<usize>();
@@ -258,7 +283,10 @@ struct Reader<'a> {
 
 impl<'a> Reader<'a> {
     fn take<const N: usize>(&mut self) -> Result<[u8; N], RecordError> {
-        let slice = self.bytes.get(self.pos..self.pos + N).ok_or(RecordError::Truncated)?;
+        let slice = self
+            .bytes
+            .get(self.pos..self.pos + N)
+            .ok_or(RecordError::Truncated)?;
         self.pos += N;
         let mut out = [0u8; N];
         out.copy_from_slice(slice);
@@ -311,7 +339,13 @@ impl<'a> Records<'a> {
     /// Records of `payload`, a block whose time base is `t0_us`.
     #[must_use]
     pub fn new(payload: &'a [u8], t0_us: u64) -> Self {
-        Self { payload, pos: 0, cursor_us: t0_us, skipped_unknown: 0, failed: false }
+        Self {
+            payload,
+            pos: 0,
+            cursor_us: t0_us,
+            skipped_unknown: 0,
+            failed: false,
+        }
     }
 
     /// Length-prefixed records of unknown kinds skipped so far.
@@ -332,17 +366,31 @@ impl<'a> Records<'a> {
                 return Ok(None);
             };
             if tag >= FIRST_SIZED_TAG {
-                let len = usize::from(*self.payload.get(self.pos + 1).ok_or(RecordError::Truncated)?);
+                let len = usize::from(
+                    *self
+                        .payload
+                        .get(self.pos + 1)
+                        .ok_or(RecordError::Truncated)?,
+                );
                 let start = self.pos + 2;
-                let body = self.payload.get(start..start + len).ok_or(RecordError::Truncated)?;
+                let body = self
+                    .payload
+                    .get(start..start + len)
+                    .ok_or(RecordError::Truncated)?;
                 self.pos = start + len;
-                let mut r = Reader { bytes: body, pos: 0 };
+                let mut r = Reader {
+                    bytes: body,
+                    pos: 0,
+                };
                 match self.sized_record(tag, &mut r)? {
                     Some(rec) => return Ok(Some(rec)),
                     None => self.skipped_unknown += 1,
                 }
             } else {
-                let mut r = Reader { bytes: self.payload, pos: self.pos + 1 };
+                let mut r = Reader {
+                    bytes: self.payload,
+                    pos: self.pos + 1,
+                };
                 let rec = self.fixed_record(tag, &mut r)?;
                 self.pos = r.pos;
                 return Ok(Some(rec));
@@ -384,7 +432,12 @@ impl<'a> Records<'a> {
                     1 => true,
                     _ => return Err(RecordError::Invalid(tag)),
                 };
-                Record::Alert(Alert { t_us, on, freq_chz: r.u16()?, amp_cdeg: r.u16()? })
+                Record::Alert(Alert {
+                    t_us,
+                    on,
+                    freq_chz: r.u16()?,
+                    amp_cdeg: r.u16()?,
+                })
             }
             TAG_MARKER => {
                 let t_us = self.signed_time(r, tag)?;
@@ -394,12 +447,21 @@ impl<'a> Records<'a> {
                 let t_us = self.signed_time(r, tag)?;
                 let frames_lost = r.u32()?;
                 let reason = DropoutReason::from_code(r.u8()?);
-                Record::Dropout(Dropout { t_us, frames_lost, reason })
+                Record::Dropout(Dropout {
+                    t_us,
+                    frames_lost,
+                    reason,
+                })
             }
             TAG_FAULT => {
                 let t_us = self.signed_time(r, tag)?;
                 let source = FaultSource::from_code(r.u8()?);
-                Record::Fault(Fault { t_us, source, code: r.u8()?, count: r.u16()? })
+                Record::Fault(Fault {
+                    t_us,
+                    source,
+                    code: r.u8()?,
+                    count: r.u16()?,
+                })
             }
             other => return Err(RecordError::UnknownTag(other)),
         })
@@ -415,9 +477,16 @@ impl<'a> Records<'a> {
             _ => return Err(RecordError::Invalid(TAG_GPS)),
         };
         let has = |bit: u8| flags & bit != 0;
-        let mut g = GpsFix { t_us, fix, ..GpsFix::default() };
+        let mut g = GpsFix {
+            t_us,
+            fix,
+            ..GpsFix::default()
+        };
         if has(GPS_UTC) {
-            g.utc = Some(UtcTime { days_since_2000: r.u16()?, ms_of_day: r.u32()? });
+            g.utc = Some(UtcTime {
+                days_since_2000: r.u16()?,
+                ms_of_day: r.u32()?,
+            });
         }
         if has(GPS_POS) {
             g.lat_e7 = Some(r.i32()?);
@@ -453,7 +522,13 @@ impl<'a> Records<'a> {
                 let run = r.u32()?;
                 let device_id = r.take::<12>()?;
                 let firmware = Reader::str(r.rest(), tag)?;
-                Record::LogInfo(LogInfo { t_us, firmware, device_id, sample_rate_hz, run })
+                Record::LogInfo(LogInfo {
+                    t_us,
+                    firmware,
+                    device_id,
+                    sample_rate_hz,
+                    run,
+                })
             }
             TAG_CHANNEL => {
                 let index = r.u8()?;
@@ -463,9 +538,18 @@ impl<'a> Records<'a> {
                 let name = rest.get(..name_len).ok_or(RecordError::Truncated)?;
                 let name = Reader::str(name, tag)?;
                 let unit = Reader::str(&rest[name_len..], tag)?;
-                Record::Channel(ChannelDef { t_us, index, name, unit, counts_per_unit })
+                Record::Channel(ChannelDef {
+                    t_us,
+                    index,
+                    name,
+                    unit,
+                    counts_per_unit,
+                })
             }
-            _ => Record::Config(ConfigLine { t_us, text: Reader::str(r.rest(), tag)? }),
+            _ => Record::Config(ConfigLine {
+                t_us,
+                text: Reader::str(r.rest(), tag)?,
+            }),
         }))
     }
 }

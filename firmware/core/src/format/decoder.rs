@@ -184,16 +184,27 @@ impl Decoder {
         end: usize,
         visit: &mut impl FnMut(Event<'c>),
     ) {
-        let Some((start, cause)) = skip.take() else { return };
+        let Some((start, cause)) = skip.take() else {
+            return;
+        };
         let len = (end.min(chunk.len()) - start) as u64;
         if len == 0 {
             return;
         }
         self.stats.bytes_skipped += len;
-        visit(Event::Skipped { offset: self.offset + start as u64, len, cause });
+        visit(Event::Skipped {
+            offset: self.offset + start as u64,
+            len,
+            cause,
+        });
     }
 
-    fn block<'c>(&mut self, header: &BlockHeader, block: &'c Block, visit: &mut impl FnMut(Event<'c>)) {
+    fn block<'c>(
+        &mut self,
+        header: &BlockHeader,
+        block: &'c Block,
+        visit: &mut impl FnMut(Event<'c>),
+    ) {
         self.stats.blocks += 1;
         self.account_gap(header, visit);
         let mut frames = 0u32;
@@ -206,7 +217,10 @@ impl Decoder {
                         frames += 1;
                         if let Some(prev) = self.last_frame_us.filter(|&p| f.t_us < p) {
                             self.stats.time_jumps += 1;
-                            visit(Event::TimeJump { from_us: prev, to_us: f.t_us });
+                            visit(Event::TimeJump {
+                                from_us: prev,
+                                to_us: f.t_us,
+                            });
                         }
                         self.last_frame_us = Some(f.t_us);
                     }
@@ -214,13 +228,19 @@ impl Decoder {
                 }
                 Err(error) => {
                     self.stats.bad_records += 1;
-                    visit(Event::BadRecord { seq: header.seq, error });
+                    visit(Event::BadRecord {
+                        seq: header.seq,
+                        error,
+                    });
                 }
             }
         }
         self.stats.frames += u64::from(frames);
         self.stats.unknown_records += u64::from(records.skipped_unknown());
-        self.last = Some(Last { seq: header.seq, frames_end: header.first_frame.wrapping_add(frames) });
+        self.last = Some(Last {
+            seq: header.seq,
+            frames_end: header.first_frame.wrapping_add(frames),
+        });
     }
 
     /// Compares a new block's header with the previous valid block's.

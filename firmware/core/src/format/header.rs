@@ -30,10 +30,24 @@ pub fn header_records<'a>(
     config: impl IntoIterator<Item = &'a str> + 'a,
 ) -> impl Iterator<Item = Record<'a>> + 'a {
     let t_us = info.t_us;
-    let channels = FRAME_CHANNELS.iter().zip(0u8..).map(move |(&(name, unit, counts_per_unit), index)| {
-        Record::Channel(ChannelDef { t_us, index, name, unit, counts_per_unit })
-    });
+    let channels =
+        FRAME_CHANNELS
+            .iter()
+            .zip(0u8..)
+            .map(move |(&(name, unit, counts_per_unit), index)| {
+                Record::Channel(ChannelDef {
+                    t_us,
+                    index,
+                    name,
+                    unit,
+                    counts_per_unit,
+                })
+            });
     core::iter::once(Record::LogInfo(info))
         .chain(channels)
-        .chain(config.into_iter().map(move |text| Record::Config(ConfigLine { t_us, text })))
+        .chain(
+            config
+                .into_iter()
+                .map(move |text| Record::Config(ConfigLine { t_us, text })),
+        )
 }

@@ -1,0 +1,147 @@
+//! Writing rows as CSV or JSON lines.
+
+use std::io::Write;
+
+use serde::Serialize;
+
+use crate::rows::Row;
+
+/// CSV column names, units in the names. `wobblog encode` reads the same.
+pub const CSV_COLUMNS: [&str; 13] = [
+    "t_s",
+    "ax_g",
+    "ay_g",
+    "az_g",
+    "gx_dps",
+    "gy_dps",
+    "gz_dps",
+    "steer_deg",
+    "speed_mps",
+    "gps_lat_deg",
+    "gps_lon_deg",
+    "gps_speed_mps",
+    "gps_fix",
+];
+
+/// Output formats of `wobblog decode`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Format {
+    /// Comma-separated values with a header line.
+    Csv,
+    /// One JSON object per line.
+    Jsonl,
+}
+
+/// Writes rows in one format.
+pub enum RowWriter<W: Write> {
+    /// CSV; the flag says whether the header line is out.
+    Csv(csv::Writer<W>, bool),
+    /// JSON lines.
+    Jsonl(W),
+}
+
+impl<W: Write> RowWriter<W> {
+    /// A writer. Nothing is written until the first row or [`Self::flush`],
+    /// so a log that cannot be read leaves no half output.
+    pub fn new(format: Format, out: W) -> Self {
+        match format {
+            Format::Csv => Self::Csv(csv::Writer::from_writer(out), false),
+            Format::Jsonl => Self::Jsonl(out),
+        }
+    }
+
+    fn header(&mut self) -> csv::Result<()> {
+        if let Self::Csv(w, done @ false) = self {
+            w.write_record(CSV_COLUMNS)?;
+            *done = true;
+        }
+        Ok(())
+    }
+
+    /// Writes one row.
+    pub fn write(&mut self, row: &Row) -> std::io::Result<()> {
+        self.header().map_err(std::io::Error::other)?;
+        match self {
+            Self::Csv(w, _) => write_csv(w, row).map_err(std::io::Error::other),
+            Self::Jsonl(w) => {
+                serde_json::to_writer(&mut *w, &JsonRow::from(row))?;
+                w.write_all(b"\n")
+            }
+        }
+    }
+
+    /// Writes the CSV header if no row came, and flushes buffered output.
+    pub fn flush(&mut self) -> std::io::Result<()> {
+        self.header().map_err(std::io::Error::other)?;
+        match self {
+            Self::Csv(w, _) => w.flush(),
+            Self::Jsonl(w) => w.flush(),
+        }
+    }
+}
+
+fn write_csv<W: Write>(w: &mut csv::Writer<W>, row: &Row) -> csv::Result<()> {
+    let mut num = ryu::Buffer::new();
+    w.write_field(num.format(row.t_s))?;
+    for v in row
+        .accel_g
+        .iter()
+        .chain(&row.gyro_dps)
+        .chain([&row.steer_deg, &row.speed_mps])
+    {
+        w.write_field(num.format(*v))?;
+    }
+    match &row.gps {
+        Some(gps) => {
+            w.write_field(num.format(gps.lat_deg))?;
+            w.write_field(num.format(gps.lon_deg))?;
+            w.write_field(gps.speed_mps.map_or("", |v| num.format(v)))?;
+            w.write_field(gps.fix.as_str())?;
+        }
+        None => (0..4).try_for_each(|_| w.write_field(""))?,
+    }
+    w.write_record(None::<&[u8]>)
+}
+
+#[derive(Serialize)]
+struct JsonRow {
+    t_s: f64,
+    ax_g: f32,
+    ay_g: f32,
+    az_g: f32,
+    gx_dps: f32,
+    gy_dps: f32,
+    gz_dps: f32,
+    steer_deg: f32,
+    speed_mps: f32,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    gps_lat_deg: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    gps_lon_deg: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    gps_speed_mps: Option<f32>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    gps_fix: Option<&'static str>,
+}
+
+impl From<&Row> for JsonRow {
+    fn from(r: &Row) -> Self {
+        let [ax_g, ay_g, az_g] = r.accel_g;
+        let [gx_dps, gy_dps, gz_dps] = r.gyro_dps;
+        Self {
+            t_s: r.t_s,
+            ax_g,
+            ay_g,
+            az_g,
+            gx_dps,
+            gy_dps,
+            gz_dps,
+            steer_deg: r.steer_deg,
+            speed_mps: r.speed_mps,
+            gps_lat_deg: r.gps.map(|g| g.lat_deg),
+            gps_lon_deg: r.gps.map(|g| g.lon_deg),
+            gps_speed_mps: r.gps.and_then(|g| g.speed_mps),
+            gps_fix: r.gps.map(|g| g.fix.as_str()),
+        }
+    }
+}

@@ -1,0 +1,138 @@
+//! One row per 100 Hz frame, with the GPS fix in force at that frame: the
+//! shape of `wobblog decode` output and of every analysis.
+
+use std::collections::VecDeque;
+
+use wobble_core::format::{FixMode, Frame, FrameStatus, GpsFix, Record};
+
+/// A GPS fix older than this no longer fills a row's GPS columns.
+pub const GPS_STALE_US: u64 = 1_000_000;
+/// How long rows wait for a GPS fix stamped before them but written after.
+const GPS_WAIT_US: u64 = 500_000;
+
+/// The GPS columns of a row.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GpsColumns {
+    /// Latitude, degrees.
+    pub lat_deg: f64,
+    /// Longitude, degrees.
+    pub lon_deg: f64,
+    /// Speed over ground, m/s, if the receiver sent it.
+    pub speed_mps: Option<f32>,
+    /// 2D or 3D.
+    pub fix: FixMode,
+}
+
+impl GpsColumns {
+    /// The columns for a fix, `None` if it has no usable position.
+    #[must_use]
+    pub fn from_fix(fix: &GpsFix) -> Option<Self> {
+        if fix.fix == FixMode::None {
+            return None;
+        }
+        Some(Self {
+            lat_deg: f64::from(fix.lat_e7?) / 1e7,
+            lon_deg: f64::from(fix.lon_e7?) / 1e7,
+            speed_mps: fix.speed_cm_s.map(|v| f32::from(v) / 100.0),
+            fix: fix.fix,
+        })
+    }
+}
+
+/// One decoded 100 Hz frame in physical units.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Row {
+    /// Seconds since boot.
+    pub t_s: f64,
+    /// Acceleration x/y/z, g.
+    pub accel_g: [f32; 3],
+    /// Angular rate x/y/z, deg/s.
+    pub gyro_dps: [f32; 3],
+    /// Steering angle, degrees.
+    pub steer_deg: f32,
+    /// Wheel speed, m/s.
+    pub speed_mps: f32,
+    /// Cumulative wheel pulses (wrapping at 2^16).
+    pub wheel_count: u16,
+    /// Status bits.
+    pub status: FrameStatus,
+    /// GPS fix in force, if any.
+    pub gps: Option<GpsColumns>,
+}
+
+impl Row {
+    fn new(frame: &Frame, gps: Option<GpsColumns>) -> Self {
+        Self {
+            t_s: frame.t_us as f64 / 1e6,
+            accel_g: frame.accel_g(),
+            gyro_dps: frame.gyro_dps(),
+            steer_deg: frame.steer_deg(),
+            speed_mps: frame.speed_mps(),
+            wheel_count: frame.wheel_count,
+            status: frame.status,
+            gps,
+        }
+    }
+}
+
+/// Turns a stream of records into rows, in bounded memory.
+///
+/// A GPS fix is stamped when its first sentence began, so it reaches the
+/// card after frames that come later than it; rows are held back for
+/// [`GPS_WAIT_US`] so such a fix still fills them.
+#[derive(Default)]
+pub struct RowAssembler {
+    pending: VecDeque<(u64, Row)>,
+    gps: Option<(u64, GpsColumns)>,
+}
+
+impl RowAssembler {
+    /// A new assembler.
+    #[must_use]
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Takes one record; calls `emit` for every row that is complete.
+    pub fn push(&mut self, record: &Record<'_>, emit: &mut impl FnMut(&Row)) {
+        match record {
+            Record::Frame(frame) => {
+                let gps = self.gps_at(frame.t_us);
+                self.pending.push_back((frame.t_us, Row::new(frame, gps)));
+                while let Some(&(t, _)) = self.pending.front() {
+                    if t + GPS_WAIT_US >= frame.t_us {
+                        break;
+                    }
+                    if let Some((_, row)) = self.pending.pop_front() {
+                        emit(&row);
+                    }
+                }
+            }
+            Record::Gps(fix) => {
+                let columns = GpsColumns::from_fix(fix);
+                let newer = self.gps.is_none_or(|(t, _)| fix.t_us >= t);
+                if newer {
+                    self.gps = columns.map(|c| (fix.t_us, c));
+                    for (t, row) in &mut self.pending {
+                        if *t >= fix.t_us {
+                            row.gps = columns.filter(|_| *t - fix.t_us <= GPS_STALE_US);
+                        }
+                    }
+                }
+            }
+            _ => {}
+        }
+    }
+
+    /// Emits the rows still held back.
+    pub fn finish(&mut self, emit: &mut impl FnMut(&Row)) {
+        for (_, row) in self.pending.drain(..) {
+            emit(&row);
+        }
+    }
+
+    fn gps_at(&self, t_us: u64) -> Option<GpsColumns> {
+        let (t, columns) = self.gps?;
+        (t <= t_us && t_us - t <= GPS_STALE_US).then_some(columns)
+    }
+}

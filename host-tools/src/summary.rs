@@ -1,0 +1,161 @@
+//! What `wobblog info` reports about a log.
+
+use std::collections::BTreeMap;
+
+use serde::Serialize;
+use wobble_core::format::{DecodeStats, Event, Record};
+
+use crate::losses::Losses;
+use crate::rows::{Row, RowAssembler};
+
+/// One wobble alert, from its switching on to its switching off.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct AlertSpan {
+    /// Time the alert switched on, s.
+    pub on_s: f64,
+    /// Time it switched off, s (absent if the log ends first).
+    pub off_s: Option<f64>,
+    /// Dominant frequency when it switched on, Hz.
+    pub freq_hz: f32,
+    /// Steering amplitude when it switched on, degrees.
+    pub amp_deg: f32,
+}
+
+/// Summary of one log.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct Summary {
+    /// Firmware that wrote the log.
+    pub firmware: Option<String>,
+    /// Device id, hex.
+    pub device_id: Option<String>,
+    /// Run number on the card.
+    pub run: Option<u32>,
+    /// Nominal frame rate, Hz.
+    pub sample_rate_hz: Option<u16>,
+    /// Configuration in force, as `key=value` lines.
+    pub config: Vec<String>,
+    /// Time of the first frame, s since boot.
+    pub start_s: Option<f64>,
+    /// Time of the last frame, s since boot.
+    pub end_s: Option<f64>,
+    /// Length of the run: frames times the frame period, s.
+    pub duration_s: f64,
+    /// Frames decoded.
+    pub samples: u64,
+    /// Dropout records: frames the logger could not write, by reason.
+    pub dropouts: BTreeMap<&'static str, u64>,
+    /// Frames the logger reported as dropped (sum of dropout records).
+    pub frames_dropped: u64,
+    /// Blocks missing from the file.
+    pub lost_blocks: u64,
+    /// Frames those blocks held.
+    pub frames_lost: u64,
+    /// Damaged blocks skipped.
+    pub damaged_blocks: u64,
+    /// Bytes that were not valid blocks.
+    pub bytes_skipped: u64,
+    /// GPS fix records.
+    pub gps_fixes: u64,
+    /// Share of frames with a GPS position, percent.
+    pub gps_coverage_pct: f64,
+    /// First UTC time seen, ISO 8601.
+    pub first_utc: Option<String>,
+    /// Wobble alerts.
+    pub alerts: Vec<AlertSpan>,
+    /// Rider markers, s.
+    pub markers: Vec<f64>,
+    /// Fault records by source: number of faults counted.
+    pub faults: BTreeMap<&'static str, u64>,
+    /// Everything lost, in detail.
+    pub losses: Losses,
+}
+
+/// Builds a [`Summary`] from decoder events.
+#[derive(Default)]
+pub struct SummaryBuilder {
+    summary: Summary,
+    rows: RowAssembler,
+    rows_with_gps: u64,
+}
+
+impl SummaryBuilder {
+    /// An empty builder.
+    #[must_use]
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Takes one decoder event.
+    pub fn observe(&mut self, event: &Event<'_>) {
+        self.summary.losses.observe(event);
+        let Event::Record(record) = event else { return };
+        let s = &mut self.summary;
+        let t_s = record.t_us() as f64 / 1e6;
+        match record {
+            Record::Frame(_) => {
+                s.samples += 1;
+                s.start_s.get_or_insert(t_s);
+                s.end_s = Some(t_s);
+            }
+            Record::Gps(fix) => {
+                s.gps_fixes += 1;
+                if s.first_utc.is_none() {
+                    s.first_utc = fix.utc.map(crate::time::iso8601);
+                }
+            }
+            Record::UtcSync(_) => {}
+            Record::Alert(a) if a.on => s.alerts.push(AlertSpan {
+                on_s: t_s,
+                off_s: None,
+                freq_hz: f32::from(a.freq_chz) / 100.0,
+                amp_deg: f32::from(a.amp_cdeg) / 100.0,
+            }),
+            Record::Alert(_) => {
+                if let Some(open) = s.alerts.last_mut().filter(|a| a.off_s.is_none()) {
+                    open.off_s = Some(t_s);
+                }
+            }
+            Record::Marker(_) => s.markers.push(t_s),
+            Record::Dropout(d) => {
+                *s.dropouts.entry(d.reason.as_str()).or_default() += 1;
+                s.frames_dropped += u64::from(d.frames_lost);
+            }
+            Record::Fault(f) => {
+                *s.faults.entry(f.source.as_str()).or_default() += u64::from(f.count.max(1))
+            }
+            Record::LogInfo(info) => {
+                s.firmware = Some(info.firmware.to_string());
+                s.device_id = Some(info.device_id.iter().map(|b| format!("{b:02x}")).collect());
+                s.run = Some(info.run);
+                s.sample_rate_hz = Some(info.sample_rate_hz);
+            }
+            Record::Channel(_) => {}
+            Record::Config(line) => s.config.push(line.text.to_string()),
+        }
+        let with_gps = &mut self.rows_with_gps;
+        self.rows.push(record, &mut |row: &Row| {
+            *with_gps += u64::from(row.gps.is_some())
+        });
+    }
+
+    /// The summary, given the decoder's totals.
+    #[must_use]
+    pub fn finish(mut self, stats: &DecodeStats) -> Summary {
+        let with_gps = &mut self.rows_with_gps;
+        self.rows
+            .finish(&mut |row: &Row| *with_gps += u64::from(row.gps.is_some()));
+        let mut s = self.summary;
+        let period_s = 1.0 / f64::from(s.sample_rate_hz.unwrap_or(100).max(1));
+        s.duration_s = s.samples as f64 * period_s;
+        s.gps_coverage_pct = if s.samples == 0 {
+            0.0
+        } else {
+            100.0 * self.rows_with_gps as f64 / s.samples as f64
+        };
+        s.lost_blocks = stats.blocks_lost;
+        s.frames_lost = stats.frames_lost;
+        s.damaged_blocks = stats.damaged_blocks;
+        s.bytes_skipped = stats.bytes_skipped;
+        s
+    }
+}
