@@ -106,20 +106,20 @@ fn write_csv<W: Write>(w: &mut csv::Writer<W>, row: &Row) -> csv::Result<()> {
 #[derive(Serialize)]
 struct JsonRow {
     t_s: f64,
-    ax_g: f32,
-    ay_g: f32,
-    az_g: f32,
-    gx_dps: f32,
-    gy_dps: f32,
-    gz_dps: f32,
-    steer_deg: f32,
-    speed_mps: f32,
+    ax_g: f64,
+    ay_g: f64,
+    az_g: f64,
+    gx_dps: f64,
+    gy_dps: f64,
+    gz_dps: f64,
+    steer_deg: f64,
+    speed_mps: f64,
     #[serde(skip_serializing_if = "Option::is_none")]
     gps_lat_deg: Option<f64>,
     #[serde(skip_serializing_if = "Option::is_none")]
     gps_lon_deg: Option<f64>,
     #[serde(skip_serializing_if = "Option::is_none")]
-    gps_speed_mps: Option<f32>,
+    gps_speed_mps: Option<f64>,
     #[serde(skip_serializing_if = "Option::is_none")]
     gps_fix: Option<&'static str>,
 }

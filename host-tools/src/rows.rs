@@ -3,7 +3,9 @@
 
 use std::collections::VecDeque;
 
-use wobble_core::format::{FixMode, Frame, FrameStatus, GpsFix, Record};
+use wobble_core::format::{
+    FixMode, Frame, FrameStatus, GpsFix, Record, ACCEL_COUNTS_PER_G, GYRO_COUNTS_PER_DPS, STEER_COUNTS_PER_DEG,
+};
 
 /// A GPS fix older than this no longer fills a row's GPS columns.
 pub const GPS_STALE_US: u64 = 1_000_000;
@@ -18,7 +20,7 @@ pub struct GpsColumns {
     /// Longitude, degrees.
     pub lon_deg: f64,
     /// Speed over ground, m/s, if the receiver sent it.
-    pub speed_mps: Option<f32>,
+    pub speed_mps: Option<f64>,
     /// 2D or 3D.
     pub fix: FixMode,
 }
@@ -33,7 +35,7 @@ impl GpsColumns {
         Some(Self {
             lat_deg: f64::from(fix.lat_e7?) / 1e7,
             lon_deg: f64::from(fix.lon_e7?) / 1e7,
-            speed_mps: fix.speed_cm_s.map(|v| f32::from(v) / 100.0),
+            speed_mps: fix.speed_cm_s.map(|v| f64::from(v) / 100.0),
             fix: fix.fix,
         })
     }
@@ -45,13 +47,13 @@ pub struct Row {
     /// Seconds since boot.
     pub t_s: f64,
     /// Acceleration x/y/z, g.
-    pub accel_g: [f32; 3],
+    pub accel_g: [f64; 3],
     /// Angular rate x/y/z, deg/s.
-    pub gyro_dps: [f32; 3],
+    pub gyro_dps: [f64; 3],
     /// Steering angle, degrees.
-    pub steer_deg: f32,
+    pub steer_deg: f64,
     /// Wheel speed, m/s.
-    pub speed_mps: f32,
+    pub speed_mps: f64,
     /// Cumulative wheel pulses (wrapping at 2^16).
     pub wheel_count: u16,
     /// Status bits.
@@ -62,12 +64,15 @@ pub struct Row {
 
 impl Row {
     fn new(frame: &Frame, gps: Option<GpsColumns>) -> Self {
+        // In f64, so that every stored count prints as its exact value (or
+        // the shortest decimal that is nearest to it).
+        let scaled = |c: i16, counts_per_unit: f32| f64::from(c) / f64::from(counts_per_unit);
         Self {
             t_s: frame.t_us as f64 / 1e6,
-            accel_g: frame.accel_g(),
-            gyro_dps: frame.gyro_dps(),
-            steer_deg: frame.steer_deg(),
-            speed_mps: frame.speed_mps(),
+            accel_g: frame.accel.map(|c| scaled(c, ACCEL_COUNTS_PER_G)),
+            gyro_dps: frame.gyro.map(|c| scaled(c, GYRO_COUNTS_PER_DPS)),
+            steer_deg: scaled(frame.steer_cdeg, STEER_COUNTS_PER_DEG),
+            speed_mps: f64::from(frame.speed_mm_s) / 1000.0,
             wheel_count: frame.wheel_count,
             status: frame.status,
             gps,

@@ -8,23 +8,50 @@ use wobble_core::format::*;
 #[derive(Clone, Debug)]
 enum Spec {
     Plain(Record<'static>),
-    Info { t_us: u64, firmware: String, device_id: [u8; 12], rate: u16, run: u32 },
-    Channel { t_us: u64, index: u8, name: String, unit: String, scale: f32 },
-    Config { t_us: u64, text: String },
+    Info {
+        t_us: u64,
+        firmware: String,
+        device_id: [u8; 12],
+        rate: u16,
+        run: u32,
+    },
+    Channel {
+        t_us: u64,
+        index: u8,
+        name: String,
+        unit: String,
+        scale: f32,
+    },
+    Config {
+        t_us: u64,
+        text: String,
+    },
 }
 
 impl Spec {
     fn record(&self) -> Record<'_> {
         match self {
             Spec::Plain(r) => *r,
-            Spec::Info { t_us, firmware, device_id, rate, run } => Record::LogInfo(LogInfo {
+            Spec::Info {
+                t_us,
+                firmware,
+                device_id,
+                rate,
+                run,
+            } => Record::LogInfo(LogInfo {
                 t_us: *t_us,
                 firmware,
                 device_id: *device_id,
                 sample_rate_hz: *rate,
                 run: *run,
             }),
-            Spec::Channel { t_us, index, name, unit, scale } => Record::Channel(ChannelDef {
+            Spec::Channel {
+                t_us,
+                index,
+                name,
+                unit,
+                scale,
+            } => Record::Channel(ChannelDef {
                 t_us: *t_us,
                 index: *index,
                 name,
@@ -39,22 +66,33 @@ impl Spec {
 const T_MAX: u64 = 1 << 50;
 
 fn frame() -> impl Strategy<Value = Frame> {
-    (0..T_MAX, any::<[i16; 3]>(), any::<[i16; 3]>(), any::<i16>(), any::<[u16; 3]>(), any::<u8>())
-        .prop_map(|(t_us, accel, gyro, steer_cdeg, [count, age, speed], status)| Frame {
-            t_us,
-            accel,
-            gyro,
-            steer_cdeg,
-            wheel_count: count,
-            wheel_edge_age_us: age,
-            speed_mm_s: speed,
-            status: FrameStatus(status),
-        })
+    (
+        0..T_MAX,
+        any::<[i16; 3]>(),
+        any::<[i16; 3]>(),
+        any::<i16>(),
+        any::<[u16; 3]>(),
+        any::<u8>(),
+    )
+        .prop_map(
+            |(t_us, accel, gyro, steer_cdeg, [count, age, speed], status)| Frame {
+                t_us,
+                accel,
+                gyro,
+                steer_cdeg,
+                wheel_count: count,
+                wheel_edge_age_us: age,
+                speed_mm_s: speed,
+                status: FrameStatus(status),
+            },
+        )
 }
 
 fn gps() -> impl Strategy<Value = GpsFix> {
-    let utc = (any::<u16>(), 0..86_401_000u32)
-        .prop_map(|(days_since_2000, ms_of_day)| UtcTime { days_since_2000, ms_of_day });
+    let utc = (any::<u16>(), 0..86_401_000u32).prop_map(|(days_since_2000, ms_of_day)| UtcTime {
+        days_since_2000,
+        ms_of_day,
+    });
     let pos = (any::<i32>(), any::<i32>());
     (
         0..T_MAX,
@@ -63,22 +101,28 @@ fn gps() -> impl Strategy<Value = GpsFix> {
         proptest::option::of(any::<u16>()),
         proptest::option::of(any::<u16>()),
         proptest::option::of(any::<i32>()),
-        prop_oneof![Just(FixMode::None), Just(FixMode::Fix2d), Just(FixMode::Fix3d)],
+        prop_oneof![
+            Just(FixMode::None),
+            Just(FixMode::Fix2d),
+            Just(FixMode::Fix3d)
+        ],
         proptest::option::of(0..255u8),
         proptest::option::of(0..255u8),
     )
-        .prop_map(|(t_us, utc, pos, speed, course, alt, fix, sats, hdop)| GpsFix {
-            t_us,
-            utc,
-            lat_e7: pos.map(|p| p.0),
-            lon_e7: pos.map(|p| p.1),
-            speed_cm_s: speed,
-            course_cdeg: course,
-            alt_cm: alt,
-            fix,
-            sats,
-            hdop_d: hdop,
-        })
+        .prop_map(
+            |(t_us, utc, pos, speed, course, alt, fix, sats, hdop)| GpsFix {
+                t_us,
+                utc,
+                lat_e7: pos.map(|p| p.0),
+                lon_e7: pos.map(|p| p.1),
+                speed_cm_s: speed,
+                course_cdeg: course,
+                alt_cm: alt,
+                fix,
+                sats,
+                hdop_d: hdop,
+            },
+        )
 }
 
 fn plain() -> impl Strategy<Value = Record<'static>> {
@@ -114,21 +158,25 @@ fn spec() -> impl Strategy<Value = Spec> {
 /// Frames at a steady 100 Hz with jitter, interleaved with other records
 /// stamped near them: what a logger writes.
 fn ride() -> impl Strategy<Value = Vec<Spec>> {
-    (vec((spec(), -20_000i64..20_000, 9_000u64..11_000), 1..400), 0..T_MAX / 2).prop_map(|(items, start)| {
-        let mut t = start;
-        items
-            .into_iter()
-            .map(|(mut s, offset, step)| {
-                if let Spec::Plain(Record::Frame(f)) = &mut s {
-                    t += step;
-                    f.t_us = t;
-                } else {
-                    set_time(&mut s, t.saturating_add_signed(offset));
-                }
-                s
-            })
-            .collect()
-    })
+    (
+        vec((spec(), -20_000i64..20_000, 9_000u64..11_000), 1..400),
+        0..T_MAX / 2,
+    )
+        .prop_map(|(items, start)| {
+            let mut t = start;
+            items
+                .into_iter()
+                .map(|(mut s, offset, step)| {
+                    if let Spec::Plain(Record::Frame(f)) = &mut s {
+                        t += step;
+                        f.t_us = t;
+                    } else {
+                        set_time(&mut s, t.saturating_add_signed(offset));
+                    }
+                    s
+                })
+                .collect()
+        })
 }
 
 fn set_time(s: &mut Spec, t: u64) {
@@ -143,7 +191,9 @@ fn set_time(s: &mut Spec, t: u64) {
             Record::Fault(x) => x.t_us = t,
             _ => unreachable!("plain records only"),
         },
-        Spec::Info { t_us, .. } | Spec::Channel { t_us, .. } | Spec::Config { t_us, .. } => *t_us = t,
+        Spec::Info { t_us, .. } | Spec::Channel { t_us, .. } | Spec::Config { t_us, .. } => {
+            *t_us = t
+        }
     }
 }
 
@@ -176,11 +226,23 @@ fn decode(file: &[u8]) -> (Vec<Event<'_>>, DecodeStats) {
 }
 
 fn records<'a>(events: &[Event<'a>]) -> Vec<Record<'a>> {
-    events.iter().filter_map(|e| if let Event::Record(r) = e { Some(*r) } else { None }).collect()
+    events
+        .iter()
+        .filter_map(|e| {
+            if let Event::Record(r) = e {
+                Some(*r)
+            } else {
+                None
+            }
+        })
+        .collect()
 }
 
 fn frames_in(block: &[Record<'_>]) -> u32 {
-    block.iter().filter(|r| matches!(r, Record::Frame(_))).count() as u32
+    block
+        .iter()
+        .filter(|r| matches!(r, Record::Frame(_)))
+        .count() as u32
 }
 
 proptest! {
@@ -294,7 +356,12 @@ proptest! {
 #[test]
 fn snapshot_then_fuller_block_share_a_place() {
     let mut enc = BlockEncoder::new();
-    let frame = |t_us| Record::Frame(Frame { t_us, ..Frame::default() });
+    let frame = |t_us| {
+        Record::Frame(Frame {
+            t_us,
+            ..Frame::default()
+        })
+    };
     assert!(enc.push(&frame(10_000)).unwrap().is_none());
     let partial = *enc.snapshot().expect("one frame");
     assert!(enc.push(&frame(20_000)).unwrap().is_none());
@@ -313,12 +380,20 @@ fn frames_average_under_32_bytes_with_20hz_gps() {
     let frames = 100 * 600;
     for i in 0..frames {
         let t_us = 1_000_000 + i * 10_000;
-        let f = Frame { t_us, accel: [1, -2, 2048], speed_mm_s: 4000, ..Frame::default() };
+        let f = Frame {
+            t_us,
+            accel: [1, -2, 2048],
+            speed_mm_s: 4000,
+            ..Frame::default()
+        };
         bytes += enc.push(&Record::Frame(f)).unwrap().map_or(0, |b| b.len());
         if i % 5 == 0 {
             let g = GpsFix {
                 t_us: t_us - 3_000,
-                utc: Some(UtcTime { days_since_2000: 7000, ms_of_day: 1 }),
+                utc: Some(UtcTime {
+                    days_since_2000: 7000,
+                    ms_of_day: 1,
+                }),
                 lat_e7: Some(522_100_000),
                 lon_e7: Some(68_800_000),
                 speed_cm_s: Some(400),

@@ -139,7 +139,7 @@ fn parse_row(columns: &Columns, record: &csv::StringRecord) -> Result<Row, Strin
         return Err(format!("t_s: {t_s} is not a time since boot in seconds"));
     }
     let t_us = (t_s * 1e6).round() as u64;
-    let q = |i: usize, scale: f32| number(i).map(|v| quantise_i16(v as f32, scale));
+    let q = |i: usize, scale: f32| number(i).map(|v| quantise_i16(v, scale));
     let frame = Frame {
         t_us,
         accel: [
@@ -155,7 +155,7 @@ fn parse_row(columns: &Columns, record: &csv::StringRecord) -> Result<Row, Strin
         steer_cdeg: q(7, STEER_COUNTS_PER_DEG)?,
         wheel_count: 0,
         wheel_edge_age_us: EDGE_AGE_NONE,
-        speed_mm_s: quantise_u16(number(8)? as f32, 1000.0),
+        speed_mm_s: quantise_u16(number(8)?, 1000.0),
         status: Default::default(),
     };
     let gps = match (field(9), field(10)) {
@@ -173,7 +173,7 @@ fn parse_row(columns: &Columns, record: &csv::StringRecord) -> Result<Row, Strin
                 speed_cm_s: field(11)
                     .map(|_| number(11))
                     .transpose()?
-                    .map(|v| quantise_u16(v as f32, 100.0)),
+                    .map(|v| quantise_u16(v, 100.0)),
                 fix,
                 ..GpsFix::default()
             })

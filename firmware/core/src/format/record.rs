@@ -14,30 +14,29 @@ pub const STEER_COUNTS_PER_DEG: f32 = 100.0;
 /// `Frame::wheel_edge_age_us` value meaning "no edge in the last 65.534 ms".
 pub const EDGE_AGE_NONE: u16 = u16::MAX;
 
-/// Round and saturate a physical value into an `i16` field.
+/// Round and saturate a physical value into an `i16` field. Computed in
+/// `f64` so that the quantisation error is half a count, whatever the input.
 #[must_use]
-pub fn quantise_i16(value: f32, counts_per_unit: f32) -> i16 {
+pub fn quantise_i16(value: impl Into<f64>, counts_per_unit: f32) -> i16 {
     // `as` saturates and maps NaN to 0, which is what a log wants.
-    libm_round(value * counts_per_unit) as i16
+    round_half_away(value.into() * f64::from(counts_per_unit)) as i16
 }
 
 /// Round and saturate a physical value into a `u16` field.
 #[must_use]
-pub fn quantise_u16(value: f32, counts_per_unit: f32) -> u16 {
-    libm_round(value * counts_per_unit) as u16
+pub fn quantise_u16(value: impl Into<f64>, counts_per_unit: f32) -> u16 {
+    round_half_away(value.into() * f64::from(counts_per_unit)) as u16
 }
 
 /// Round and saturate a physical value into an `i32` field.
 #[must_use]
 pub fn quantise_i32(value: f64, counts_per_unit: f64) -> i32 {
-    let x = value * counts_per_unit;
-    // Round half away from zero without `std`.
-    (if x >= 0.0 { x + 0.5 } else { x - 0.5 }) as i32
+    round_half_away(value * counts_per_unit) as i32
 }
 
-fn libm_round(x: f32) -> f32 {
-    // `f32::round` needs std; truncation after the half-offset is exact here
-    // because `as` casts truncate toward zero.
+/// `f64::round` needs std; adding the half and letting `as` truncate toward
+/// zero rounds half away from zero.
+fn round_half_away(x: f64) -> f64 {
     if x >= 0.0 {
         x + 0.5
     } else {

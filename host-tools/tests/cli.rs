@@ -1,0 +1,104 @@
+//! The `wobblog` binary: exit codes, messages and damage reports.
+
+use assert_cmd::Command;
+use std::path::{Path, PathBuf};
+
+fn wobblog() -> Command {
+    Command::cargo_bin("wobblog").unwrap()
+}
+
+/// A 30 s log of a steady ride with GPS, from CSV through `wobblog encode`.
+fn sample_log(dir: &Path) -> PathBuf {
+    let mut csv = String::from("t_s,steer_deg,speed_mps,gps_lat_deg,gps_lon_deg,gps_speed_mps,gps_fix\n");
+    for i in 0..3000 {
+        let t = f64::from(i) / 100.0;
+        let steer = (t * 6.4 * std::f64::consts::TAU).sin();
+        csv.push_str(&format!("{t},{steer:.2},4.0,52.2,6.88,4.0,3d\n"));
+    }
+    let csv_path = dir.join("in.csv");
+    std::fs::write(&csv_path, csv).unwrap();
+    let log = dir.join("run.wbl");
+    wobblog().args(["encode", "--csv"]).arg(&csv_path).arg("-o").arg(&log).assert().success();
+    log
+}
+
+fn info_json(log: &Path) -> serde_json::Value {
+    let out = wobblog().arg("info").arg(log).arg("--json").output().unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    serde_json::from_slice(&out.stdout).unwrap()
+}
+
+#[test]
+fn info_reports_samples_duration_and_gps() {
+    let dir = tempfile::tempdir().unwrap();
+    let info = info_json(&sample_log(dir.path()));
+    assert_eq!(info["samples"], 3000);
+    assert_eq!(info["duration_s"], 30.0);
+    assert_eq!(info["lost_blocks"], 0);
+    assert_eq!(info["gps_coverage_pct"], 100.0);
+}
+
+#[test]
+fn damaged_block_is_reported_with_its_frames_and_time() {
+    let dir = tempfile::tempdir().unwrap();
+    let log = sample_log(dir.path());
+    let mut bytes = std::fs::read(&log).unwrap();
+    bytes[10 * 512 + 100] ^= 0x40;
+    std::fs::write(&log, &bytes).unwrap();
+    let info = info_json(&log);
+    assert_eq!(info["lost_blocks"], 1);
+    assert_eq!(info["damaged_blocks"], 1);
+    let lost = &info["losses"]["lost_blocks"][0];
+    assert_eq!(lost["first_block"], 10);
+    let frames = lost["frames"].as_u64().unwrap();
+    assert!(frames > 10, "{frames} frames in a block");
+    assert_eq!(info["samples"].as_u64().unwrap() + frames, 3000);
+
+    let out = wobblog().arg("decode").arg(&log).output().unwrap();
+    assert!(out.status.success());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains("blocks 10-10 lost"), "{stderr}");
+    assert_eq!(out.stdout.iter().filter(|&&b| b == b'\n').count() as u64, 3000 - frames + 1);
+}
+
+#[test]
+fn unreadable_inputs_exit_1_naming_the_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let missing = dir.path().join("nope.wbl");
+    let out = wobblog().arg("info").arg(&missing).output().unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("nope.wbl"));
+
+    let junk = dir.path().join("junk.wbl");
+    std::fs::write(&junk, vec![0x5a; 5000]).unwrap();
+    let out = wobblog().arg("decode").arg(&junk).output().unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    assert!(out.stdout.is_empty());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("junk.wbl: no valid log block"));
+
+    let bad_csv = dir.path().join("bad.csv");
+    std::fs::write(&bad_csv, "t_s,steer_deg\n0.01,abc\n").unwrap();
+    let out = wobblog().args(["encode", "--csv"]).arg(&bad_csv).arg("-o").arg(dir.path().join("x.wbl")).output().unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains("bad.csv: line 2: steer_deg: not a number"), "{stderr}");
+}
+
+#[test]
+fn usage_errors_exit_2() {
+    wobblog().assert().code(2);
+    wobblog().args(["decode"]).assert().code(2);
+    wobblog().args(["decode", "x.wbl", "--format", "xml"]).assert().code(2);
+}
+
+#[test]
+fn truncated_log_decodes_every_complete_block() {
+    let dir = tempfile::tempdir().unwrap();
+    let log = sample_log(dir.path());
+    let bytes = std::fs::read(&log).unwrap();
+    std::fs::write(&log, &bytes[..bytes.len() - 700]).unwrap();
+    let info = info_json(&log);
+    let skipped = &info["losses"]["skipped"][0];
+    assert_eq!(skipped["cause"], "truncated tail");
+    assert_eq!(skipped["len"], 512 - 700 % 512);
+}
