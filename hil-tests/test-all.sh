@@ -1,0 +1,27 @@
+#!/usr/bin/env bash
+# Runs every check and test of the project on a fresh machine: installs what
+# it needs first (idempotent), then formatting, lints on the host and on the
+# MCU target, the host test suite, and the firmware build.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+TARGET=thumbv7em-none-eabihf
+
+step() { printf '\n==> %s\n' "$*"; }
+
+step "toolchain components and the $TARGET target"
+rustup component add rustfmt clippy >/dev/null 2>&1 || true
+rustup target list --installed | grep -qx "$TARGET" || rustup target add "$TARGET"
+
+step "cargo fmt --check"
+cargo fmt --all -- --check
+
+step "clippy, host crates (all targets)"
+cargo clippy --workspace --all-targets -- -D warnings
+
+step "clippy and build, core crate for $TARGET"
+cargo clippy -p wobble-core --target "$TARGET" -- -D warnings
+cargo build -p wobble-core --target "$TARGET" --release
+
+step "tests"
+cargo test --workspace
