@@ -60,9 +60,9 @@ impl<W: Write> RowWriter<W> {
 
     /// Writes one row.
     pub fn write(&mut self, row: &Row) -> std::io::Result<()> {
-        self.header().map_err(std::io::Error::other)?;
+        self.header().map_err(csv_io_error)?;
         match self {
-            Self::Csv(w, _) => write_csv(w, row).map_err(std::io::Error::other),
+            Self::Csv(w, _) => write_csv(w, row).map_err(csv_io_error),
             Self::Jsonl(w) => {
                 serde_json::to_writer(&mut *w, &JsonRow::from(row))?;
                 w.write_all(b"\n")
@@ -72,7 +72,7 @@ impl<W: Write> RowWriter<W> {
 
     /// Writes the CSV header if no row came, and flushes buffered output.
     pub fn flush(&mut self) -> std::io::Result<()> {
-        self.header().map_err(std::io::Error::other)?;
+        self.header().map_err(csv_io_error)?;
         match self {
             Self::Csv(w, _) => w.flush(),
             Self::Jsonl(w) => w.flush(),
@@ -143,5 +143,14 @@ impl From<&Row> for JsonRow {
             gps_speed_mps: r.gps.and_then(|g| g.speed_mps),
             gps_fix: r.gps.map(|g| g.fix.as_str()),
         }
+    }
+}
+
+/// Keeps the kind of an I/O error wrapped by `csv` (its own conversion
+/// turns every error into `Other`, hiding a closed pipe).
+fn csv_io_error(err: csv::Error) -> std::io::Error {
+    match err.into_kind() {
+        csv::ErrorKind::Io(e) => e,
+        other => std::io::Error::other(format!("{other:?}")),
     }
 }

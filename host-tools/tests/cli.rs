@@ -102,3 +102,24 @@ fn truncated_log_decodes_every_complete_block() {
     assert_eq!(skipped["cause"], "truncated tail");
     assert_eq!(skipped["len"], 512 - 700 % 512);
 }
+
+#[test]
+fn closing_the_output_pipe_early_is_not_an_error() {
+    use std::io::Read;
+    use std::process::Stdio;
+    let dir = tempfile::tempdir().unwrap();
+    let log = sample_log(dir.path());
+    let mut child = std::process::Command::new(assert_cmd::cargo::cargo_bin("wobblog"))
+        .arg("decode")
+        .arg(&log)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut first = [0u8; 100];
+    child.stdout.take().unwrap().read_exact(&mut first).unwrap();
+    let out = child.wait_with_output().unwrap();
+    assert!(first.starts_with(b"t_s,ax_g"));
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(out.stderr.is_empty());
+}

@@ -66,9 +66,10 @@ pub fn decode_to(
         }
     })?;
     rows.finish(&mut emit);
-    if let Some(e) = failure {
-        return Err(write_err(&e));
+    match failure.map_or_else(|| writer.flush(), Err) {
+        // The reader went away (`wobblog decode LOG | head`): not a failure.
+        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(losses),
+        Err(e) => Err(write_err(&e)),
+        Ok(()) => Ok(losses),
     }
-    writer.flush().map_err(|e| write_err(&e))?;
-    Ok(losses)
 }
