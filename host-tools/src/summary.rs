@@ -38,7 +38,7 @@ pub struct Summary {
     pub start_s: Option<f64>,
     /// Time of the last frame, s since boot.
     pub end_s: Option<f64>,
-    /// Length of the run: frames times the frame period, s.
+    /// Length of the run: first to last frame plus one frame period, s.
     pub duration_s: f64,
     /// Frames decoded.
     pub samples: u64,
@@ -74,6 +74,8 @@ pub struct Summary {
 #[derive(Default)]
 pub struct SummaryBuilder {
     summary: Summary,
+    /// First and last frame times, µs.
+    span_us: Option<(u64, u64)>,
     rows: RowAssembler,
     rows_with_gps: u64,
 }
@@ -92,10 +94,12 @@ impl SummaryBuilder {
         let s = &mut self.summary;
         let t_s = record.t_us() as f64 / 1e6;
         match record {
-            Record::Frame(_) => {
+            Record::Frame(f) => {
                 s.samples += 1;
                 s.start_s.get_or_insert(t_s);
                 s.end_s = Some(t_s);
+                let first = self.span_us.map_or(f.t_us, |(first, _)| first);
+                self.span_us = Some((first, f.t_us));
             }
             Record::Gps(fix) => {
                 s.gps_fixes += 1;
@@ -145,8 +149,8 @@ impl SummaryBuilder {
         self.rows
             .finish(&mut |row: &Row| *with_gps += u64::from(row.gps.is_some()));
         let mut s = self.summary;
-        let period_s = 1.0 / f64::from(s.sample_rate_hz.unwrap_or(100).max(1));
-        s.duration_s = s.samples as f64 * period_s;
+        let period_us = 1_000_000 / u64::from(s.sample_rate_hz.unwrap_or(100).max(1));
+        s.duration_s = self.span_us.map_or(0.0, |(first, last)| (last.saturating_sub(first) + period_us) as f64 / 1e6);
         s.gps_coverage_pct = if s.samples == 0 {
             0.0
         } else {

@@ -102,6 +102,10 @@ fn render(path: &std::path::Path, s: &Summary) -> String {
             faults.join(", ")
         }
     );
+    let _ = writeln!(o, "config:       {} lines", s.config.len());
+    for line in &s.config {
+        let _ = writeln!(o, "  {line}");
+    }
     for line in s.losses.describe() {
         let _ = writeln!(o, "  {line}");
     }
