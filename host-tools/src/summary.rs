@@ -54,6 +54,12 @@ pub struct Summary {
     pub damaged_blocks: u64,
     /// Bytes that were not valid blocks.
     pub bytes_skipped: u64,
+    /// Records in valid blocks that could not be read.
+    pub bad_records: u64,
+    /// Frames whose time went backwards.
+    pub time_jumps: u64,
+    /// Blocks whose sequence number went backwards (stale data).
+    pub out_of_order_blocks: u64,
     /// GPS fix records.
     pub gps_fixes: u64,
     /// Share of frames with a GPS position, percent.
@@ -160,6 +166,9 @@ impl SummaryBuilder {
         s.frames_lost = stats.frames_lost;
         s.damaged_blocks = stats.damaged_blocks;
         s.bytes_skipped = stats.bytes_skipped;
+        s.bad_records = stats.bad_records;
+        s.time_jumps = stats.time_jumps;
+        s.out_of_order_blocks = stats.out_of_order_blocks;
         s
     }
 }
