@@ -1,0 +1,556 @@
+//! The SD-card logger: a state machine that keeps one log file per power-on
+//! on a FAT32 card, over embedded-sdmmc's [`BlockDevice`].
+//!
+//! ```text
+//!            open ok                     write/flush error
+//!  NoCard ────────────> Logging ────────────────────────> NoCard
+//!    ^  │ (retry every           (count lost frames,        (retry every
+//!    └──┘  retry_period_ms)       remember the fault)        retry_period_ms)
+//! ```
+//!
+//! - **One file per power-on**: `RUNnnnnn.WBL`, the next free number in the
+//!   root directory, created fresh; the header records
+//!   ([`crate::format::header::header_records`]) go first.
+//! - **Whole blocks**: block `seq` of the [`BlockEncoder`] is written at file
+//!   offset `seq * 512`, so embedded-sdmmc never does a read-modify-write.
+//! - **Bounded power-loss window**: every `flush_period_ms` the open block is
+//!   written as a snapshot at its own offset and the file is flushed, which
+//!   updates the directory entry's size. The file is never closed and
+//!   reopened per write; it is closed once, by [`CardLogger::close`].
+//! - **Card missing, removed or full**: logging goes on without the card.
+//!   Frames that never reached it are counted, and when a card is back the new
+//!   file carries a fault record ([`crate::format::FaultSource::Card`], codes
+//!   below) and a dropout record ([`DropoutReason::CardUnavailable`]) with the
+//!   exact number of frames not written. A full card cannot hold the record
+//!   of its own fullness; the count stays in [`LoggerStats`] for the status
+//!   output and goes into the next file if space returns.
+//!
+//! Everything is blocking (embedded-sdmmc is): the writer runs in thread mode
+//! while the sampler preempts it from a higher-priority executor.
+
+#[cfg(feature = "mock")]
+pub mod mock;
+
+use core::ops::ControlFlow;
+
+use embedded_sdmmc::{
+    BlockDevice, Error as FsError, Mode, RawDirectory, RawFile, RawVolume, ShortFileName,
+    TimeSource, VolumeIdx, VolumeManager,
+};
+
+use crate::format::header::header_records;
+use crate::format::{
+    Block, BlockEncoder, Dropout, DropoutReason, Fault, FaultSource, LogInfo, Record, BLOCK_LEN,
+};
+
+/// Card fault 1: no usable card: none inserted, not answering, or without a
+/// FAT volume (seen when opening the card at boot or on a retry). The
+/// record's count is the number of failed attempts.
+pub const FAULT_CARD_ABSENT: u8 = 1;
+/// Card fault 2: a write or flush failed while logging (card removed or
+/// broken). Frames not yet on the card at that moment are counted as lost.
+pub const FAULT_CARD_WRITE: u8 = 2;
+/// Card fault 3: the card is full.
+pub const FAULT_CARD_FULL: u8 = 3;
+/// Number of card fault codes (`1..=FAULT_CARD_CODES`).
+pub const FAULT_CARD_CODES: usize = 3;
+
+/// Highest run number a short file name `RUNnnnnn.WBL` can hold.
+pub const MAX_RUN: u32 = 99_999;
+
+/// Timing of the logger.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct LoggerConfig {
+    /// Longest time data stays in RAM before it is on the card with a file
+    /// size that covers it: the power-loss window.
+    pub flush_period_ms: u32,
+    /// Time between two attempts to open a card after a failure.
+    pub retry_period_ms: u32,
+}
+
+impl LoggerConfig {
+    /// Flush twice a second (half a second of data at risk at a power cut,
+    /// three extra block writes per flush); retry a missing card every second.
+    pub const DEFAULT: Self = Self {
+        flush_period_ms: 500,
+        retry_period_ms: 1000,
+    };
+}
+
+impl Default for LoggerConfig {
+    fn default() -> Self {
+        Self::DEFAULT
+    }
+}
+
+/// What goes into the header of every file besides the channel definitions.
+#[derive(Clone, Copy, Debug)]
+pub struct HeaderSpec<'a> {
+    /// Firmware version string.
+    pub firmware: &'a str,
+    /// Unique device id (the MCU's UID).
+    pub device_id: [u8; 12],
+    /// Nominal frame rate.
+    pub sample_rate_hz: u16,
+    /// The `key=value` configuration lines in force.
+    pub config: &'a [&'a str],
+}
+
+/// A clock for the files' time stamps that always says the same time:
+/// before a GPS fix the logger knows no date, and the card log carries the
+/// real UTC in its own records.
+#[derive(Clone, Copy, Debug)]
+pub struct FixedTime(pub embedded_sdmmc::Timestamp);
+
+impl FixedTime {
+    /// 2020-01-01 00:00:00, the time stamp of files written before any fix.
+    pub const EPOCH: Self = Self(embedded_sdmmc::Timestamp {
+        year_since_1970: 50,
+        zero_indexed_month: 0,
+        zero_indexed_day: 0,
+        hours: 0,
+        minutes: 0,
+        seconds: 0,
+    });
+}
+
+impl TimeSource for FixedTime {
+    fn get_timestamp(&self) -> embedded_sdmmc::Timestamp {
+        self.0
+    }
+}
+
+/// Where the logger stands.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum LoggerState {
+    /// No file open: waiting for the next attempt to open a card.
+    NoCard,
+    /// Writing `RUNnnnnn.WBL` with this run number.
+    Logging {
+        /// The run number of the open file.
+        run: u32,
+    },
+}
+
+/// Counters since boot, for the status output and the tests.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct LoggerStats {
+    /// Files created.
+    pub files_opened: u32,
+    /// Sealed blocks written.
+    pub blocks_written: u32,
+    /// Successful flushes (snapshot + directory entry).
+    pub flushes: u32,
+    /// Frames a reader finds in the current file: in blocks that the file
+    /// size of the last flush covers, in their latest written version.
+    /// Frames past it are lost if the card goes now.
+    pub frames_on_card: u32,
+    /// Frames that never reached a card, since boot.
+    pub frames_lost: u32,
+    /// Frames lost and not yet reported in a dropout record on a card.
+    pub frames_lost_unreported: u32,
+    /// Faults by code (`faults[code - 1]`), since boot.
+    pub faults: [u32; FAULT_CARD_CODES],
+    /// Records the encoder refused (a bug or an oversized config line).
+    pub encode_errors: u32,
+}
+
+/// Why [`CardLogger::close`] could not close the file cleanly.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[non_exhaustive]
+pub enum CloseError {
+    /// No file was open.
+    NoFile,
+    /// The final write, flush or close failed; the file keeps the state of
+    /// its last successful flush.
+    Card,
+}
+
+/// The logger (see the module docs).
+pub struct CardLogger<'a, D: BlockDevice, T: TimeSource> {
+    fs: VolumeManager<D, T, 1, 1, 1>,
+    header: HeaderSpec<'a>,
+    config: LoggerConfig,
+    encoder: BlockEncoder,
+    open: Option<OpenFile>,
+    next_try_us: u64,
+    next_flush_us: u64,
+    /// Blocks the directory entry's file size covers (as of the last flush).
+    size_blocks: u32,
+    /// Fault counts not yet on a card, by code.
+    faults_unreported: [u16; FAULT_CARD_CODES],
+    stats: LoggerStats,
+}
+
+#[derive(Clone, Copy, Debug)]
+struct OpenFile {
+    volume: RawVolume,
+    dir: RawDirectory,
+    file: RawFile,
+    run: u32,
+}
+
+/// What made a card operation fail, reduced to the fault it stands for.
+fn fault_code<E: core::fmt::Debug + core::error::Error>(err: &FsError<E>) -> u8 {
+    match err {
+        FsError::DiskFull | FsError::NotEnoughSpace => FAULT_CARD_FULL,
+        _ => FAULT_CARD_WRITE,
+    }
+}
+
+impl<'a, D: BlockDevice, T: TimeSource> CardLogger<'a, D, T> {
+    /// A logger that will open the card at the first [`Self::poll`].
+    pub fn new(device: D, time: T, header: HeaderSpec<'a>, config: LoggerConfig) -> Self {
+        Self {
+            fs: VolumeManager::new_with_limits(device, time, 0),
+            header,
+            config,
+            encoder: BlockEncoder::new(),
+            open: None,
+            next_try_us: 0,
+            next_flush_us: 0,
+            size_blocks: 0,
+            faults_unreported: [0; FAULT_CARD_CODES],
+            stats: LoggerStats::default(),
+        }
+    }
+
+    /// Where the logger stands.
+    pub fn state(&self) -> LoggerState {
+        match self.open {
+            Some(f) => LoggerState::Logging { run: f.run },
+            None => LoggerState::NoCard,
+        }
+    }
+
+    /// Counters since boot.
+    pub fn stats(&self) -> LoggerStats {
+        self.stats
+    }
+
+    /// Runs `f` on the block device (the tests' fault injection uses this).
+    pub fn with_device<R>(&self, f: impl FnOnce(&mut D) -> R) -> R {
+        self.fs.device(f)
+    }
+
+    /// Logs one record at local time `now_us`. Without a card, frames are
+    /// counted as lost and other records are dropped.
+    pub fn push(&mut self, rec: &Record<'_>, now_us: u64) {
+        if self.open.is_none() {
+            if matches!(rec, Record::Frame(_)) {
+                self.count_lost(1);
+            }
+            return;
+        }
+        self.encode(rec, now_us);
+    }
+
+    /// Does what is due at `now_us`: a flush while logging, an attempt to
+    /// open the card without one. Call it at least every few tens of ms.
+    pub fn poll(&mut self, now_us: u64) {
+        match self.open {
+            Some(_) if now_us >= self.next_flush_us => self.flush(now_us),
+            Some(_) => {}
+            None if now_us >= self.next_try_us => self.try_open(now_us),
+            None => {}
+        }
+    }
+
+    /// Writes everything, flushes and closes the file (end of ride, clean
+    /// shutdown): after this the file system is clean.
+    ///
+    /// # Errors
+    /// No file was open, or the card failed (the file keeps its last flush).
+    pub fn close(&mut self, now_us: u64) -> Result<(), CloseError> {
+        if self.open.is_none() {
+            return Err(CloseError::NoFile);
+        }
+        self.flush(now_us);
+        let f = self.open.take().ok_or(CloseError::Card)?;
+        let closed = self.fs.close_file(f.file).is_ok();
+        self.release(f.dir, f.volume);
+        if closed {
+            Ok(())
+        } else {
+            Err(CloseError::Card)
+        }
+    }
+
+    fn count_lost(&mut self, frames: u32) {
+        self.stats.frames_lost = self.stats.frames_lost.saturating_add(frames);
+        self.stats.frames_lost_unreported =
+            self.stats.frames_lost_unreported.saturating_add(frames);
+    }
+
+    fn count_fault(&mut self, code: u8) {
+        let i = usize::from(code - 1);
+        self.stats.faults[i] = self.stats.faults[i].saturating_add(1);
+        self.faults_unreported[i] = self.faults_unreported[i].saturating_add(1);
+    }
+
+    /// Encodes `rec` and writes the block it closed, if any.
+    fn encode(&mut self, rec: &Record<'_>, now_us: u64) {
+        let Some(f) = self.open else { return };
+        let frames_before = self.encoder.frames_total();
+        // A block that closes is the one open now.
+        let seq = self.encoder.open_seq();
+        let written = match self.encoder.push(rec) {
+            Ok(Some(block)) => Some(write_block(&self.fs, f.file, seq, block)),
+            Ok(None) => None,
+            Err(_) => {
+                self.stats.encode_errors = self.stats.encode_errors.saturating_add(1);
+                None
+            }
+        };
+        match written {
+            Some(Ok(())) => {
+                self.stats.blocks_written = self.stats.blocks_written.saturating_add(1);
+                // The closed block holds every frame before `rec`; it only
+                // counts once a flush has put its offset inside the file
+                // size (the snapshot block being overwritten already is).
+                if seq < self.size_blocks {
+                    self.stats.frames_on_card = frames_before;
+                }
+            }
+            Some(Err(e)) => self.fail(fault_code(&e), now_us),
+            None => {}
+        }
+    }
+
+    /// Snapshot of the open block plus a file flush.
+    fn flush(&mut self, now_us: u64) {
+        let Some(f) = self.open else { return };
+        self.next_flush_us = now_us.saturating_add(u64::from(self.config.flush_period_ms) * 1000);
+        let seq = self.encoder.open_seq();
+        let (snapshot, size_blocks) = match self.encoder.snapshot() {
+            Some(block) => (
+                write_block(&self.fs, f.file, seq, block),
+                seq.saturating_add(1),
+            ),
+            None => (Ok(()), seq),
+        };
+        match snapshot.and_then(|()| self.fs.flush_file(f.file)) {
+            Ok(()) => {
+                self.stats.flushes = self.stats.flushes.saturating_add(1);
+                self.size_blocks = size_blocks;
+                self.stats.frames_on_card = self.encoder.frames_total();
+                // Whatever was pending is now in this file, on the card.
+                self.faults_unreported = [0; FAULT_CARD_CODES];
+                self.stats.frames_lost_unreported = 0;
+            }
+            Err(e) => self.fail(fault_code(&e), now_us),
+        }
+    }
+
+    /// The card failed: count what did not reach it, let go of the file.
+    fn fail(&mut self, code: u8, now_us: u64) {
+        self.count_fault(code);
+        let lost = self
+            .encoder
+            .frames_total()
+            .wrapping_sub(self.stats.frames_on_card);
+        self.count_lost(lost);
+        if let Some(f) = self.open.take() {
+            // The handles are released even when the card does not answer.
+            let _ = self.fs.close_file(f.file);
+            self.release(f.dir, f.volume);
+        }
+        self.encoder = BlockEncoder::new();
+        self.stats.frames_on_card = 0;
+        self.size_blocks = 0;
+        self.next_try_us = now_us.saturating_add(u64::from(self.config.retry_period_ms) * 1000);
+    }
+
+    fn release(&mut self, dir: RawDirectory, volume: RawVolume) {
+        // Closing handles only fails for unknown handles, which these are not.
+        let _ = self.fs.close_dir(dir);
+        let _ = self.fs.close_volume(volume);
+    }
+
+    /// Opens the card, creates the next run's file and writes its header,
+    /// then the fault and dropout records of what happened without a card.
+    fn try_open(&mut self, now_us: u64) {
+        let retry_at = now_us.saturating_add(u64::from(self.config.retry_period_ms) * 1000);
+        let Ok(volume) = self.fs.open_raw_volume(VolumeIdx(0)) else {
+            self.count_fault(FAULT_CARD_ABSENT);
+            self.next_try_us = retry_at;
+            return;
+        };
+        let opened = self
+            .fs
+            .open_root_dir(volume)
+            .map_err(|e| (e, None))
+            .and_then(|dir| {
+                let run = next_run(&self.fs, dir).map_err(|e| (e, Some(dir)))?;
+                let name = run_file_name(run).map_err(|e| (e, Some(dir)))?;
+                let file = self
+                    .fs
+                    .open_file_in_dir(dir, name, Mode::ReadWriteCreate)
+                    .map_err(|e| (e, Some(dir)))?;
+                Ok(OpenFile {
+                    volume,
+                    dir,
+                    file,
+                    run,
+                })
+            });
+        let f = match opened {
+            Ok(f) => f,
+            Err((e, dir)) => {
+                if let Some(dir) = dir {
+                    let _ = self.fs.close_dir(dir);
+                }
+                let _ = self.fs.close_volume(volume);
+                let code = match e {
+                    FsError::DiskFull | FsError::NotEnoughSpace => FAULT_CARD_FULL,
+                    _ => FAULT_CARD_ABSENT,
+                };
+                self.count_fault(code);
+                self.next_try_us = retry_at;
+                return;
+            }
+        };
+        self.open = Some(f);
+        self.stats.files_opened = self.stats.files_opened.saturating_add(1);
+        self.encoder = BlockEncoder::new();
+        self.stats.frames_on_card = 0;
+        self.size_blocks = 0;
+        let info = LogInfo {
+            t_us: now_us,
+            firmware: self.header.firmware,
+            device_id: self.header.device_id,
+            sample_rate_hz: self.header.sample_rate_hz,
+            run: f.run,
+        };
+        let config = self.header.config;
+        for rec in header_records(info, config.iter().copied()) {
+            self.encode(&rec, now_us);
+        }
+        self.report_unavailable(now_us);
+        self.flush(now_us);
+        if self.open.is_none() {
+            // The card failed before the file held a frame (full, or pulled
+            // out): do not leave an empty file behind on every retry.
+            self.delete_run(f.run);
+        }
+    }
+
+    /// Best effort: removes the (closed) file of `run`.
+    fn delete_run(&mut self, run: u32) {
+        let Ok(name) = run_file_name::<D::Error>(run) else {
+            return;
+        };
+        let Ok(volume) = self.fs.open_raw_volume(VolumeIdx(0)) else {
+            return;
+        };
+        if let Ok(dir) = self.fs.open_root_dir(volume) {
+            let _ = self.fs.delete_entry_in_dir(dir, name);
+            let _ = self.fs.close_dir(dir);
+        }
+        let _ = self.fs.close_volume(volume);
+    }
+
+    fn report_unavailable(&mut self, now_us: u64) {
+        let pending = self.faults_unreported;
+        for (i, &count) in pending.iter().enumerate() {
+            if count > 0 {
+                let rec = Record::Fault(Fault {
+                    t_us: now_us,
+                    source: FaultSource::Card,
+                    // `i < FAULT_CARD_CODES`, a small number.
+                    code: (i + 1) as u8,
+                    count,
+                });
+                self.encode(&rec, now_us);
+            }
+        }
+        let lost = self.stats.frames_lost_unreported;
+        if lost > 0 {
+            let rec = Record::Dropout(Dropout {
+                t_us: now_us,
+                frames_lost: lost,
+                reason: DropoutReason::CardUnavailable,
+            });
+            self.encode(&rec, now_us);
+        }
+    }
+}
+
+/// Writes one whole block at its offset in the file.
+fn write_block<D: BlockDevice, T: TimeSource>(
+    fs: &VolumeManager<D, T, 1, 1, 1>,
+    file: RawFile,
+    seq: u32,
+    block: &Block,
+) -> Result<(), FsError<D::Error>> {
+    let offset = seq
+        .checked_mul(BLOCK_LEN as u32)
+        .ok_or(FsError::NotEnoughSpace)?;
+    fs.file_seek_from_start(file, offset)?;
+    fs.write(file, block)
+}
+
+/// The run number after the highest `RUNnnnnn.WBL` in `dir` (1 on an empty
+/// card).
+fn next_run<D: BlockDevice, T: TimeSource>(
+    fs: &VolumeManager<D, T, 1, 1, 1>,
+    dir: RawDirectory,
+) -> Result<u32, FsError<D::Error>> {
+    let mut highest = 0;
+    fs.iterate_dir(dir, |entry| {
+        if let Some(run) = parse_run(&entry.name) {
+            highest = highest.max(run);
+        }
+        ControlFlow::Continue(())
+    })?;
+    if highest >= MAX_RUN {
+        return Err(FsError::NotEnoughSpace);
+    }
+    Ok(highest + 1)
+}
+
+/// `RUN00042.WBL` -> 42.
+fn parse_run(name: &ShortFileName) -> Option<u32> {
+    let digits = name.base_name().strip_prefix(b"RUN")?;
+    if name.extension() != b"WBL" || digits.len() != 5 {
+        return None;
+    }
+    digits.iter().try_fold(0u32, |acc, &d| {
+        d.is_ascii_digit().then(|| acc * 10 + u32::from(d - b'0'))
+    })
+}
+
+/// 42 -> `RUN00042.WBL`.
+fn run_file_name<E: core::fmt::Debug + core::error::Error>(
+    run: u32,
+) -> Result<ShortFileName, FsError<E>> {
+    let mut text = *b"RUN00000.WBL";
+    let mut n = run;
+    for d in text[3..8].iter_mut().rev() {
+        *d = b'0' + (n % 10) as u8;
+        n /= 10;
+    }
+    let text = core::str::from_utf8(&text).map_err(|_| FsError::NotFound)?;
+    ShortFileName::create_from_str(text).map_err(FsError::FilenameError)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn run_names_round_trip() {
+        for run in [1, 42, 99_999] {
+            let name = run_file_name::<std::io::Error>(run).expect("valid name");
+            assert_eq!(parse_run(&name), Some(run));
+        }
+        let other = ShortFileName::create_from_str("RUN0001X.WBL").expect("valid name");
+        assert_eq!(parse_run(&other), None);
+        let other = ShortFileName::create_from_str("RUN00001.CSV").expect("valid name");
+        assert_eq!(parse_run(&other), None);
+    }
+}

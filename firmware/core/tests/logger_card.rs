@@ -1,0 +1,332 @@
+//! The SD logger against an in-memory FAT32 card: file naming, header,
+//! whole-block writes, flushing, power cuts, missing, removed and full cards.
+
+use std::io::{Read, Seek, SeekFrom, Write};
+
+use proptest::prelude::*;
+use wobble_core::format::{
+    Decoder, Dropout, DropoutReason, Event, FaultSource, Frame, FrameStatus, Record,
+};
+use wobble_core::logger::mock::MockCard;
+use wobble_core::logger::{
+    CardLogger, FixedTime, HeaderSpec, LoggerConfig, LoggerState, FAULT_CARD_ABSENT,
+    FAULT_CARD_FULL, FAULT_CARD_WRITE,
+};
+
+/// Partition start: one MBR sector, then the FAT32 volume.
+const PART_START_BLOCKS: u64 = 1;
+/// Smallest comfortable FAT32 volume with 512-byte clusters (65 525 needed).
+const CARD_BYTES: u64 = 40 << 20;
+const FRAME_PERIOD_US: u64 = 10_000;
+const CONFIG: [&str; 2] = ["sample_rate_hz=100", "flush_period_ms=500"];
+
+fn header() -> HeaderSpec<'static> {
+    HeaderSpec {
+        firmware: "test",
+        device_id: [7; 12],
+        sample_rate_hz: 100,
+        config: &CONFIG,
+    }
+}
+
+type Logger = CardLogger<'static, MockCard, FixedTime>;
+
+fn logger(card: MockCard) -> Logger {
+    CardLogger::new(card, FixedTime::EPOCH, header(), LoggerConfig::DEFAULT)
+}
+
+/// A card image: an MBR with one FAT32 (LBA) partition, formatted.
+fn fat32_image() -> Vec<u8> {
+    let mut image = vec![0u8; CARD_BYTES as usize];
+    let start = (PART_START_BLOCKS * 512) as usize;
+    let blocks = (CARD_BYTES / 512 - PART_START_BLOCKS) as u32;
+    let opts = fatfs::FormatVolumeOptions::new()
+        .fat_type(fatfs::FatType::Fat32)
+        .bytes_per_cluster(512);
+    fatfs::format_volume(std::io::Cursor::new(&mut image[start..]), opts).expect("format");
+    let entry = &mut image[446..462];
+    entry[4] = 0x0C; // FAT32 with LBA addressing
+    entry[8..12].copy_from_slice(&(PART_START_BLOCKS as u32).to_le_bytes());
+    entry[12..16].copy_from_slice(&blocks.to_le_bytes());
+    image[510] = 0x55;
+    image[511] = 0xAA;
+    image
+}
+
+fn with_fs<R>(
+    image: &mut [u8],
+    f: impl FnOnce(&fatfs::FileSystem<std::io::Cursor<&mut [u8]>>) -> R,
+) -> R {
+    let start = (PART_START_BLOCKS * 512) as usize;
+    let fs = fatfs::FileSystem::new(
+        std::io::Cursor::new(&mut image[start..]),
+        fatfs::FsOptions::new(),
+    )
+    .expect("mount");
+    f(&fs)
+}
+
+/// The contents of a file, as the directory entry's size says.
+fn read_file(image: &[u8], name: &str) -> Option<Vec<u8>> {
+    let mut image = image.to_vec();
+    with_fs(&mut image, |fs| {
+        let mut file = fs.root_dir().open_file(name).ok()?;
+        let mut data = Vec::new();
+        file.read_to_end(&mut data).ok()?;
+        Some(data)
+    })
+}
+
+/// Fills the card but `free_bytes` with a file.
+fn fill_card(image: &mut [u8], free_bytes: u64) {
+    with_fs(image, |fs| {
+        let stats = fs.stats().expect("stats");
+        let free = stats.free_clusters() as u64 * stats.cluster_size() as u64;
+        let mut file = fs.root_dir().create_file("FILLER.BIN").expect("create");
+        let chunk = vec![0xA5u8; 1 << 16];
+        let mut left = free - free_bytes;
+        while left > 0 {
+            let n = left.min(chunk.len() as u64) as usize;
+            file.write_all(&chunk[..n]).expect("fill");
+            left -= n as u64;
+        }
+        file.flush().expect("flush");
+        file.seek(SeekFrom::Start(0)).expect("seek");
+    });
+}
+
+#[derive(Debug, Default)]
+struct Decoded {
+    frames: Vec<u64>,
+    dropouts: Vec<Dropout>,
+    card_faults: Vec<(u8, u16)>,
+    configs: Vec<String>,
+    first_is_info: bool,
+    damaged: u64,
+}
+
+fn decode(data: &[u8]) -> Decoded {
+    let mut out = Decoded::default();
+    let mut first = true;
+    let mut decoder = Decoder::new();
+    decoder.feed(data, true, &mut |ev| {
+        if let Event::Record(rec) = ev {
+            if first {
+                out.first_is_info = matches!(rec, Record::LogInfo(_));
+                first = false;
+            }
+            match rec {
+                Record::Frame(f) => out.frames.push(f.t_us),
+                Record::Dropout(d) => out.dropouts.push(d),
+                Record::Fault(f) if f.source == FaultSource::Card => {
+                    out.card_faults.push((f.code, f.count));
+                }
+                Record::Config(c) => out.configs.push(c.text.to_string()),
+                _ => {}
+            }
+        }
+    });
+    out.damaged = decoder.stats().damaged_blocks;
+    out
+}
+
+fn frame(i: u64) -> Record<'static> {
+    Record::Frame(Frame {
+        t_us: i * FRAME_PERIOD_US,
+        accel: [i as i16, 2, 2048],
+        gyro: [1, 2, 3],
+        steer_cdeg: (i % 300) as i16,
+        wheel_count: i as u16,
+        wheel_edge_age_us: 100,
+        speed_mm_s: 4000,
+        status: FrameStatus(0),
+    })
+}
+
+/// Pushes frames `from..to` at 100 Hz, polling the logger as the writer does.
+fn run(log: &mut Logger, from: u64, to: u64) {
+    for i in from..to {
+        let now = i * FRAME_PERIOD_US;
+        log.poll(now);
+        log.push(&frame(i), now);
+    }
+}
+
+#[test]
+fn fresh_card_gets_run_one_with_header_then_every_frame() {
+    let mut log = logger(MockCard::new(fat32_image()));
+    run(&mut log, 0, 3000);
+    assert_eq!(log.state(), LoggerState::Logging { run: 1 });
+    log.close(3000 * FRAME_PERIOD_US).expect("close");
+    let image = log.with_device(|c| c.image());
+    let data = read_file(&image, "RUN00001.WBL").expect("file");
+    assert_eq!(data.len() % 512, 0);
+    let d = decode(&data);
+    assert!(d.first_is_info);
+    assert_eq!(d.configs, CONFIG);
+    let expected: Vec<u64> = (0..3000).map(|i| i * FRAME_PERIOD_US).collect();
+    assert_eq!(d.frames, expected);
+    assert!(d.dropouts.is_empty() && d.card_faults.is_empty());
+    assert_eq!(log.stats().frames_lost, 0);
+}
+
+#[test]
+fn each_power_on_takes_the_next_free_run_number() {
+    let mut image = fat32_image();
+    for run_no in 1..=3 {
+        let mut log = logger(MockCard::new(image));
+        run(&mut log, 0, 10);
+        assert_eq!(log.state(), LoggerState::Logging { run: run_no });
+        log.close(100_000).expect("close");
+        image = log.with_device(|c| c.image());
+    }
+    for name in ["RUN00001.WBL", "RUN00002.WBL", "RUN00003.WBL"] {
+        assert_eq!(
+            decode(&read_file(&image, name).expect(name)).frames.len(),
+            10
+        );
+    }
+}
+
+#[test]
+fn flushes_keep_the_file_size_within_one_flush_period() {
+    let mut log = logger(MockCard::new(fat32_image()));
+    // No close: what a reader sees at any moment is what the last flush said.
+    let mut start = 0;
+    for end in [130u64, 777, 1500] {
+        run(&mut log, start, end);
+        start = end;
+        let image = log.with_device(|c| c.image());
+        let on_card = decode(&read_file(&image, "RUN00001.WBL").expect("file"))
+            .frames
+            .len() as u64;
+        let period_frames = u64::from(LoggerConfig::DEFAULT.flush_period_ms) / 10;
+        assert!(
+            end - on_card <= period_frames,
+            "{on_card} of {end} frames on card"
+        );
+        assert_eq!(on_card, u64::from(log.stats().frames_on_card));
+    }
+}
+
+#[test]
+fn card_absent_at_boot_is_reported_with_the_exact_loss() {
+    let card = MockCard::new(fat32_image());
+    card.set_removed(true);
+    let mut log = logger(card);
+    run(&mut log, 0, 350);
+    assert_eq!(log.state(), LoggerState::NoCard);
+    log.with_device(|c| c.set_removed(false));
+    run(&mut log, 350, 600);
+    log.close(600 * FRAME_PERIOD_US).expect("close");
+    let image = log.with_device(|c| c.image());
+    let d = decode(&read_file(&image, "RUN00001.WBL").expect("file"));
+    // Attempts at 0, 1, 2, 3 s failed; the one at 4 s found the card.
+    assert_eq!(d.card_faults, [(FAULT_CARD_ABSENT, 4)]);
+    assert_eq!(d.dropouts.len(), 1);
+    assert_eq!(d.dropouts[0].reason, DropoutReason::CardUnavailable);
+    assert_eq!(d.dropouts[0].frames_lost, 400);
+    assert_eq!(d.frames.len(), 200);
+    assert_eq!(d.frames[0], 400 * FRAME_PERIOD_US);
+}
+
+#[test]
+fn card_pulled_mid_run_loses_only_what_was_not_on_it() {
+    let mut log = logger(MockCard::new(fat32_image()));
+    run(&mut log, 0, 1234);
+    log.with_device(|c| c.set_removed(true));
+    run(&mut log, 1234, 1700);
+    assert_eq!(log.state(), LoggerState::NoCard);
+    log.with_device(|c| c.set_removed(false));
+    run(&mut log, 1700, 2500);
+    assert_eq!(log.state(), LoggerState::Logging { run: 2 });
+    log.close(2500 * FRAME_PERIOD_US).expect("close");
+    let image = log.with_device(|c| c.image());
+    let first = decode(&read_file(&image, "RUN00001.WBL").expect("run 1"));
+    let second = decode(&read_file(&image, "RUN00002.WBL").expect("run 2"));
+    // One failed write, then failed attempts at 1, 2, 3 and 4 s after it.
+    assert_eq!(
+        second.card_faults,
+        [(FAULT_CARD_ABSENT, 4), (FAULT_CARD_WRITE, 1)]
+    );
+    assert_eq!(second.dropouts.len(), 1);
+    let lost = u64::from(second.dropouts[0].frames_lost);
+    // Every frame is either on the card or counted, never both.
+    let on_card = (first.frames.len() + second.frames.len()) as u64;
+    assert_eq!(on_card + lost, 2500);
+    assert!(first
+        .frames
+        .windows(2)
+        .all(|w| w[1] == w[0] + FRAME_PERIOD_US));
+    assert_eq!(
+        *first.frames.last().expect("frames") / FRAME_PERIOD_US + 1,
+        first.frames.len() as u64
+    );
+    assert_eq!(
+        second.frames[0] / FRAME_PERIOD_US,
+        first.frames.len() as u64 + lost
+    );
+}
+
+#[test]
+fn full_card_keeps_logging_and_counts_the_loss() {
+    let mut image = fat32_image();
+    fill_card(&mut image, 16 * 1024);
+    let mut log = logger(MockCard::new(image));
+    run(&mut log, 0, 2000);
+    assert_eq!(log.state(), LoggerState::NoCard);
+    let stats = log.stats();
+    assert!(stats.faults[usize::from(FAULT_CARD_FULL) - 1] >= 1);
+    let image = log.with_device(|c| c.image());
+    let d = decode(&read_file(&image, "RUN00001.WBL").expect("file"));
+    assert_eq!(d.frames.len() as u64 + u64::from(stats.frames_lost), 2000);
+    assert_eq!(d.damaged, 0);
+    // Retries on the full card leave no empty files behind.
+    let names: Vec<String> = with_fs(&mut image.clone(), |fs| {
+        fs.root_dir()
+            .iter()
+            .filter_map(Result::ok)
+            .map(|e| e.file_name())
+            .collect()
+    });
+    assert_eq!(
+        names.iter().filter(|n| n.starts_with("RUN")).count(),
+        1,
+        "{names:?}"
+    );
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(24))]
+
+    /// A power cut at any block write keeps every frame of the last flush,
+    /// loses at most one flush period, and never damages a written block.
+    #[test]
+    fn power_cut_loses_at_most_one_flush_period(cut_after_writes in 1u32..400) {
+        let card = MockCard::new(fat32_image());
+        card.set_fuel(Some(cut_after_writes));
+        let mut log = logger(card);
+        let mut flushed_frames = 0u32;
+        let mut cut_at = None;
+        for i in 0..4000u64 {
+            let now = i * FRAME_PERIOD_US;
+            log.poll(now);
+            log.push(&frame(i), now);
+            if log.state() == LoggerState::NoCard {
+                cut_at = Some(i + 1);
+                break;
+            }
+            flushed_frames = log.stats().frames_on_card;
+        }
+        let cut_at = cut_at.expect("the power cut happened");
+        let image = log.with_device(|c| c.image());
+        let data = read_file(&image, "RUN00001.WBL").unwrap_or_default();
+        let d = decode(&data);
+        prop_assert_eq!(d.damaged, 0);
+        prop_assert!(d.frames.len() as u32 >= flushed_frames);
+        let expected: Vec<u64> = (0..d.frames.len() as u64).map(|i| i * FRAME_PERIOD_US).collect();
+        prop_assert_eq!(&d.frames, &expected);
+        let period_frames = u64::from(LoggerConfig::DEFAULT.flush_period_ms) / 10;
+        prop_assert!(cut_at - d.frames.len() as u64 <= period_frames + 1);
+    }
+}
