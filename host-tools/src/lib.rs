@@ -2,6 +2,7 @@
 //! analyses, reusing the firmware's core crate for everything the logger does.
 #![warn(missing_docs)]
 
+pub mod analysis;
 pub mod cmd;
 pub mod error;
 pub mod export;

@@ -1,0 +1,408 @@
+//! Wobble episodes found offline in the steering angle, each measured the
+//! way the seed paper measures its eigenvalues: the envelope of the free
+//! oscillation fitted with an exponential, `A e^(sigma t)`, and the
+//! frequency of the oscillation under it.
+//!
+//! 1. The steering angle is band-passed around the wobble band (zero phase)
+//!    and its envelope taken from the smoothed signal energy. An episode is
+//!    a stretch where that envelope exceeds [`DETECT_AMP_DEG`], extended on
+//!    both sides to where it is back below [`QUIET_AMP_DEG`].
+//! 2. Its frequency comes from zero crossings around the peak; the signal
+//!    is then demodulated at that frequency (narrow, zero-phase) for a clean
+//!    envelope, and the background in that narrow band (sensor noise, wheel
+//!    ripple) is measured before the episode and removed in power.
+//! 3. If the envelope rises exponentially to the peak for long enough, the
+//!    wobble is **unstable** and sigma is the fitted growth rate; otherwise
+//!    the oscillation was struck (a kick, a pothole) and rings down, the mode
+//!    is **stable**, and sigma is the fitted (negative) decay rate.
+//! 4. An unstable episode's onset is where the fitted exponential is
+//!    [`ONSET_AMP_DEG`]: the wobble's start "from nothing", independent of
+//!    where the noise floor happens to be. A stable episode starts where it
+//!    was struck.
+
+use std::f64::consts::TAU;
+use std::ops::Range;
+
+use serde::Serialize;
+
+use super::filter::{contiguous_spans, wobble_band, Biquad, Pass};
+use super::run::Run;
+use super::sinefit::{fit_mode, SineFit};
+
+/// Envelope at which an unstable wobble is said to start, degrees: below
+/// every sensor's noise, so onsets compare across runs and bicycles.
+pub const ONSET_AMP_DEG: f64 = 0.02;
+/// Envelope that makes an episode, degrees (the size the rider feels).
+pub const DETECT_AMP_DEG: f64 = 0.5;
+/// Envelope below which an episode is over, degrees.
+pub const QUIET_AMP_DEG: f64 = 0.25;
+
+/// Smoothing of the signal energy for detection, Hz.
+const ENERGY_SMOOTHING_HZ: f64 = 2.0;
+/// Low-pass after demodulation, Hz: passes a growth of 4/s with a constant
+/// gain (corrected), rejects the wheel harmonics a few hertz off.
+const DEMOD_LOWPASS_HZ: f64 = 2.0;
+/// Background is measured over this long before an episode, s.
+const BACKGROUND_WINDOW_S: f64 = 8.0;
+/// Envelope fits use the range from this many times the background...
+const FIT_FLOOR_OVER_BACKGROUND: f64 = 3.0;
+/// ...and never start below this, degrees...
+const FIT_FLOOR_MIN_DEG: f64 = 0.1;
+/// ...up to this fraction of the peak, where the envelope still follows the
+/// free oscillation rather than the rider's intervention.
+const FIT_TOP_OF_PEAK: f64 = 0.85;
+/// A growth fit must span this long to call the wobble unstable, s:
+/// a struck oscillation rises within a cycle or two.
+const MIN_GROWTH_FIT_S: f64 = 0.4;
+/// A decay fit must span at least this long, s.
+const MIN_DECAY_FIT_S: f64 = 0.15;
+/// Least coefficient of determination of a fit on the log envelope.
+const MIN_FIT_R2: f64 = 0.9;
+/// Speed at onset is the mean over onset ± this, s.
+const SPEED_HALF_WIDTH_S: f64 = 0.25;
+/// Spans shorter than this (between gaps in the data) are not analysed, s.
+const MIN_SPAN_S: f64 = 2.0;
+
+/// Whether the wobble mode grew or decayed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Stability {
+    /// Struck and ringing down: sigma < 0.
+    Stable,
+    /// Growing by itself: sigma > 0.
+    Unstable,
+}
+
+/// One wobble episode.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Episode {
+    /// Start, s since boot (see the module notes).
+    pub onset_s: f64,
+    /// Envelope back below [`QUIET_AMP_DEG`], s since boot.
+    pub end_s: f64,
+    /// Time of the largest envelope, s since boot.
+    pub peak_s: f64,
+    /// Dominant frequency, Hz.
+    pub freq_hz: f64,
+    /// Real part of the mode: growth (> 0) or decay (< 0) rate of the
+    /// envelope, 1/s.
+    pub sigma_per_s: f64,
+    /// Largest envelope (zero to peak), degrees.
+    pub peak_amp_deg: f64,
+    /// Wheel speed at onset, m/s.
+    pub speed_at_onset_mps: f64,
+    /// Stable or unstable.
+    pub stability: Stability,
+    /// The stretch the envelope fit used, s since boot.
+    pub fit_s: [f64; 2],
+}
+
+impl Episode {
+    /// Imaginary part of the mode, `2 pi f`, rad/s.
+    #[must_use]
+    pub fn omega_rad_s(&self) -> f64 {
+        TAU * self.freq_hz
+    }
+}
+
+/// The wobble speed: the lowest speed at onset of an unstable episode, m/s.
+#[must_use]
+pub fn wobble_speed_mps(episodes: &[Episode]) -> Option<f64> {
+    episodes
+        .iter()
+        .filter(|e| e.stability == Stability::Unstable)
+        .map(|e| e.speed_at_onset_mps)
+        .min_by(f64::total_cmp)
+}
+
+/// Every episode of `run`, in time order.
+#[must_use]
+pub fn find_episodes(run: &Run) -> Vec<Episode> {
+    let fs_hz = run.sample_rate_hz();
+    contiguous_spans(&run.t_s, 1.0 / fs_hz)
+        .into_iter()
+        .filter(|span| span.len() as f64 >= MIN_SPAN_S * fs_hz)
+        .flat_map(|span| Span::new(run, span).episodes())
+        .collect()
+}
+
+/// One evenly sampled stretch of a run, band-passed.
+struct Span<'a> {
+    run: &'a Run,
+    t_s: &'a [f64],
+    band: Vec<f64>,
+    energy: Vec<f64>,
+    fs_hz: f64,
+}
+
+impl<'a> Span<'a> {
+    fn new(run: &'a Run, span: Range<usize>) -> Self {
+        let fs_hz = run.sample_rate_hz();
+        let band = wobble_band(&run.steer_deg[span.clone()], fs_hz);
+        let mut energy: Vec<f64> = band.iter().map(|v| 2.0 * v * v).collect();
+        Biquad::butterworth(Pass::Low, ENERGY_SMOOTHING_HZ, fs_hz).filtfilt(&mut energy);
+        let energy = energy.into_iter().map(|e| e.max(0.0).sqrt()).collect();
+        Self {
+            run,
+            t_s: &run.t_s[span],
+            band,
+            energy,
+            fs_hz,
+        }
+    }
+
+    fn samples(&self, s: f64) -> usize {
+        (s * self.fs_hz).round() as usize
+    }
+
+    fn episodes(&self) -> Vec<Episode> {
+        let mut out = Vec::new();
+        let mut i = 0;
+        while let Some(hit) = self.energy[i..].iter().position(|&e| e > DETECT_AMP_DEG) {
+            let hit = i + hit;
+            let quiet = |&e: &f64| e <= QUIET_AMP_DEG;
+            let start = self.energy[..hit]
+                .iter()
+                .rposition(quiet)
+                .map_or(0, |q| q + 1);
+            let end = self.energy[hit..]
+                .iter()
+                .position(quiet)
+                .map_or(self.energy.len(), |q| hit + q);
+            out.extend(self.measure(start..end));
+            i = end;
+        }
+        out
+    }
+
+    /// Measures the episode whose energy envelope is above quiet over `region`.
+    fn measure(&self, region: Range<usize>) -> Option<Episode> {
+        let peak = region.start + argmax(&self.energy[region.clone()])?;
+        let half_s = self.samples(0.5);
+        let around = peak.saturating_sub(half_s).max(region.start)..(peak + half_s).min(region.end);
+        let f0_hz = crossing_freq_hz(&self.t_s[around.clone()], &self.band[around])?;
+
+        let window = region
+            .start
+            .saturating_sub(self.samples(BACKGROUND_WINDOW_S))
+            ..(region.end + self.samples(1.0)).min(self.band.len());
+        let t = &self.t_s[window.clone()];
+        let env = demod_envelope(&self.band[window.clone()], t, f0_hz, self.fs_hz);
+        let before = region.start.saturating_sub(self.samples(0.3)) - window.start;
+        let background_sq = median(env[..before].iter().map(|e| e * e).collect());
+        let clean: Vec<f64> = env
+            .iter()
+            .map(|e| (e * e - background_sq).max(0.0).sqrt())
+            .collect();
+
+        let local = region.start - window.start..region.end - window.start;
+        let top = local.start + argmax(&clean[local.clone()])?;
+        let peak_amp_deg = clean[top];
+        let floor = (FIT_FLOOR_OVER_BACKGROUND * background_sq.sqrt()).max(FIT_FLOOR_MIN_DEG);
+        let ceiling = FIT_TOP_OF_PEAK * peak_amp_deg;
+        if ceiling <= floor {
+            return None;
+        }
+
+        let growth = growth_range(&clean, top, floor, ceiling)
+            .and_then(|r| fit_log(&t[r.clone()], &clean[r.clone()]).map(|f| (r, f)))
+            .filter(|(r, f)| {
+                f.slope > 0.0 && f.r2 >= MIN_FIT_R2 && f.span_s(t, r) >= MIN_GROWTH_FIT_S
+            });
+        let (stability, range, fit) = match growth {
+            Some((r, f)) => (Stability::Unstable, r, f),
+            None => {
+                let r = decay_range(&clean, top, floor, ceiling)?;
+                let f = fit_log(&t[r.clone()], &clean[r.clone()])?;
+                if f.slope >= 0.0 || f.r2 < MIN_FIT_R2 || f.span_s(t, &r) < MIN_DECAY_FIT_S {
+                    return None;
+                }
+                (Stability::Stable, r, f)
+            }
+        };
+        let band = &self.band[window.clone()][range.clone()];
+        let f1_hz = crossing_freq_hz(&t[range.clone()], band).unwrap_or(f0_hz);
+        let mode = fit_mode(&t[range.clone()], band, fit.slope, TAU * f1_hz)?;
+        let same_sign = (mode.sigma_per_s > 0.0) == (stability == Stability::Unstable);
+        if !same_sign {
+            return None;
+        }
+        let freq_hz = mode.omega_rad_s / TAU;
+        let onset_s = match stability {
+            Stability::Unstable => {
+                let level = mode.log_amp - self.level_bias(t, top, &mode, range.clone());
+                (mode.t0_s + (ONSET_AMP_DEG.ln() - level) / mode.sigma_per_s).max(self.t_s[0])
+            }
+            Stability::Stable => self.t_s[region.start],
+        };
+        let end = region.end.min(self.t_s.len() - 1);
+        Some(Episode {
+            onset_s,
+            end_s: self.t_s[end],
+            peak_s: t[top],
+            freq_hz,
+            sigma_per_s: mode.sigma_per_s,
+            peak_amp_deg,
+            speed_at_onset_mps: self.run.speed_around(onset_s, SPEED_HALF_WIDTH_S),
+            stability,
+            fit_s: [t[range.start], t[range.end - 1]],
+        })
+    }
+
+    /// How much the band-pass changes the fitted log amplitude of `mode`
+    /// over `range`: a synthetic wobble with that mode, growing up to `top`
+    /// and caught as fast, goes through the same filter and fit.
+    fn level_bias(&self, t: &[f64], top: usize, mode: &SineFit, range: Range<usize>) -> f64 {
+        let t_top = t[top];
+        let t0 = mode.t0_s;
+        let sigma = mode.sigma_per_s.abs();
+        let log_env =
+            |ts: f64| mode.log_amp + mode.sigma_per_s * (t_top - t0) - sigma * (ts - t_top).abs();
+        let synthetic: Vec<f64> = t
+            .iter()
+            .map(|&ts| log_env(ts).exp() * (mode.omega_rad_s * (ts - t0)).sin())
+            .collect();
+        let filtered = wobble_band(&synthetic, self.fs_hz);
+        fit_mode(
+            &t[range.clone()],
+            &filtered[range],
+            mode.sigma_per_s,
+            mode.omega_rad_s,
+        )
+        .map_or(0.0, |f| f.log_amp - mode.log_amp)
+    }
+}
+
+/// The last stretch before `top` where the envelope climbs from `floor` to
+/// `ceiling` without falling back under `floor`.
+fn growth_range(env: &[f64], top: usize, floor: f64, ceiling: f64) -> Option<Range<usize>> {
+    let end = env[..=top].iter().rposition(|&e| e <= ceiling)? + 1;
+    let start = env[..end]
+        .iter()
+        .rposition(|&e| e < floor)
+        .map_or(0, |i| i + 1);
+    (end > start + 2).then_some(start..end)
+}
+
+/// The first stretch after `top` where the envelope falls from `ceiling`
+/// to `floor`.
+fn decay_range(env: &[f64], top: usize, floor: f64, ceiling: f64) -> Option<Range<usize>> {
+    let start = top + env[top..].iter().position(|&e| e <= ceiling)?;
+    let end = env[start..]
+        .iter()
+        .position(|&e| e < floor)
+        .map_or(env.len(), |i| start + i);
+    (end > start + 2).then_some(start..end)
+}
+
+/// A straight line through `(t, ln env)`.
+#[derive(Clone, Copy, Debug)]
+struct LogFit {
+    /// 1/s.
+    slope: f64,
+    /// Coefficient of determination.
+    r2: f64,
+}
+
+impl LogFit {
+    fn span_s(&self, t: &[f64], r: &Range<usize>) -> f64 {
+        t[r.end - 1] - t[r.start]
+    }
+}
+
+/// Least squares on the log envelope; `None` without two distinct times or
+/// with a non-positive envelope.
+fn fit_log(t: &[f64], env: &[f64]) -> Option<LogFit> {
+    let t0_s = *t.first()?;
+    let n = t.len() as f64;
+    let ys: Vec<f64> = env.iter().map(|e| e.ln()).collect();
+    if ys.iter().any(|y| !y.is_finite()) {
+        return None;
+    }
+    let mean_t = t.iter().map(|v| v - t0_s).sum::<f64>() / n;
+    let mean_y = ys.iter().sum::<f64>() / n;
+    let (mut stt, mut sty, mut syy) = (0.0, 0.0, 0.0);
+    for (tv, y) in t.iter().zip(&ys) {
+        let (dt, dy) = (tv - t0_s - mean_t, y - mean_y);
+        stt += dt * dt;
+        sty += dt * dy;
+        syy += dy * dy;
+    }
+    if stt <= 0.0 || syy <= 0.0 {
+        return None;
+    }
+    let slope = sty / stt;
+    Some(LogFit {
+        slope,
+        r2: sty * sty / (stt * syy),
+    })
+}
+
+/// Envelope of `band` at `freq_hz`: mixed down to 0 Hz and low-passed
+/// (zero phase), so only what lies within the low-pass of `freq_hz` counts.
+fn demod_envelope(band: &[f64], t: &[f64], freq_hz: f64, fs_hz: f64) -> Vec<f64> {
+    let Some(&t0) = t.first() else {
+        return Vec::new();
+    };
+    let (mut i, mut q): (Vec<f64>, Vec<f64>) = band
+        .iter()
+        .zip(t)
+        .map(|(x, ts)| {
+            let (sin, cos) = (TAU * freq_hz * (ts - t0)).sin_cos();
+            (2.0 * x * cos, 2.0 * x * sin)
+        })
+        .unzip();
+    let lowpass = Biquad::butterworth(Pass::Low, DEMOD_LOWPASS_HZ, fs_hz);
+    lowpass.filtfilt(&mut i);
+    lowpass.filtfilt(&mut q);
+    i.iter().zip(&q).map(|(a, b)| a.hypot(*b)).collect()
+}
+
+/// Frequency from the zero crossings of `x` (at least four), Hz.
+fn crossing_freq_hz(t: &[f64], x: &[f64]) -> Option<f64> {
+    let mut crossings = (1..x.len())
+        .filter(|&i| (x[i - 1] < 0.0) != (x[i] < 0.0))
+        .map(|i| t[i - 1] + (t[i] - t[i - 1]) * x[i - 1] / (x[i - 1] - x[i]));
+    let first = crossings.next()?;
+    let (count, last) = crossings.fold((1usize, first), |(n, _), c| (n + 1, c));
+    (count >= 4 && last > first).then(|| (count - 1) as f64 / (2.0 * (last - first)))
+}
+
+fn argmax(x: &[f64]) -> Option<usize> {
+    x.iter()
+        .enumerate()
+        .max_by(|a, b| a.1.total_cmp(b.1))
+        .map(|(i, _)| i)
+}
+
+/// Median of `v` (0 if empty).
+fn median(mut v: Vec<f64>) -> f64 {
+    if v.is_empty() {
+        return 0.0;
+    }
+    let mid = v.len() / 2;
+    *v.select_nth_unstable_by(mid, f64::total_cmp).1
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn crossings_give_the_tone_frequency() {
+        let t: Vec<f64> = (0..200).map(|i| f64::from(i) / 100.0).collect();
+        let x: Vec<f64> = t.iter().map(|t| (TAU * 6.37 * t + 0.3).sin()).collect();
+        let f = crossing_freq_hz(&t, &x).unwrap();
+        assert!((f - 6.37).abs() < 0.01, "{f}");
+        assert_eq!(crossing_freq_hz(&t[..10], &x[..10]), None);
+    }
+
+    #[test]
+    fn log_fit_recovers_an_exponential() {
+        let t: Vec<f64> = (0..100).map(|i| 3.0 + f64::from(i) / 100.0).collect();
+        let env: Vec<f64> = t.iter().map(|t| 0.1 * (1.7 * (t - 3.0)).exp()).collect();
+        let f = fit_log(&t, &env).unwrap();
+        assert!((f.slope - 1.7).abs() < 1e-9);
+        assert!(f.r2 > 0.999_999);
+    }
+}

@@ -1,0 +1,136 @@
+//! Zero-phase filtering for offline analysis: second-order Butterworth
+//! sections run forwards and backwards, so nothing the analysis measures is
+//! shifted in time.
+
+use std::f64::consts::{FRAC_1_SQRT_2, TAU};
+
+/// One second-order section (direct form II transposed), normalised `a0 = 1`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Biquad {
+    b: [f64; 3],
+    a: [f64; 2],
+}
+
+/// Which side of the corner frequency a section passes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Pass {
+    /// Passes below the corner.
+    Low,
+    /// Passes above the corner.
+    High,
+}
+
+impl Biquad {
+    /// A Butterworth section (Q = 1/sqrt 2) with its corner at `corner_hz`,
+    /// for samples at `fs_hz` (bilinear transform, as in the RBJ cookbook).
+    #[must_use]
+    pub fn butterworth(pass: Pass, corner_hz: f64, fs_hz: f64) -> Self {
+        let w0 = TAU * corner_hz / fs_hz;
+        let (sin, cos) = w0.sin_cos();
+        let alpha = sin / (2.0 * FRAC_1_SQRT_2);
+        let a0 = 1.0 + alpha;
+        let b = match pass {
+            Pass::Low => [(1.0 - cos) / 2.0, 1.0 - cos, (1.0 - cos) / 2.0],
+            Pass::High => [(1.0 + cos) / 2.0, -(1.0 + cos), (1.0 + cos) / 2.0],
+        };
+        Self {
+            b: b.map(|v| v / a0),
+            a: [-2.0 * cos / a0, (1.0 - alpha) / a0],
+        }
+    }
+
+    /// Filters `x` in place in one direction, starting from the state a
+    /// constant input equal to the first sample would have settled to, so a
+    /// signal offset does not ring at the edges.
+    fn run(&self, x: &mut [f64], forward: bool) {
+        let [b0, b1, b2] = self.b;
+        let [a1, a2] = self.a;
+        let first = if forward { x.first() } else { x.last() };
+        let Some(&x0) = first else { return };
+        let dc_gain = (b0 + b1 + b2) / (1.0 + a1 + a2);
+        let y0 = dc_gain * x0;
+        let mut z2 = b2 * x0 - a2 * y0;
+        let mut z1 = b1 * x0 - a1 * y0 + z2;
+        let mut step = |v: &mut f64| {
+            let input = *v;
+            let y = b0 * input + z1;
+            z1 = b1 * input - a1 * y + z2;
+            z2 = b2 * input - a2 * y;
+            *v = y;
+        };
+        if forward {
+            x.iter_mut().for_each(&mut step);
+        } else {
+            x.iter_mut().rev().for_each(&mut step);
+        }
+    }
+
+    /// Filters `x` forwards then backwards: zero phase, squared magnitude.
+    pub fn filtfilt(&self, x: &mut [f64]) {
+        self.run(x, true);
+        self.run(x, false);
+    }
+}
+
+/// The band-pass every steering analysis starts from: 4-12 Hz around the
+/// 6-9 Hz wobble band, wide enough that weave, corners and pedalling (below
+/// 2 Hz, their 4th harmonic below 6 Hz at the most) are gone, while the
+/// band's edges barely touch a wobble.
+#[must_use]
+pub fn wobble_band(x: &[f64], fs_hz: f64) -> Vec<f64> {
+    let mut y = x.to_vec();
+    Biquad::butterworth(Pass::High, 4.0, fs_hz).filtfilt(&mut y);
+    Biquad::butterworth(Pass::Low, 12.0, fs_hz).filtfilt(&mut y);
+    y
+}
+
+/// The indices of `t_s` split where samples are missing (a step over 1.5
+/// frame periods) or time goes backwards: each range is evenly sampled.
+#[must_use]
+pub fn contiguous_spans(t_s: &[f64], period_s: f64) -> Vec<std::ops::Range<usize>> {
+    let mut spans = Vec::new();
+    let mut start = 0;
+    for i in 1..t_s.len() {
+        let dt = t_s[i] - t_s[i - 1];
+        if !(dt > 0.5 * period_s && dt < 1.5 * period_s) {
+            spans.push(start..i);
+            start = i;
+        }
+    }
+    if start < t_s.len() {
+        spans.push(start..t_s.len());
+    }
+    spans
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn tone_amplitude_after(pass: Pass, corner_hz: f64, f_hz: f64) -> f64 {
+        let fs = 100.0;
+        let mut x: Vec<f64> = (0..4000)
+            .map(|i| (TAU * f_hz * f64::from(i) / fs).sin())
+            .collect();
+        Biquad::butterworth(pass, corner_hz, fs).filtfilt(&mut x);
+        x[1000..3000].iter().fold(0.0, |m, v| m.max(v.abs()))
+    }
+
+    #[test]
+    fn corner_is_half_power_after_both_passes() {
+        // One pass is -3 dB at the corner; forwards and backwards, -6 dB.
+        for pass in [Pass::Low, Pass::High] {
+            let a = tone_amplitude_after(pass, 8.0, 8.0);
+            assert!((a - 0.5).abs() < 0.01, "{pass:?}: {a}");
+        }
+        assert!(tone_amplitude_after(Pass::Low, 2.0, 20.0) < 1e-3);
+        assert!(tone_amplitude_after(Pass::High, 4.0, 0.5) < 1e-3);
+    }
+
+    #[test]
+    fn spans_split_at_gaps_and_reversals() {
+        let t = [0.0, 0.01, 0.02, 0.05, 0.06, 0.055, 0.065];
+        assert_eq!(contiguous_spans(&t, 0.01), vec![0..3, 3..5, 5..7]);
+        assert!(contiguous_spans(&[], 0.01).is_empty());
+    }
+}
