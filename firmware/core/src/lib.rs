@@ -7,5 +7,7 @@
 #![cfg_attr(not(any(test, feature = "std")), no_std)]
 #![warn(missing_docs)]
 
+pub mod app;
+pub mod channels;
 pub mod format;
 pub mod logger;

@@ -1,0 +1,263 @@
+//! The queues and shared state between the tasks, each with its size and who
+//! fills and drains it.
+//!
+//! | item | producer | consumer |
+//! |---|---|---|
+//! | [`RecordQueue`] | sampler (high-priority executor), GPS task | writer (thread mode) |
+//! | [`SharedStatus`] | GPS task, writer | sampler (status bits, LED) |
+//!
+//! Queue sizing: at 100 frames/s plus a 20 Hz GPS (fix, and now and then a
+//! UTC pair, an alert or a fault) the producers make at most about 125
+//! records per second. The SD specification lets a card stall a write for up
+//! to 500 ms, during which the writer drains nothing: 0.5 s × 125 /s = 63
+//! records. [`QUEUE_LEN`] = 128 holds 1.0 s of records, twice the allowed
+//! stall, so only a card that breaks the specification costs data, and that
+//! loss is counted and logged. 128 records of at most 56 bytes: 7 KiB of RAM.
+
+use core::sync::atomic::{AtomicU32, Ordering};
+
+use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
+use embassy_sync::channel::Channel;
+
+use crate::format::{Dropout, DropoutReason, Record};
+
+/// Capacity of the sampler -> writer queue, in records (see the module docs).
+pub const QUEUE_LEN: usize = 128;
+
+/// The bounded queue from the producers to the SD writer.
+///
+/// Producers never wait: when the queue is full a frame is counted as
+/// dropped, and the next push that finds room for two records first sends a
+/// [`Dropout`] ([`DropoutReason::QueueFull`]) with the exact count. Usable
+/// from any executor: the lock is a critical section.
+pub struct RecordQueue {
+    channel: Channel<CriticalSectionRawMutex, Record<'static>, QUEUE_LEN>,
+    /// Frames dropped and not yet reported in a dropout record.
+    frames_dropped: AtomicU32,
+    /// Records other than frames dropped since boot (not reported on the
+    /// card: the dropout record counts frames).
+    others_dropped: AtomicU32,
+    /// Highest fill level seen, records.
+    high_water: AtomicU32,
+}
+
+impl Default for RecordQueue {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl RecordQueue {
+    /// An empty queue (a `static`).
+    #[must_use]
+    pub const fn new() -> Self {
+        Self {
+            channel: Channel::new(),
+            frames_dropped: AtomicU32::new(0),
+            others_dropped: AtomicU32::new(0),
+            high_water: AtomicU32::new(0),
+        }
+    }
+
+    /// Queues `rec`; returns whether it was queued. Never blocks.
+    ///
+    /// Frames and the dropout record are pushed by one producer, the
+    /// sampler; other producers push other records, so the dropped-frame
+    /// count has one writer and one reader at a time.
+    pub fn push(&self, rec: Record<'static>) -> bool {
+        let dropped = self.frames_dropped.load(Ordering::Acquire);
+        // The dropout goes in only with room for the record after it, so
+        // the reader learns of the loss before the next frame.
+        if dropped > 0 && matches!(rec, Record::Frame(_)) && self.channel.free_capacity() >= 2 {
+            let dropout = Record::Dropout(Dropout {
+                t_us: rec.t_us(),
+                frames_lost: dropped,
+                reason: DropoutReason::QueueFull,
+            });
+            if self.channel.try_send(dropout).is_ok() {
+                self.frames_dropped.fetch_sub(dropped, Ordering::AcqRel);
+            }
+        }
+        let queued = self.channel.try_send(rec).is_ok();
+        if queued {
+            let len = u32::try_from(self.channel.len()).unwrap_or(u32::MAX);
+            self.high_water.fetch_max(len, Ordering::Relaxed);
+        } else if matches!(rec, Record::Frame(_)) {
+            self.frames_dropped.fetch_add(1, Ordering::AcqRel);
+        } else {
+            self.others_dropped.fetch_add(1, Ordering::Relaxed);
+        }
+        queued
+    }
+
+    /// Waits for the next record.
+    pub async fn pop(&self) -> Record<'static> {
+        self.channel.receive().await
+    }
+
+    /// Takes the next record if there is one.
+    pub fn try_pop(&self) -> Option<Record<'static>> {
+        self.channel.try_receive().ok()
+    }
+
+    /// Records waiting.
+    pub fn len(&self) -> usize {
+        self.channel.len()
+    }
+
+    /// Whether no record is waiting.
+    pub fn is_empty(&self) -> bool {
+        self.channel.is_empty()
+    }
+
+    /// Highest fill level seen since boot, records.
+    pub fn high_water(&self) -> u32 {
+        self.high_water.load(Ordering::Relaxed)
+    }
+
+    /// Frames dropped and not yet reported on the queue.
+    pub fn frames_dropped_pending(&self) -> u32 {
+        self.frames_dropped.load(Ordering::Acquire)
+    }
+
+    /// Records other than frames dropped since boot.
+    pub fn others_dropped(&self) -> u32 {
+        self.others_dropped.load(Ordering::Relaxed)
+    }
+}
+
+/// Small facts the tasks share, each a single word (no 64-bit atomics on
+/// the Cortex-M4).
+pub struct SharedStatus {
+    /// Local time of the last GPS fix with a position, ms since boot; 0:
+    /// none yet.
+    last_fix_ms: AtomicU32,
+    /// Whether the writer has a file open on a card (0/1).
+    card_ok: AtomicU32,
+    /// Whether the writer should close the log (0/1).
+    stop: AtomicU32,
+}
+
+impl Default for SharedStatus {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl SharedStatus {
+    /// Nothing known yet.
+    #[must_use]
+    pub const fn new() -> Self {
+        Self {
+            last_fix_ms: AtomicU32::new(0),
+            card_ok: AtomicU32::new(0),
+            stop: AtomicU32::new(0),
+        }
+    }
+
+    /// The GPS task saw a fix with a position at `t_us`.
+    pub fn set_fix(&self, t_us: u64) {
+        let ms = u32::try_from(t_us / 1000).unwrap_or(u32::MAX).max(1);
+        self.last_fix_ms.store(ms, Ordering::Relaxed);
+    }
+
+    /// Whether the last fix is older than `max_age_us` at `now_us` (or
+    /// there was none).
+    pub fn gps_stale(&self, now_us: u64, max_age_us: u64) -> bool {
+        match self.last_fix_ms.load(Ordering::Relaxed) {
+            0 => true,
+            ms => now_us.saturating_sub(u64::from(ms) * 1000) > max_age_us,
+        }
+    }
+
+    /// The writer reports whether it is logging to a card.
+    pub fn set_card_ok(&self, ok: bool) {
+        self.card_ok.store(u32::from(ok), Ordering::Relaxed);
+    }
+
+    /// Whether the writer is logging to a card.
+    pub fn card_ok(&self) -> bool {
+        self.card_ok.load(Ordering::Relaxed) != 0
+    }
+
+    /// Asks the writer to write what is queued, close the file and return
+    /// (end of a replayed ride, or a shutdown on the board).
+    pub fn request_stop(&self) {
+        self.stop.store(1, Ordering::Release);
+    }
+
+    /// Whether a stop was requested.
+    pub fn stop_requested(&self) -> bool {
+        self.stop.load(Ordering::Acquire) != 0
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::format::{Frame, FrameStatus};
+    use proptest::prelude::*;
+
+    fn frame(t_us: u64) -> Record<'static> {
+        Record::Frame(Frame {
+            t_us,
+            accel: [0; 3],
+            gyro: [0; 3],
+            steer_cdeg: 0,
+            wheel_count: 0,
+            wheel_edge_age_us: 0,
+            speed_mm_s: 0,
+            status: FrameStatus(0),
+        })
+    }
+
+    proptest! {
+        /// A writer that stalls for any stretch: every frame is either
+        /// delivered in order or counted in a dropout record that comes
+        /// before the next delivered frame; nothing is lost silently.
+        #[test]
+        fn stalls_lose_nothing_silently(stalls in proptest::collection::vec((10u64..300, 0u64..2000), 1..6)) {
+            let q = RecordQueue::new();
+            let mut delivered = Vec::new();
+            let mut lost = 0u64;
+            let mut t = 0u64;
+            for &(run_ms, stall_ms) in &stalls {
+                for _ in 0..run_ms / 10 {
+                    q.push(frame(t));
+                    t += 10_000;
+                    while let Some(r) = q.try_pop() {
+                        match r {
+                            Record::Frame(f) => delivered.push((f.t_us, lost)),
+                            Record::Dropout(d) => lost += u64::from(d.frames_lost),
+                            _ => {}
+                        }
+                    }
+                }
+                for _ in 0..stall_ms / 10 {
+                    q.push(frame(t));
+                    t += 10_000;
+                }
+            }
+            q.push(frame(t));
+            t += 10_000;
+            while let Some(r) = q.try_pop() {
+                match r {
+                    Record::Frame(f) => delivered.push((f.t_us, lost)),
+                    Record::Dropout(d) => lost += u64::from(d.frames_lost),
+                    _ => {}
+                }
+            }
+            let total = t / 10_000;
+            prop_assert_eq!(delivered.len() as u64 + lost + u64::from(q.frames_dropped_pending()), total);
+            // Each delivered frame's index = frames before it delivered + lost before it.
+            for (i, &(t_us, lost_before)) in delivered.iter().enumerate() {
+                prop_assert_eq!(t_us / 10_000, i as u64 + lost_before);
+            }
+            let max_stall_ms = stalls.iter().map(|s| s.1).max().unwrap_or(0);
+            if max_stall_ms / 10 < QUEUE_LEN as u64 {
+                prop_assert_eq!(lost, 0);
+            }
+            prop_assert!(q.high_water() as usize <= QUEUE_LEN);
+        }
+    }
+}
