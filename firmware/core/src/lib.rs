@@ -9,5 +9,7 @@
 
 pub mod app;
 pub mod channels;
+pub mod config;
+pub mod drivers;
 pub mod format;
 pub mod logger;

@@ -1,0 +1,742 @@
+//! `CONFIG.TXT`: the rider-editable configuration on the card.
+//!
+//! The file holds `key=value` lines; `#` starts a comment (whole line or
+//! after a value), blank lines are ignored, keys are case-sensitive, and
+//! whitespace around keys and values is ignored. A missing file or key means
+//! the default, which is each module's own `Default` ([`WheelConfig`],
+//! [`SteeringCalibration`], [`ImuConfig`], [`DetectorConfig`],
+//! [`PatternConfig`]), so the firmware and the host tools agree on what a
+//! blank card does.
+//!
+//! Nothing in the file can stop the logger: a line that cannot be understood
+//! is skipped and reported as a [`LineFault`] (written to the log as a
+//! [`FaultSource::Config`] fault), and a section whose values do not make
+//! sense together (say `detector.amp_off_deg` above `detector.amp_on_deg`)
+//! falls back to its defaults as a whole, also reported. Whatever is in force
+//! afterwards is written into the log header by [`Config::write_lines`], in
+//! the same `key=value` syntax, so a log says exactly how it was recorded and the
+//! lines can be pasted back into a `CONFIG.TXT`.
+
+use core::fmt;
+
+use crate::detector::{DetectorConfig, PatternConfig};
+use crate::format::{Fault, FaultSource};
+use crate::imu::{AxisMap, Imu, ImuConfig, SignedAxis};
+use crate::steering::{CalPoint, Steering, SteeringCalibration};
+use crate::wheel::{WheelConfig, WheelSpeed};
+
+/// Fault code: a line without `=` or with an empty key.
+pub const FAULT_SYNTAX: u8 = 1;
+/// Fault code: a key this firmware does not know (a typo, or a newer file).
+pub const FAULT_UNKNOWN_KEY: u8 = 2;
+/// Fault code: a value that does not parse as the key's type (or is NaN,
+/// infinite, negative for a count, too large for its field).
+pub const FAULT_BAD_VALUE: u8 = 3;
+/// Fault code: values that parse but do not work together; their section
+/// (wheel, steering, IMU, detector) fell back to its defaults.
+pub const FAULT_REJECTED: u8 = 4;
+/// Fault code: a line that is not UTF-8, or the part of a file too long to
+/// be read.
+pub const FAULT_UNREADABLE: u8 = 5;
+/// Number of config fault codes (`1..=FAULT_CODES`).
+pub const FAULT_CODES: usize = 5;
+
+/// Line faults kept with their line numbers (the counts stay exact beyond).
+pub const MAX_LINE_FAULTS: usize = 8;
+
+/// Longest text [`Config::write_lines`] produces, for any configuration
+/// (checked by a test with every value at its widest).
+pub const MAX_TEXT_LEN: usize = 2048;
+
+/// Whether the rider is told about a wobble, and how.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct AlertConfig {
+    /// Drive the buzzer and alert LED. When off, alerts are still detected
+    /// and logged, the rider just is not told (blind trials). Default on.
+    pub enabled: bool,
+    /// Beep timing.
+    pub pattern: PatternConfig,
+}
+
+impl Default for AlertConfig {
+    fn default() -> Self {
+        Self {
+            enabled: true,
+            pattern: PatternConfig::DEFAULT,
+        }
+    }
+}
+
+/// Everything `CONFIG.TXT` can set.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Config {
+    /// Wheel-speed sensor.
+    pub wheel: WheelConfig,
+    /// Steering potentiometer calibration.
+    pub steering: SteeringCalibration,
+    /// IMU mounting and health check. The sensitivities are the driver's
+    /// business: the file cannot set them.
+    pub imu: ImuConfig,
+    /// Wobble detector.
+    pub detector: DetectorConfig,
+    /// Rider alert.
+    pub alert: AlertConfig,
+}
+
+/// The sections that are validated (and fall back to defaults) as a whole,
+/// in the order of [`SECTIONS`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Section {
+    Wheel,
+    Steering,
+    Imu,
+    Detector,
+    Alert,
+}
+
+/// How a section is checked and put back to its defaults.
+struct SectionRules {
+    valid: fn(&Config) -> bool,
+    reset: fn(&mut Config),
+}
+
+/// Indexed by [`Section`]. Each check is the one the module applies when it
+/// is built, so the firmware never starts a module on values it refuses.
+const SECTIONS: [SectionRules; 5] = [
+    SectionRules {
+        valid: |c| WheelSpeed::try_new(c.wheel).is_ok(),
+        reset: |c| c.wheel = WheelConfig::default(),
+    },
+    SectionRules {
+        valid: |c| Steering::try_new(c.steering).is_ok(),
+        reset: |c| c.steering = SteeringCalibration::default(),
+    },
+    SectionRules {
+        valid: |c| Imu::try_new(c.imu).is_ok(),
+        reset: |c| c.imu = ImuConfig::default(),
+    },
+    SectionRules {
+        valid: |c| c.detector.cost().is_ok(),
+        reset: |c| c.detector = DetectorConfig::default(),
+    },
+    SectionRules {
+        valid: |_| true,
+        reset: |c| c.alert = AlertConfig::default(),
+    },
+];
+
+/// A value type a key can hold: how it is read from and written to text.
+trait Field: Copy {
+    fn parse(text: &str) -> Option<Self>;
+    fn write(self, out: &mut dyn fmt::Write) -> fmt::Result;
+}
+
+impl Field for f32 {
+    fn parse(text: &str) -> Option<Self> {
+        text.parse::<f32>().ok().filter(|v| v.is_finite())
+    }
+    fn write(self, out: &mut dyn fmt::Write) -> fmt::Result {
+        // Both formats print the shortest text that parses back to the same
+        // value, so the header lines round-trip exactly. `Display` never
+        // uses an exponent (1e-38 would take 40 digits): keep it for the
+        // everyday range only.
+        if self == 0.0 || (1e-4..1e7).contains(&self.abs()) {
+            write!(out, "{self}")
+        } else {
+            write!(out, "{self:e}")
+        }
+    }
+}
+
+macro_rules! unsigned_field {
+    ($($t:ty),+) => {$(
+        impl Field for $t {
+            fn parse(text: &str) -> Option<Self> {
+                text.parse().ok()
+            }
+            fn write(self, out: &mut dyn fmt::Write) -> fmt::Result {
+                write!(out, "{self}")
+            }
+        }
+    )+};
+}
+unsigned_field!(u8, u16, u32);
+
+/// Mounting axes as text: `+x`, `-y`, ...
+const AXIS_NAMES: [(&str, SignedAxis); 6] = [
+    ("+x", SignedAxis::PosX),
+    ("-x", SignedAxis::NegX),
+    ("+y", SignedAxis::PosY),
+    ("-y", SignedAxis::NegY),
+    ("+z", SignedAxis::PosZ),
+    ("-z", SignedAxis::NegZ),
+];
+
+/// `+x,+y,+z`: for the bicycle's x (forward), y (left) and z (up), the
+/// sensor axis along it.
+impl Field for AxisMap {
+    fn parse(text: &str) -> Option<Self> {
+        let mut parts = text.split(',').map(|part| {
+            let part = part.trim();
+            AXIS_NAMES
+                .iter()
+                .find(|(name, _)| *name == part)
+                .map(|&(_, axis)| axis)
+        });
+        let map = [parts.next()??, parts.next()??, parts.next()??];
+        parts.next().is_none().then_some(Self(map))
+    }
+    fn write(self, out: &mut dyn fmt::Write) -> fmt::Result {
+        for (i, axis) in self.0.iter().enumerate() {
+            let name = AXIS_NAMES
+                .iter()
+                .find(|(_, a)| a == axis)
+                .map_or("?", |(n, _)| n);
+            out.write_str(if i == 0 { "" } else { "," })?;
+            out.write_str(name)?;
+        }
+        Ok(())
+    }
+}
+
+/// `none`, or three `counts:deg` points separated by commas.
+impl Field for Option<[CalPoint; 3]> {
+    fn parse(text: &str) -> Option<Self> {
+        if text == "none" {
+            return Some(None);
+        }
+        let mut points = text.split(',').map(|point| {
+            let (counts, deg) = point.split_once(':')?;
+            Some(CalPoint {
+                counts: f32::parse(counts.trim())?,
+                deg: f32::parse(deg.trim())?,
+            })
+        });
+        let three = [points.next()??, points.next()??, points.next()??];
+        points.next().is_none().then_some(Some(three))
+    }
+    fn write(self, out: &mut dyn fmt::Write) -> fmt::Result {
+        let Some(points) = self else {
+            return out.write_str("none");
+        };
+        for (i, p) in points.iter().enumerate() {
+            out.write_str(if i == 0 { "" } else { "," })?;
+            p.counts.write(out)?;
+            out.write_char(':')?;
+            p.deg.write(out)?;
+        }
+        Ok(())
+    }
+}
+
+impl Field for bool {
+    fn parse(text: &str) -> Option<Self> {
+        match text {
+            "true" | "on" | "yes" | "1" => Some(true),
+            "false" | "off" | "no" | "0" => Some(false),
+            _ => None,
+        }
+    }
+    fn write(self, out: &mut dyn fmt::Write) -> fmt::Result {
+        out.write_str(if self { "true" } else { "false" })
+    }
+}
+
+/// One key of the file: its name, section, and how to set and show it.
+struct Key {
+    name: &'static str,
+    section: Section,
+    /// Parses `text` into the field; `false` when it does not parse.
+    apply: fn(&mut Config, &str) -> bool,
+    show: fn(&Config, &mut dyn fmt::Write) -> fmt::Result,
+}
+
+macro_rules! key {
+    ($section:ident, $name:literal, $($field:ident).+) => {
+        Key {
+            name: $name,
+            section: Section::$section,
+            apply: |config, text| match Field::parse(text) {
+                Some(value) => {
+                    config.$($field).+ = value;
+                    true
+                }
+                None => false,
+            },
+            show: |config, out| Field::write(config.$($field).+, out),
+        }
+    };
+}
+
+/// Every key, in the order [`Config::write_lines`] writes them. Not keys: the
+/// detector's sample rate (the firmware's frame rate), the ADC's range and
+/// the IMU's sensitivities (facts of the board, not choices of the rider).
+const KEYS: &[Key] = &[
+    key!(Wheel, "wheel.circumference_m", wheel.circumference_m),
+    key!(Wheel, "wheel.holes", wheel.holes),
+    key!(Wheel, "wheel.timeout_us", wheel.timeout_us),
+    key!(
+        Wheel,
+        "wheel.min_edge_interval_us",
+        wheel.min_edge_interval_us
+    ),
+    key!(Wheel, "wheel.glitch_fraction", wheel.glitch_fraction),
+    key!(Wheel, "wheel.window_edges", wheel.window_edges),
+    key!(Wheel, "wheel.max_window_us", wheel.max_window_us),
+    key!(Steering, "steering.center_counts", steering.center_counts),
+    key!(Steering, "steering.deg_per_count", steering.deg_per_count),
+    key!(Steering, "steering.three_point", steering.three_point),
+    key!(
+        Steering,
+        "steering.saturation_margin",
+        steering.saturation_margin
+    ),
+    key!(Imu, "imu.axis_map", imu.axis_map),
+    key!(Imu, "imu.stuck_samples", imu.stuck_samples),
+    key!(Detector, "detector.window_s", detector.window_s),
+    key!(Detector, "detector.hop_s", detector.hop_s),
+    key!(Detector, "detector.bin_lo_hz", detector.bin_lo_hz),
+    key!(Detector, "detector.bin_hi_hz", detector.bin_hi_hz),
+    key!(Detector, "detector.bin_spacing_hz", detector.bin_spacing_hz),
+    key!(Detector, "detector.band_lo_hz", detector.band_lo_hz),
+    key!(Detector, "detector.band_hi_hz", detector.band_hi_hz),
+    key!(Detector, "detector.highpass_hz", detector.highpass_hz),
+    key!(Detector, "detector.amp_on_deg", detector.amp_on_deg),
+    key!(Detector, "detector.amp_off_deg", detector.amp_off_deg),
+    key!(Detector, "detector.off_hold_s", detector.off_hold_s),
+    key!(Detector, "detector.lookback_s", detector.lookback_s),
+    key!(
+        Detector,
+        "detector.min_growth_ratio",
+        detector.min_growth_ratio
+    ),
+    key!(Detector, "detector.confirm_hops", detector.confirm_hops),
+    key!(Detector, "detector.impulse_fast_s", detector.impulse_fast_s),
+    key!(Detector, "detector.impulse_ref_s", detector.impulse_ref_s),
+    key!(Detector, "detector.impulse_ratio", detector.impulse_ratio),
+    key!(
+        Detector,
+        "detector.impulse_min_deg",
+        detector.impulse_min_deg
+    ),
+    key!(
+        Detector,
+        "detector.impulse_holdoff_s",
+        detector.impulse_holdoff_s
+    ),
+    key!(
+        Detector,
+        "detector.impulse_catchup",
+        detector.impulse_catchup
+    ),
+    key!(
+        Detector,
+        "detector.impulse_capture_s",
+        detector.impulse_capture_s
+    ),
+    key!(
+        Detector,
+        "detector.max_growth_ratio",
+        detector.max_growth_ratio
+    ),
+    key!(Detector, "detector.freq_window_s", detector.freq_window_s),
+    key!(Detector, "detector.min_speed_mps", detector.min_speed_mps),
+    key!(
+        Detector,
+        "detector.wheel_circumference_m",
+        detector.wheel_circumference_m
+    ),
+    key!(
+        Detector,
+        "detector.harmonic_tol_hz",
+        detector.harmonic_tol_hz
+    ),
+    key!(
+        Detector,
+        "detector.harmonic_growth_ratio",
+        detector.harmonic_growth_ratio
+    ),
+    key!(Alert, "alert.enabled", alert.enabled),
+    key!(Alert, "alert.beep_on_us", alert.pattern.beep_on_us),
+    key!(Alert, "alert.beep_off_us", alert.pattern.beep_off_us),
+    key!(Alert, "alert.min_active_us", alert.pattern.min_active_us),
+];
+
+/// Number of `key=value` lines [`Config::write_lines`] produces.
+pub const KEY_COUNT: usize = KEYS.len();
+
+const WHEEL_CIRCUMFERENCE_KEY: &str = "wheel.circumference_m";
+const DETECTOR_CIRCUMFERENCE_KEY: &str = "detector.wheel_circumference_m";
+
+impl Config {
+    /// Reads a `CONFIG.TXT`. Never fails: what cannot be used is reported in
+    /// [`Loaded::faults`] and replaced by defaults.
+    ///
+    /// Setting `wheel.circumference_m` alone also sets
+    /// `detector.wheel_circumference_m` (the detector places the wheel's
+    /// harmonics with it); a file may still set the two apart.
+    #[must_use]
+    pub fn parse(text: &[u8]) -> Loaded {
+        let mut config = Self::default();
+        let mut faults = ConfigFaults::default();
+        // Per section, the last line that set one of its keys (for reports).
+        let mut touched: [Option<u16>; SECTIONS.len()] = [None; SECTIONS.len()];
+        let mut detector_circumference_given = false;
+        let mut wheel_circumference_given = false;
+        for (index, raw) in text.split(|&b| b == b'\n').enumerate() {
+            let line_no = u16::try_from(index + 1).unwrap_or(u16::MAX);
+            let Ok(line) = core::str::from_utf8(raw) else {
+                faults.push(line_no, FAULT_UNREADABLE);
+                continue;
+            };
+            let line = line
+                .split_once('#')
+                .map_or(line, |(before, _)| before)
+                .trim();
+            if line.is_empty() {
+                continue;
+            }
+            let Some((name, value)) = line.split_once('=').map(|(k, v)| (k.trim(), v.trim()))
+            else {
+                faults.push(line_no, FAULT_SYNTAX);
+                continue;
+            };
+            if name.is_empty() {
+                faults.push(line_no, FAULT_SYNTAX);
+                continue;
+            }
+            let Some(key) = KEYS.iter().find(|k| k.name == name) else {
+                faults.push(line_no, FAULT_UNKNOWN_KEY);
+                continue;
+            };
+            if !(key.apply)(&mut config, value) {
+                faults.push(line_no, FAULT_BAD_VALUE);
+                continue;
+            }
+            touched[key.section as usize] = Some(line_no);
+            wheel_circumference_given |= name == WHEEL_CIRCUMFERENCE_KEY;
+            detector_circumference_given |= name == DETECTOR_CIRCUMFERENCE_KEY;
+        }
+        if wheel_circumference_given && !detector_circumference_given {
+            config.detector.wheel_circumference_m = config.wheel.circumference_m;
+        }
+        for (rules, line) in SECTIONS.iter().zip(touched) {
+            if !(rules.valid)(&config) {
+                (rules.reset)(&mut config);
+                faults.push(line.unwrap_or(0), FAULT_REJECTED);
+            }
+        }
+        Loaded { config, faults }
+    }
+
+    /// Writes the configuration as `key=value` lines, each ending in `\n`,
+    /// one per key in a fixed order: what the log header records (one
+    /// record per line) and a complete `CONFIG.TXT`. Parsing the text gives
+    /// this configuration back exactly. At most [`MAX_TEXT_LEN`] bytes.
+    ///
+    /// # Errors
+    /// When `out` fails (is full).
+    pub fn write_lines(&self, out: &mut impl fmt::Write) -> fmt::Result {
+        for key in KEYS {
+            write!(out, "{}=", key.name)?;
+            (key.show)(self, out)?;
+            out.write_char('\n')?;
+        }
+        Ok(())
+    }
+}
+
+/// One line of the file that was not used.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct LineFault {
+    /// Line number, from 1; 0 for a section rejected with no line of its own.
+    pub line: u16,
+    /// One of the `FAULT_*` codes of this module.
+    pub code: u8,
+}
+
+/// What was wrong with a `CONFIG.TXT`: every fault counted per code, the
+/// first [`MAX_LINE_FAULTS`] with their line numbers.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct ConfigFaults {
+    counts: [u16; FAULT_CODES],
+    lines: heapless::Vec<LineFault, MAX_LINE_FAULTS>,
+}
+
+impl ConfigFaults {
+    /// Records a fault with one of the `FAULT_*` codes (others are ignored).
+    pub fn push(&mut self, line: u16, code: u8) {
+        let Some(count) = usize::from(code)
+            .checked_sub(1)
+            .and_then(|i| self.counts.get_mut(i))
+        else {
+            return;
+        };
+        *count = count.saturating_add(1);
+        // Beyond the first few, only the counts are kept.
+        let _ = self.lines.push(LineFault { line, code });
+    }
+
+    /// No fault at all.
+    #[must_use]
+    pub fn is_empty(&self) -> bool {
+        self.counts.iter().all(|&c| c == 0)
+    }
+
+    /// Faults with `code`.
+    #[must_use]
+    pub fn count(&self, code: u8) -> u16 {
+        usize::from(code)
+            .checked_sub(1)
+            .and_then(|i| self.counts.get(i))
+            .copied()
+            .unwrap_or(0)
+    }
+
+    /// The first faults, with their line numbers, in file order.
+    #[must_use]
+    pub fn first(&self) -> &[LineFault] {
+        &self.lines
+    }
+
+    /// One fault record per code that occurred, stamped `t_us`, with its
+    /// count: what the log keeps.
+    pub fn records(&self, t_us: u64) -> impl Iterator<Item = Fault> + '_ {
+        (1u8..)
+            .zip(self.counts)
+            .filter(|&(_, count)| count > 0)
+            .map(move |(code, count)| Fault {
+                t_us,
+                source: FaultSource::Config,
+                code,
+                count,
+            })
+    }
+}
+
+/// A configuration read from a file, with what was wrong with it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Loaded {
+    /// The configuration in force.
+    pub config: Config,
+    /// What was skipped or replaced by defaults.
+    pub faults: ConfigFaults,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn text_of(config: &Config) -> String {
+        let mut text = String::new();
+        config.write_lines(&mut text).expect("String grows");
+        text
+    }
+
+    #[test]
+    fn empty_file_is_the_defaults() {
+        let loaded = Config::parse(b"");
+        assert_eq!(loaded.config, Config::default());
+        assert!(loaded.faults.is_empty());
+    }
+
+    #[test]
+    fn values_comments_and_whitespace() {
+        let text = b"# my bike\r\n\
+            wheel.circumference_m = 2.05   # measured\r\n\
+            \n\
+            detector.amp_on_deg=0.6\n\
+            alert.enabled = off\n";
+        let loaded = Config::parse(text);
+        assert!(loaded.faults.is_empty(), "{:?}", loaded.faults);
+        let c = loaded.config;
+        assert_eq!(c.wheel.circumference_m, 2.05);
+        assert_eq!(c.detector.wheel_circumference_m, 2.05);
+        assert_eq!(c.detector.amp_on_deg, 0.6);
+        assert!(!c.alert.enabled);
+        assert_eq!(c.wheel.holes, WheelConfig::DEFAULT.holes);
+    }
+
+    #[test]
+    fn bad_lines_are_skipped_and_counted_with_line_numbers() {
+        let text = b"wheel.holes=36\nno equals sign\nwheel.colour=red\nwheel.holes=-3\n\
+            detector.amp_on_deg=nan\n=5\n\xff\xfe\n";
+        let loaded = Config::parse(text);
+        assert_eq!(loaded.config.wheel.holes, 36);
+        assert_eq!(loaded.config.detector, DetectorConfig::DEFAULT);
+        let f = &loaded.faults;
+        assert_eq!(
+            f.first(),
+            [
+                LineFault {
+                    line: 2,
+                    code: FAULT_SYNTAX
+                },
+                LineFault {
+                    line: 3,
+                    code: FAULT_UNKNOWN_KEY
+                },
+                LineFault {
+                    line: 4,
+                    code: FAULT_BAD_VALUE
+                },
+                LineFault {
+                    line: 5,
+                    code: FAULT_BAD_VALUE
+                },
+                LineFault {
+                    line: 6,
+                    code: FAULT_SYNTAX
+                },
+                LineFault {
+                    line: 7,
+                    code: FAULT_UNREADABLE
+                },
+            ]
+        );
+        let records: Vec<_> = f.records(7).map(|r| (r.code, r.count)).collect();
+        assert_eq!(records, [(1, 2), (2, 1), (3, 2), (5, 1)]);
+        assert!(f
+            .records(7)
+            .all(|r| r.source == FaultSource::Config && r.t_us == 7));
+    }
+
+    #[test]
+    fn an_inconsistent_section_falls_back_whole() {
+        let text = b"detector.amp_on_deg=0.2\ndetector.amp_off_deg=0.3\nwheel.holes=36\n";
+        let loaded = Config::parse(text);
+        assert_eq!(loaded.config.detector, DetectorConfig::DEFAULT);
+        assert_eq!(loaded.config.wheel.holes, 36);
+        assert_eq!(
+            loaded.faults.first(),
+            [LineFault {
+                line: 2,
+                code: FAULT_REJECTED
+            }]
+        );
+    }
+
+    #[test]
+    fn mounting_and_three_point_calibration() {
+        let text = b"imu.axis_map = -y, +x, +z
+            steering.three_point = 100:-40, 2048:0.5, 4000:41
+";
+        let loaded = Config::parse(text);
+        assert!(loaded.faults.is_empty(), "{:?}", loaded.faults);
+        assert_eq!(
+            loaded.config.imu.axis_map,
+            AxisMap([SignedAxis::NegY, SignedAxis::PosX, SignedAxis::PosZ])
+        );
+        let points = loaded.config.steering.three_point.expect("three points");
+        assert_eq!(
+            points[1],
+            CalPoint {
+                counts: 2048.0,
+                deg: 0.5
+            }
+        );
+        assert_eq!(points[2].deg, 41.0);
+    }
+
+    #[test]
+    fn a_mirrored_mounting_and_unordered_points_are_rejected() {
+        let text = b"imu.axis_map=+y,+x,+z
+steering.three_point=3000:0,2000:1,4000:2
+";
+        let loaded = Config::parse(text);
+        assert_eq!(loaded.config.imu, ImuConfig::default());
+        assert_eq!(loaded.config.steering, SteeringCalibration::default());
+        assert_eq!(
+            loaded.faults.first(),
+            [
+                LineFault {
+                    line: 2,
+                    code: FAULT_REJECTED
+                },
+                LineFault {
+                    line: 1,
+                    code: FAULT_REJECTED
+                }
+            ]
+        );
+        let garbled = Config::parse(
+            b"imu.axis_map=+x,+y
+steering.three_point=1:2,3
+",
+        );
+        assert_eq!(garbled.faults.count(FAULT_BAD_VALUE), 2);
+    }
+
+    #[test]
+    fn a_zero_hole_wheel_is_rejected() {
+        let loaded = Config::parse(b"wheel.holes=0\n");
+        assert_eq!(loaded.config.wheel, WheelConfig::DEFAULT);
+        assert_eq!(loaded.faults.count(FAULT_REJECTED), 1);
+    }
+
+    #[test]
+    fn the_lines_round_trip_and_fit() {
+        let mut c = Config::default();
+        c.wheel.circumference_m = 2.1234567;
+        c.detector.amp_on_deg = 0.55;
+        c.alert.enabled = false;
+        c.imu.axis_map = AxisMap([SignedAxis::PosZ, SignedAxis::NegY, SignedAxis::PosX]);
+        c.steering.three_point = Some([
+            CalPoint {
+                counts: 12.5,
+                deg: -30.25,
+            },
+            CalPoint {
+                counts: 2000.0,
+                deg: 0.0,
+            },
+            CalPoint {
+                counts: 4000.0,
+                deg: 31.0,
+            },
+        ]);
+        let text = text_of(&c);
+        assert_eq!(text.lines().count(), KEY_COUNT);
+        let back = Config::parse(text.as_bytes());
+        assert!(back.faults.is_empty());
+        assert_eq!(back.config, c);
+    }
+
+    #[test]
+    fn the_widest_values_fit_the_text_bound() {
+        let mut c = Config::default();
+        let widest_float = "-1.1754942e-38";
+        let three_point = [widest_float; 3].map(|f| format!("{f}:{f}")).join(",");
+        for key in KEYS {
+            // Whichever of these parses as the key's type (no validation).
+            let applied = [
+                widest_float,
+                "4294967295",
+                "65535",
+                "255",
+                "false",
+                "-x,-y,-z",
+                &three_point,
+            ]
+            .iter()
+            .any(|v| (key.apply)(&mut c, v));
+            assert!(applied, "{}", key.name);
+        }
+        let text = text_of(&c);
+        assert!(text.len() <= MAX_TEXT_LEN, "{} bytes", text.len());
+        assert!(text.contains(&three_point));
+        let mut bounded = heapless::String::<MAX_TEXT_LEN>::new();
+        assert!(c.write_lines(&mut bounded).is_ok());
+    }
+
+    #[test]
+    fn fault_list_keeps_exact_counts_beyond_its_capacity() {
+        let text = "x=1\n".repeat(100);
+        let loaded = Config::parse(text.as_bytes());
+        assert_eq!(loaded.faults.count(FAULT_UNKNOWN_KEY), 100);
+        assert_eq!(loaded.faults.first().len(), MAX_LINE_FAULTS);
+    }
+}

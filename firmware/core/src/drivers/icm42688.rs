@@ -1,0 +1,339 @@
+//! TDK InvenSense ICM-42688-P 6-axis IMU on SPI (`embedded-hal-async`).
+//!
+//! Configured for the wobble logger: ±16 g and ±500 deg/s by default (the
+//! study needs at least ±10 g and ±300 deg/s), both sensors in low-noise mode
+//! at a 100 Hz output data rate, read by the 100 Hz sampler.
+//!
+//! **Anti-aliasing.** The chip samples far faster than 100 Hz and decimates;
+//! two of its filters decide what aliases into the 100 Hz output:
+//! - the analogue-rate anti-alias filter (AAF, 2nd order) is set to its
+//!   lowest corner, 42 Hz (datasheet table: DELT 1, DELTSQR 1, BITSHIFT 15);
+//! - the UI filter ahead of the final decimation runs at max(400 Hz, ODR) =
+//!   400 Hz; it is set to 3rd order with a bandwidth of 400 Hz / 10 = 40 Hz.
+//!
+//! Together that is a 5th-order roll-off from about 40 Hz. Modelled as
+//! Butterworth sections, a component at 60 Hz (which would fold onto 40 Hz)
+//! is down by about 18 dB, one at 90 Hz (folding onto 10 Hz, next to the
+//! wobble band) by about 35 dB. The wobble band, 6-9 Hz, is flat to within
+//! a fraction of a dB and delayed by about 15 ms.
+//!
+//! **Health.** [`Icm42688::init`] checks `WHO_AM_I`: a bus with nothing on it
+//! reads 0x00 or 0xFF ([`Error::NoResponse`]), another part reads something
+//! else ([`Error::WrongId`]). [`Icm42688::read`] reports a sensor whose
+//! registers hold the "no data" marker ([`Error::NotReady`]: it reset or
+//! powered down). A sensor that answers with frozen values is found one level
+//! up, by [`crate::imu::Imu`] ([`FAULT_STUCK`]). Each error maps to an IMU
+//! fault code ([`Error::fault_code`]); the caller re-runs `init` to recover.
+
+use embedded_hal_async::delay::DelayNs;
+use embedded_hal_async::spi::{Operation, SpiDevice};
+
+use crate::imu::{ImuConfig, RawImu};
+
+/// Register addresses and fields (datasheet DS-000347, section 14).
+pub mod reg {
+    /// Bank-select register, present in every bank.
+    pub const REG_BANK_SEL: u8 = 0x76;
+
+    // User bank 0.
+    /// Bank 0: soft reset.
+    pub const DEVICE_CONFIG: u8 = 0x11;
+    /// Bank 0: first data register: ACCEL_DATA_X1 .. GYRO_DATA_Z0 follow,
+    /// 12 bytes, big-endian.
+    pub const ACCEL_DATA_X1: u8 = 0x1F;
+    /// Bank 0: power modes of gyro and accelerometer.
+    pub const PWR_MGMT0: u8 = 0x4E;
+    /// Bank 0: gyro full scale and output data rate.
+    pub const GYRO_CONFIG0: u8 = 0x4F;
+    /// Bank 0: accelerometer full scale and output data rate.
+    pub const ACCEL_CONFIG0: u8 = 0x50;
+    /// Bank 0: gyro UI filter order (bits 3:2).
+    pub const GYRO_CONFIG1: u8 = 0x51;
+    /// Bank 0: UI filter bandwidths, accel (7:4) and gyro (3:0).
+    pub const GYRO_ACCEL_CONFIG0: u8 = 0x52;
+    /// Bank 0: accelerometer UI filter order (bits 4:3).
+    pub const ACCEL_CONFIG1: u8 = 0x53;
+    /// Bank 0: device identity.
+    pub const WHO_AM_I: u8 = 0x75;
+
+    // User bank 1: gyro anti-alias filter.
+    /// Bank 1: GYRO_AAF_DELT (5:0).
+    pub const GYRO_CONFIG_STATIC3: u8 = 0x0C;
+    /// Bank 1: GYRO_AAF_DELTSQR bits 7:0.
+    pub const GYRO_CONFIG_STATIC4: u8 = 0x0D;
+    /// Bank 1: GYRO_AAF_BITSHIFT (7:4), GYRO_AAF_DELTSQR bits 11:8 (3:0).
+    pub const GYRO_CONFIG_STATIC5: u8 = 0x0E;
+
+    // User bank 2: accelerometer anti-alias filter.
+    /// Bank 2: ACCEL_AAF_DELT (6:1), ACCEL_AAF_DIS (0).
+    pub const ACCEL_CONFIG_STATIC2: u8 = 0x03;
+    /// Bank 2: ACCEL_AAF_DELTSQR bits 7:0.
+    pub const ACCEL_CONFIG_STATIC3: u8 = 0x04;
+    /// Bank 2: ACCEL_AAF_BITSHIFT (7:4), ACCEL_AAF_DELTSQR bits 11:8 (3:0).
+    pub const ACCEL_CONFIG_STATIC4: u8 = 0x05;
+
+    /// Set in the address byte of a read.
+    pub const READ: u8 = 0x80;
+    /// `WHO_AM_I` of the ICM-42688-P.
+    pub const WHO_AM_I_VALUE: u8 = 0x47;
+    /// `DEVICE_CONFIG`: SOFT_RESET_CONFIG.
+    pub const SOFT_RESET: u8 = 0x01;
+    /// `PWR_MGMT0`: gyro (3:2) and accel (1:0) in low-noise mode.
+    pub const PWR_GYRO_ACCEL_LOW_NOISE: u8 = 0b0000_1111;
+    /// Output data rate code for 100 Hz (GYRO_ODR / ACCEL_ODR, bits 3:0).
+    pub const ODR_100HZ: u8 = 0b1000;
+    /// Shift of the full-scale field (bits 7:5) in GYRO/ACCEL_CONFIG0.
+    pub const FS_SEL_SHIFT: u8 = 5;
+    /// GYRO_UI_FILT_ORD field (bits 3:2) of GYRO_CONFIG1.
+    pub const GYRO_UI_FILT_ORD_MASK: u8 = 0b0000_1100;
+    /// ACCEL_UI_FILT_ORD field (bits 4:3) of ACCEL_CONFIG1.
+    pub const ACCEL_UI_FILT_ORD_MASK: u8 = 0b0001_1000;
+    /// UI filter order value for 3rd order (2), before shifting.
+    pub const UI_FILT_ORD_3RD: u8 = 2;
+    /// UI filter bandwidth index 4: max(400 Hz, ODR) / 10.
+    pub const UI_FILT_BW_DIV10: u8 = 4;
+    /// AAF setting for a 42 Hz corner: DELT.
+    pub const AAF_42HZ_DELT: u8 = 1;
+    /// AAF setting for a 42 Hz corner: DELTSQR (12 bits).
+    pub const AAF_42HZ_DELTSQR: u16 = 1;
+    /// AAF setting for a 42 Hz corner: BITSHIFT.
+    pub const AAF_42HZ_BITSHIFT: u8 = 15;
+    /// What a data register holds when no sample is available.
+    pub const NO_DATA: i16 = i16::MIN;
+}
+
+/// Wait after a soft reset before the next register access (datasheet: 1 ms).
+pub const RESET_WAIT_US: u32 = 1_000;
+/// Wait after switching the sensors on: the gyro needs 45 ms before its
+/// output is valid (the accelerometer less); no register write for 200 µs.
+pub const STARTUP_WAIT_US: u32 = 45_000;
+
+/// Fault code (source IMU): the SPI bus reported an error.
+pub const FAULT_BUS: u8 = 1;
+/// Fault code: nothing answers (`WHO_AM_I` reads 0x00 or 0xFF).
+pub const FAULT_NO_RESPONSE: u8 = 2;
+/// Fault code: another part answers.
+pub const FAULT_WRONG_ID: u8 = 3;
+/// Fault code: the outputs stopped changing ([`crate::imu::ImuSample::stuck`]).
+pub const FAULT_STUCK: u8 = 4;
+/// Fault code: the data registers hold the "no data" marker.
+pub const FAULT_NOT_READY: u8 = 5;
+
+/// Accelerometer full scale: ±16 g, the only range of this part that
+/// covers the ±10 g the study needs.
+pub const ACCEL_FS_SEL_16G: u8 = 0;
+/// Accelerometer counts per g at ±16 g.
+pub const ACCEL_COUNTS_PER_G: f32 = 2048.0;
+
+/// Gyro full scale.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum GyroRange {
+    /// ±1000 deg/s.
+    Dps1000,
+    /// ±500 deg/s.
+    Dps500,
+}
+
+impl GyroRange {
+    const fn fs_sel(self) -> u8 {
+        match self {
+            Self::Dps1000 => 1,
+            Self::Dps500 => 2,
+        }
+    }
+
+    /// Counts per deg/s.
+    #[must_use]
+    pub const fn counts_per_dps(self) -> f32 {
+        match self {
+            Self::Dps1000 => 32.8,
+            Self::Dps500 => 65.5,
+        }
+    }
+}
+
+/// Driver configuration. The accelerometer range, output rate and filters
+/// are fixed (see the module documentation); the gyro range may be widened.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Config {
+    /// Gyro full scale. Default ±500 deg/s.
+    pub gyro_range: GyroRange,
+}
+
+impl Config {
+    /// `base` with this sensor's datasheet sensitivities for the configured
+    /// ranges (2048 LSB/g at ±16 g, 65.5 LSB/(deg/s) at ±500 deg/s).
+    #[must_use]
+    pub fn imu_config(&self, base: ImuConfig) -> ImuConfig {
+        ImuConfig {
+            accel_g_per_lsb: 1.0 / ACCEL_COUNTS_PER_G,
+            gyro_dps_per_lsb: 1.0 / self.gyro_range.counts_per_dps(),
+            ..base
+        }
+    }
+}
+
+impl Default for Config {
+    fn default() -> Self {
+        Self {
+            gyro_range: GyroRange::Dps500,
+        }
+    }
+}
+
+/// What went wrong.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[non_exhaustive]
+pub enum Error<E> {
+    /// The SPI bus failed.
+    Comm(E),
+    /// `WHO_AM_I` read 0x00 or 0xFF: no sensor on the bus (or no power).
+    NoResponse,
+    /// `WHO_AM_I` read this instead of 0x47: another part.
+    WrongId(u8),
+    /// The data registers hold the "no data" marker: the sensor is off or
+    /// was reset.
+    NotReady,
+}
+
+impl<E> Error<E> {
+    /// The IMU fault code (`FAULT_*`) recorded in the log.
+    #[must_use]
+    pub const fn fault_code(&self) -> u8 {
+        match self {
+            Self::Comm(_) => FAULT_BUS,
+            Self::NoResponse => FAULT_NO_RESPONSE,
+            Self::WrongId(_) => FAULT_WRONG_ID,
+            Self::NotReady => FAULT_NOT_READY,
+        }
+    }
+}
+
+/// Bytes of one accel + gyro burst.
+const DATA_LEN: usize = 12;
+
+/// The driver. Owns its SPI device (chip select handled by the device).
+#[derive(Debug)]
+pub struct Icm42688<SPI> {
+    spi: SPI,
+    config: Config,
+}
+
+impl<SPI: SpiDevice> Icm42688<SPI> {
+    /// A driver for the sensor on `spi`; nothing is sent until [`Self::init`].
+    pub const fn new(spi: SPI, config: Config) -> Self {
+        Self { spi, config }
+    }
+
+    /// Gives the SPI device back.
+    pub fn release(self) -> SPI {
+        self.spi
+    }
+
+    /// Checks the identity, resets the sensor and configures ranges, rate
+    /// and filters, then switches both sensors on and waits until their
+    /// output is valid. Safe to call again to recover from any error.
+    ///
+    /// # Errors
+    /// [`Error::Comm`] on a bus error, [`Error::NoResponse`] or
+    /// [`Error::WrongId`] when the sensor is not there.
+    pub async fn init(&mut self, delay: &mut impl DelayNs) -> Result<(), Error<SPI::Error>> {
+        use reg::*;
+        // The MCU may have reset while the sensor was left in another bank.
+        self.write(REG_BANK_SEL, 0).await?;
+        match self.read_reg(WHO_AM_I).await? {
+            WHO_AM_I_VALUE => {}
+            0x00 | 0xFF => return Err(Error::NoResponse),
+            other => return Err(Error::WrongId(other)),
+        }
+        self.write(DEVICE_CONFIG, SOFT_RESET).await?;
+        delay.delay_us(RESET_WAIT_US).await;
+
+        // Anti-alias filters, banks 1 (gyro) and 2 (accel); the sensors are
+        // off after the reset, as the filter registers require.
+        let [deltsqr_hi, deltsqr_lo] = AAF_42HZ_DELTSQR.to_be_bytes();
+        let shift_and_hi = (AAF_42HZ_BITSHIFT << 4) | deltsqr_hi;
+        self.write(REG_BANK_SEL, 1).await?;
+        self.write(GYRO_CONFIG_STATIC3, AAF_42HZ_DELT).await?;
+        self.write(GYRO_CONFIG_STATIC4, deltsqr_lo).await?;
+        self.write(GYRO_CONFIG_STATIC5, shift_and_hi).await?;
+        self.write(REG_BANK_SEL, 2).await?;
+        // ACCEL_AAF_DIS (bit 0) stays clear: the filter is on.
+        self.write(ACCEL_CONFIG_STATIC2, AAF_42HZ_DELT << 1).await?;
+        self.write(ACCEL_CONFIG_STATIC3, deltsqr_lo).await?;
+        self.write(ACCEL_CONFIG_STATIC4, shift_and_hi).await?;
+        self.write(REG_BANK_SEL, 0).await?;
+
+        let gyro_fs = self.config.gyro_range.fs_sel() << FS_SEL_SHIFT;
+        let accel_fs = ACCEL_FS_SEL_16G << FS_SEL_SHIFT;
+        self.write(GYRO_CONFIG0, gyro_fs | ODR_100HZ).await?;
+        self.write(ACCEL_CONFIG0, accel_fs | ODR_100HZ).await?;
+        // The filter-order registers hold reserved bits: read-modify-write.
+        self.modify(GYRO_CONFIG1, GYRO_UI_FILT_ORD_MASK, UI_FILT_ORD_3RD << 2)
+            .await?;
+        self.modify(ACCEL_CONFIG1, ACCEL_UI_FILT_ORD_MASK, UI_FILT_ORD_3RD << 3)
+            .await?;
+        self.write(
+            GYRO_ACCEL_CONFIG0,
+            (UI_FILT_BW_DIV10 << 4) | UI_FILT_BW_DIV10,
+        )
+        .await?;
+
+        self.write(PWR_MGMT0, PWR_GYRO_ACCEL_LOW_NOISE).await?;
+        delay.delay_us(STARTUP_WAIT_US).await;
+        Ok(())
+    }
+
+    /// Reads the latest accel and gyro sample (one 12-byte burst), in the
+    /// sensor's axes and counts: scale with [`Config::imu_config`].
+    ///
+    /// # Errors
+    /// [`Error::Comm`] on a bus error, [`Error::NotReady`] when the sensor
+    /// has no data.
+    pub async fn read(&mut self) -> Result<RawImu, Error<SPI::Error>> {
+        let mut raw = [0u8; DATA_LEN];
+        self.read_regs(reg::ACCEL_DATA_X1, &mut raw).await?;
+        let word = |i: usize| i16::from_be_bytes([raw[2 * i], raw[2 * i + 1]]);
+        let sample = RawImu {
+            accel: [word(0), word(1), word(2)],
+            gyro: [word(3), word(4), word(5)],
+        };
+        if sample
+            .accel
+            .iter()
+            .chain(&sample.gyro)
+            .all(|&w| w == reg::NO_DATA)
+        {
+            return Err(Error::NotReady);
+        }
+        Ok(sample)
+    }
+
+    async fn write(&mut self, register: u8, value: u8) -> Result<(), Error<SPI::Error>> {
+        self.spi
+            .write(&[register, value])
+            .await
+            .map_err(Error::Comm)
+    }
+
+    async fn read_regs(&mut self, first: u8, out: &mut [u8]) -> Result<(), Error<SPI::Error>> {
+        self.spi
+            .transaction(&mut [Operation::Write(&[first | reg::READ]), Operation::Read(out)])
+            .await
+            .map_err(Error::Comm)
+    }
+
+    async fn read_reg(&mut self, register: u8) -> Result<u8, Error<SPI::Error>> {
+        let mut value = [0u8];
+        self.read_regs(register, &mut value).await?;
+        Ok(value[0])
+    }
+
+    async fn modify(&mut self, register: u8, mask: u8, bits: u8) -> Result<(), Error<SPI::Error>> {
+        let old = self.read_reg(register).await?;
+        self.write(register, (old & !mask) | (bits & mask)).await
+    }
+}

@@ -1,0 +1,6 @@
+//! Drivers for the parts on the logger board, written against the
+//! `embedded-hal(-async)` traits only, so they are tested on the host with
+//! mocked buses and run unchanged on any MCU.
+
+pub mod icm42688;
+pub mod sdcard;

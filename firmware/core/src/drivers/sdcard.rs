@@ -1,0 +1,48 @@
+//! The SD card on SPI: embedded-sdmmc's [`SdCard`] with this logger's
+//! acquisition options, and the wake-up clocks the card needs first.
+//!
+//! Acquisition blocks the thread-mode executor, so its worst case matters
+//! more than its patience: a card that never answers costs, per attempt, one
+//! CMD0 polled 10 001 times plus 255 flush bytes (about 0.36 s at the
+//! 400 kHz identification clock, with embedded-sdmmc's 10 µs poll delay).
+//! Two attempts bound a missing card to about 0.7 s; the logger retries on
+//! its own schedule anyway, so nothing is lost by giving up early.
+
+use embedded_hal::delay::DelayNs;
+use embedded_hal::spi::{SpiBus, SpiDevice};
+use embedded_sdmmc::sdcard::spi::AcquireOpts;
+use embedded_sdmmc::SdCard;
+
+/// Acquisition attempts after the first before the card counts as absent.
+pub const ACQUIRE_RETRIES: u32 = 1;
+
+/// Highest SPI clock while the card is identified (SD physical layer spec).
+pub const IDENTIFICATION_CLOCK_HZ: u32 = 400_000;
+
+/// Bytes of 0xFF sent with the chip select released before the first
+/// command: at least 74 clock cycles (SD spec 6.4.1.1) make 10 bytes.
+pub const WAKE_UP_BYTES: usize = 10;
+const _: () = assert!(WAKE_UP_BYTES * 8 >= 74);
+
+/// Clocks the card into its native mode: [`WAKE_UP_BYTES`] of 0xFF on the
+/// raw bus, with the card's chip select released by the caller.
+///
+/// # Errors
+/// The bus's error.
+pub fn wake_up<B: SpiBus>(bus: &mut B) -> Result<(), B::Error> {
+    bus.write(&[0xFF; WAKE_UP_BYTES])?;
+    bus.flush()
+}
+
+/// The card driver with CRC checking on and [`ACQUIRE_RETRIES`]. Nothing is
+/// sent until the first block access (or `get_card_type`).
+pub fn sd_card<S: SpiDevice, D: DelayNs>(spi: S, delay: D) -> SdCard<S, D> {
+    SdCard::new_with_options(
+        spi,
+        delay,
+        AcquireOpts {
+            use_crc: true,
+            acquire_retries: ACQUIRE_RETRIES,
+        },
+    )
+}

@@ -1,0 +1,39 @@
+//! A sensor that does not answer, or another part in its place, is reported
+//! after the identity check and nothing is written to it.
+
+mod icm42688_support;
+
+use embassy_futures::block_on;
+use embedded_hal_mock::eh1::delay::NoopDelay;
+use embedded_hal_mock::eh1::spi::Mock;
+use icm42688_support::{read_regs, write_reg};
+use wobble_core::drivers::icm42688::{
+    reg::*, Config, Error, Icm42688, FAULT_NO_RESPONSE, FAULT_WRONG_ID,
+};
+
+fn init_with_who_am_i(answer: u8) -> Error<embedded_hal::spi::ErrorKind> {
+    let expectations = [write_reg(REG_BANK_SEL, 0), read_regs(WHO_AM_I, &[answer])].concat();
+    let mut spi = Mock::new(&expectations);
+    let mut imu = Icm42688::new(spi.clone(), Config::default());
+    let err = block_on(imu.init(&mut NoopDelay::new())).expect_err("no sensor");
+    spi.done();
+    err
+}
+
+#[test]
+fn floating_miso_reads_as_no_response() {
+    // Pulled up (no sensor) and held low (sensor unpowered).
+    for answer in [0xFF, 0x00] {
+        let err = init_with_who_am_i(answer);
+        assert_eq!(err, Error::NoResponse);
+        assert_eq!(err.fault_code(), FAULT_NO_RESPONSE);
+    }
+}
+
+#[test]
+fn another_part_is_named_by_its_id() {
+    // 0x12: an ICM-20602 fitted instead.
+    let err = init_with_who_am_i(0x12);
+    assert_eq!(err, Error::WrongId(0x12));
+    assert_eq!(err.fault_code(), FAULT_WRONG_ID);
+}
