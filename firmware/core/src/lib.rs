@@ -10,6 +10,13 @@
 pub mod app;
 pub mod channels;
 pub mod config;
+pub mod decimate;
 pub mod drivers;
+pub mod faults;
 pub mod format;
+pub mod frame_assembly;
+pub mod gps;
+pub mod imu;
 pub mod logger;
+pub mod steering;
+pub mod wheel;
