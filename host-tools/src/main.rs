@@ -22,6 +22,8 @@ enum Command {
     Decode(cmd::decode::Args),
     /// Build a log from a CSV through the firmware's encoder (tests and demos).
     Encode(cmd::encode::Args),
+    /// Replay a raw NMEA capture through the firmware's GPS path; one JSON fix per line.
+    Nmea(cmd::nmea::Args),
 }
 
 fn main() -> ExitCode {
@@ -30,6 +32,7 @@ fn main() -> ExitCode {
         Command::Info(args) => cmd::info::run(&args),
         Command::Decode(args) => cmd::decode::run(&args),
         Command::Encode(args) => cmd::encode::run(&args),
+        Command::Nmea(args) => cmd::nmea::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -6,6 +6,11 @@
 //! interval, with the count since the previous record of that kind (the
 //! `count` field of [`Fault`]). Nothing is lost: the counts add up to the
 //! number of faults that happened.
+//!
+//! Each source defines its codes as `FAULT_*` constants next to the code
+//! that detects them. GPS ([`crate::gps`]): 1 checksum mismatch, 2 line
+//! without checksum, 3 overlong line, 4 broken line (lost or corrupt bytes),
+//! 5 unparseable sentence.
 
 use crate::format::{Fault, FaultSource};
 

@@ -110,7 +110,7 @@ pub struct ImuConfig {
     /// Mounting of the sensor on the bicycle.
     pub axis_map: AxisMap,
     /// This many identical consecutive raw samples mean the IMU is stuck.
-    /// Default 50.
+    /// Default 50; 0 disables the check.
     pub stuck_samples: u16,
 }
 
@@ -263,7 +263,7 @@ impl Imu {
             gyro_dps: c
                 .axis_map
                 .apply([gx, gy, gz].map(|x| x * c.gyro_dps_per_lsb)),
-            stuck: self.repeats.saturating_add(1) >= c.stuck_samples,
+            stuck: c.stuck_samples != 0 && self.repeats.saturating_add(1) >= c.stuck_samples,
         })
     }
 }

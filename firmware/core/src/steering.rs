@@ -1,10 +1,9 @@
 //! Steering angle: potentiometer ADC counts -> degrees, one value per frame.
 //!
 //! The ADC samples the potentiometer much faster than 100 Hz; every sample is
-//! added to a [`Boxcar`](crate::decimate::Boxcar) and each frame takes the
-//! mean of the samples since the previous frame (the anti-alias filter, see
-//! [`crate::decimate`]). The mean in counts is then calibrated to degrees,
-//! positive to the left:
+//! added to a [`Boxcar`] and each frame takes the mean of the samples since
+//! the previous frame (the anti-alias filter, see [`crate::decimate`]). The
+//! mean in counts is then calibrated to degrees, positive to the left:
 //!
 //! - two-point (default): `deg = (counts − center_counts) × deg_per_count`;
 //! - three-point: piecewise linear through three measured (counts, degrees)

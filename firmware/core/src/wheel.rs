@@ -115,6 +115,8 @@ pub enum WheelConfigError {
     Window,
     /// `glitch_fraction` is outside 0..1.
     GlitchFraction,
+    /// `timeout_us` is not longer than `min_edge_interval_us`.
+    Timeout,
 }
 
 impl fmt::Display for WheelConfigError {
@@ -124,6 +126,7 @@ impl fmt::Display for WheelConfigError {
             Self::NoHoles => "the wheel disc needs at least one hole",
             Self::Window => "wheel speed window must be 1 to 63 edges",
             Self::GlitchFraction => "wheel glitch fraction must be between 0 and 1",
+            Self::Timeout => "wheel timeout must be longer than the minimum edge interval",
         })
     }
 }
@@ -187,6 +190,9 @@ impl WheelSpeed {
         }
         if !(0.0..1.0).contains(&config.glitch_fraction) {
             return Err(WheelConfigError::GlitchFraction);
+        }
+        if config.timeout_us <= config.min_edge_interval_us {
+            return Err(WheelConfigError::Timeout);
         }
         Ok(Self {
             config,
@@ -362,6 +368,13 @@ mod tests {
                 ..d
             }),
             WheelConfigError::GlitchFraction
+        );
+        assert_eq!(
+            bad(WheelConfig {
+                timeout_us: 400,
+                ..d
+            }),
+            WheelConfigError::Timeout
         );
     }
 

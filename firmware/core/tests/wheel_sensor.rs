@@ -313,9 +313,11 @@ fn accuracy_report() {
         eccentricity_m: 0.3e-3 * CIRCUMFERENCE_M / (std::f64::consts::TAU * 0.06),
         jitter_us: 2.0,
     };
-    println!("wheel speed accuracy, 100 Hz samples over 10 s after the first revolution");
+    println!(
+        "wheel speed accuracy at 100 Hz samples: steady cases over 10 s after the first second"
+    );
     println!("(disc ±0.1 mm, 0.3 mm eccentric, ±2 µs jitter, 1 µs timer)");
-    println!("{:<34} {:>12} {:>12}", "case", "max |err|", "rms err");
+    println!("{:<34} {:>14} {:>14}", "case", "max |err|", "rms err");
     let mut rng = Rng(0x5eed);
     for v in [4.0, 10.0] {
         let m = Motion::steady(v, 11.0);
@@ -329,10 +331,10 @@ fn accuracy_report() {
             .collect();
         let (max, rms) = stats(&ours, |t| m.speed(t));
         println!(
-            "{:<34} {:>9.4} m/s {:>8.4} m/s   ({:.3} % max)",
+            "{:<34} {:>9.2} mm/s {:>9.2} mm/s   ({:.4} % max)",
             format!("{v} m/s, period over 1 revolution"),
-            max,
-            rms,
+            1e3 * max,
+            1e3 * rms,
             100.0 * max / v
         );
         assert!(max / v < 0.001, "{v} m/s: {max}");
@@ -349,18 +351,18 @@ fn accuracy_report() {
             .collect();
         let (max, rms) = stats(&short, |t| m.speed(t));
         println!(
-            "{:<34} {:>9.4} m/s {:>8.4} m/s",
+            "{:<34} {:>9.2} mm/s {:>9.2} mm/s",
             format!("{v} m/s, period over 5 intervals"),
-            max,
-            rms
+            1e3 * max,
+            1e3 * rms
         );
         let naive = counts_per_frame(&edges, from, 11_000_000);
         let (max, rms) = stats(&naive, |t| m.speed(t));
         println!(
-            "{:<34} {:>9.4} m/s {:>8.4} m/s",
+            "{:<34} {:>9.0} mm/s {:>9.0} mm/s",
             format!("{v} m/s, edges counted per 10 ms"),
-            max,
-            rms
+            1e3 * max,
+            1e3 * rms
         );
     }
     // Steady 7 m/s for 1 s, then 1 s of acceleration or braking.
@@ -380,10 +382,10 @@ fn accuracy_report() {
             .collect();
         let (max, rms) = stats(&ours, |t| m.speed(t));
         println!(
-            "{:<34} {:>9.4} m/s {:>8.4} m/s",
+            "{:<34} {:>9.1} mm/s {:>9.1} mm/s",
             format!("7 m/s, then {a:+} m/s² for 1 s"),
-            max,
-            rms
+            1e3 * max,
+            1e3 * rms
         );
     }
 }

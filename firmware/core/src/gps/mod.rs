@@ -50,6 +50,19 @@ pub const FAULT_UNPARSEABLE: u8 = 5;
 /// Number of GPS fault codes (`1..=FAULT_CODES`).
 pub const FAULT_CODES: usize = 5;
 
+/// A short name for GPS fault `code`, for reports.
+#[must_use]
+pub const fn fault_name(code: u8) -> Option<&'static str> {
+    Some(match code {
+        FAULT_CHECKSUM => "checksum errors",
+        FAULT_NO_CHECKSUM => "lines without checksum",
+        FAULT_OVERLONG => "overlong lines",
+        FAULT_FRAMING => "broken lines (lost or corrupt bytes)",
+        FAULT_UNPARSEABLE => "unparseable sentences",
+        _ => return None,
+    })
+}
+
 /// Configuration of the GPS path.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
