@@ -220,7 +220,7 @@ fn encode_gps(w: &mut Writer<'_>, g: &GpsFix, sdelta: i64) -> Option<()> {
         | u8::from(g.course_cdeg.is_some()) * GPS_COURSE
         | u8::from(g.alt_cm.is_some()) * GPS_ALT
         | u8::from(quality) * GPS_QUALITY
-        | fix_bits << GPS_FIX_SHIFT;
+        | (fix_bits << GPS_FIX_SHIFT);
     w.u8(TAG_GPS)?;
     w.uvar(varint::zigzag(sdelta))?;
     w.u8(flags)?;
