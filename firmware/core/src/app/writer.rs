@@ -25,13 +25,14 @@ pub async fn run<D: BlockDevice, T: TimeSource>(
     shared: &SharedStatus,
 ) -> Result<(), CloseError> {
     loop {
-        let next = select(queue.pop(), Timer::after_millis(IDLE_POLL_MS)).await;
-        let now_us = Instant::now().as_micros();
-        if let Either::First(rec) = next {
-            logger.push(&rec, now_us);
-        }
-        logger.poll(now_us);
+        // Polled before the first record too: the card is opened at boot,
+        // while the queue holds what the sampler makes meanwhile.
+        logger.poll(Instant::now().as_micros());
         shared.set_card_ok(matches!(logger.state(), LoggerState::Logging { .. }));
+        let next = select(queue.pop(), Timer::after_millis(IDLE_POLL_MS)).await;
+        if let Either::First(rec) = next {
+            logger.push(&rec, Instant::now().as_micros());
+        }
         if shared.stop_requested() && queue.is_empty() {
             return logger.close(Instant::now().as_micros());
         }

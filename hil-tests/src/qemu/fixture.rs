@@ -1,0 +1,214 @@
+//! The files a QEMU run replays: `ride.bin` (steering, IMU and wheel edges
+//! per 10 ms frame) from a corpus ride, and `gps.bin` (NMEA bytes with their
+//! arrival times) from a real receiver capture. Layouts are documented in
+//! `qemu-image/src/replay.rs`.
+
+use std::path::{Path, PathBuf};
+
+use wobble_core::format::{GpsFix, ACCEL_COUNTS_PER_G, GYRO_COUNTS_PER_DPS};
+use wobble_core::gps::{GpsConfig, GpsEvent, GpsReceiver};
+use wobble_core::wheel::WheelConfig;
+
+use crate::corpus::{self, FixtureTruth, Row};
+
+/// Frame period, µs.
+pub const FRAME_US: u64 = 10_000;
+/// UART character time at the receiver's 115 200 baud (8N1), µs.
+const CHAR_US: f64 = 10.0 * 1e6 / 115_200.0;
+/// Longest `gps.bin` record the image takes (its buffer), bytes.
+const MAX_GPS_RECORD: usize = 200;
+
+/// A corpus ride and its ground truth.
+#[derive(Clone, Debug)]
+pub struct CorpusRide {
+    /// 100 Hz rows.
+    pub rows: Vec<Row>,
+    /// Ground truth from the manifest.
+    pub truth: FixtureTruth,
+}
+
+/// Loads corpus fixture `name`: the committed CSV if present, else the
+/// generator's output (the same bytes: a corpus test checks that).
+///
+/// # Errors
+/// No fixture of that name, or an unreadable CSV.
+pub fn corpus_ride(name: &str) -> Result<CorpusRide, String> {
+    let dir = corpus::corpus_dir();
+    let manifest = std::fs::read_to_string(dir.join("manifest.json"))
+        .ok()
+        .and_then(|text| serde_json::from_str::<corpus::Manifest>(&text).ok());
+    let committed = manifest.and_then(|m| m.fixtures.into_iter().find(|f| f.name == name));
+    if let Some(truth) = committed {
+        if let Ok(csv) = std::fs::read_to_string(corpus::fixture_path(&dir, &truth)) {
+            return Ok(CorpusRide {
+                rows: corpus::parse_rows(&csv)?,
+                truth,
+            });
+        }
+    }
+    let fixture = corpus::generate()
+        .into_iter()
+        .find(|f| f.truth.name == name)
+        .ok_or_else(|| format!("no corpus fixture named {name}"))?;
+    Ok(CorpusRide {
+        rows: fixture.rows()?,
+        truth: fixture.truth,
+    })
+}
+
+/// Writes `ride.bin` for the first `frames` rows of `rows` (the last row
+/// repeats if the ride is shorter).
+///
+/// The IMU is synthesised: gravity on z, a lateral acceleration and a yaw
+/// rate that follow the steering (v²·δ/L and v·δ/L of a 1.1 m wheelbase),
+/// so the frames carry plausible values that the test can recognise.
+/// Wheel edges come from integrating the speed over the firmware's wheel
+/// (its default circumference and hole count).
+///
+/// # Errors
+/// The file could not be written.
+pub fn write_ride(path: &Path, rows: &[Row], frames: usize) -> std::io::Result<()> {
+    const WHEELBASE_M: f64 = 1.1;
+    let wheel = WheelConfig::DEFAULT;
+    let pitch_m = f64::from(wheel.circumference_m) / f64::from(wheel.holes);
+    let mut out = Vec::with_capacity(frames * 20);
+    let mut distance_m = 0.0f64;
+    let mut next_edge_m = pitch_m;
+    let last = rows.last().copied().unwrap_or(Row {
+        t_s: 0.0,
+        steer_deg: 0.0,
+        speed_mps: 0.0,
+    });
+    for k in 0..frames {
+        let row = rows.get(k).copied().unwrap_or(last);
+        let steer_rad = f64::from(row.steer_deg).to_radians();
+        let v = f64::from(row.speed_mps);
+        let lat_g = v * v * steer_rad / WHEELBASE_M / 9.81;
+        let yaw_dps = (v * steer_rad / WHEELBASE_M).to_degrees();
+        let steer_cdeg = (f64::from(row.steer_deg) * 100.0).round() as i16;
+        let accel = [0.0, lat_g, 1.0].map(|g| (g * f64::from(ACCEL_COUNTS_PER_G)).round() as i16);
+        let gyro = [0.0, 0.0, yaw_dps].map(|d| (d * f64::from(GYRO_COUNTS_PER_DPS)).round() as i16);
+        out.extend_from_slice(&steer_cdeg.to_le_bytes());
+        for v in accel.iter().chain(&gyro) {
+            out.extend_from_slice(&v.to_le_bytes());
+        }
+        // Edges within this frame's 10 ms, as ages before the frame's end.
+        let step_m = v * FRAME_US as f64 / 1e6;
+        let mut ages = Vec::new();
+        while next_edge_m <= distance_m + step_m && step_m > 0.0 {
+            let frac = (next_edge_m - distance_m) / step_m;
+            ages.push(((1.0 - frac) * FRAME_US as f64) as u16);
+            next_edge_m += pitch_m;
+        }
+        distance_m += step_m;
+        out.push(ages.len() as u8);
+        for age in ages {
+            out.extend_from_slice(&age.to_le_bytes());
+        }
+    }
+    std::fs::write(path, out)
+}
+
+/// One chunk of GPS bytes and when its last byte arrives, µs since boot.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct GpsChunk {
+    /// Arrival time of the chunk's last byte, µs since boot.
+    pub t_us: u64,
+    /// The bytes.
+    pub bytes: Vec<u8>,
+}
+
+/// The NMEA capture `fixtures/gps/NAME` scheduled as it was sent: each line
+/// at its sentence's time of day relative to the first one (lines without a
+/// time follow the previous one at UART pace), starting at `start_us`,
+/// until `end_us`.
+///
+/// # Errors
+/// The capture could not be read.
+pub fn gps_schedule(name: &str, start_us: u64, end_us: u64) -> Result<Vec<GpsChunk>, String> {
+    let path = gps_capture_path(name);
+    let text = std::fs::read(&path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let mut chunks = Vec::new();
+    let mut first_tod_ms: Option<u64> = None;
+    let mut t_us = start_us;
+    for line in text
+        .split(|&b| b == b'\n')
+        .filter(|l| !l.starts_with(b"#") && !l.is_empty())
+    {
+        if let Some(tod_ms) = time_of_day_ms(line) {
+            let base = *first_tod_ms.get_or_insert(tod_ms);
+            t_us = t_us.max(start_us + tod_ms.saturating_sub(base) * 1000);
+        }
+        let mut bytes = line.to_vec();
+        bytes.push(b'\n');
+        for piece in bytes.chunks(MAX_GPS_RECORD) {
+            t_us += (piece.len() as f64 * CHAR_US) as u64;
+            if t_us >= end_us {
+                return Ok(chunks);
+            }
+            chunks.push(GpsChunk {
+                t_us,
+                bytes: piece.to_vec(),
+            });
+        }
+    }
+    Ok(chunks)
+}
+
+/// `hil-tests/fixtures/gps/NAME`.
+#[must_use]
+pub fn gps_capture_path(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("fixtures")
+        .join("gps")
+        .join(name)
+}
+
+/// The time of day of an RMC, GGA, GLL or ZDA line, ms.
+fn time_of_day_ms(line: &[u8]) -> Option<u64> {
+    let text = std::str::from_utf8(line).ok()?;
+    let mut fields = text.split(',');
+    let kind = fields.next()?.get(3..)?;
+    let field = match kind {
+        "RMC" | "GGA" | "ZDA" => fields.next()?,
+        "GLL" => fields.nth(4)?,
+        _ => return None,
+    };
+    let hh: u64 = field.get(0..2)?.parse().ok()?;
+    let mm: u64 = field.get(2..4)?.parse().ok()?;
+    let secs: f64 = field.get(4..)?.parse().ok()?;
+    Some((hh * 3600 + mm * 60) * 1000 + (secs * 1000.0).round() as u64)
+}
+
+/// Writes `gps.bin` (`t_ms` u32, `len` u16, bytes) for `chunks`.
+///
+/// # Errors
+/// The file could not be written.
+pub fn write_gps(path: &Path, chunks: &[GpsChunk]) -> std::io::Result<()> {
+    let mut out = Vec::new();
+    for c in chunks {
+        let t_ms = u32::try_from(c.t_us / 1000).unwrap_or(u32::MAX);
+        out.extend_from_slice(&t_ms.to_le_bytes());
+        out.extend_from_slice(&(c.bytes.len() as u16).to_le_bytes());
+        out.extend_from_slice(&c.bytes);
+    }
+    std::fs::write(path, out)
+}
+
+/// The fixes the firmware's GPS path makes of `chunks` (the same code, run
+/// on the host): what the card must hold.
+#[must_use]
+pub fn expected_fixes(chunks: &[GpsChunk]) -> Vec<GpsFix> {
+    let mut rx = GpsReceiver::new(GpsConfig::default());
+    let mut fixes = Vec::new();
+    let mut emit = |ev: GpsEvent| {
+        if let GpsEvent::Fix(f) = ev {
+            fixes.push(f);
+        }
+    };
+    for c in chunks {
+        // The image hands the chunk over when its record's ms comes due.
+        rx.feed(&c.bytes, c.t_us / 1000 * 1000, &mut emit);
+    }
+    fixes
+}

@@ -1,0 +1,91 @@
+//! The QEMU harness: builds the firmware image for `netduinoplus2`, runs it
+//! under `qemu-system-arm -icount shift=auto,sleep=off` on fixtures with a
+//! fresh FAT32 card image, and reads back what it wrote.
+//!
+//! ```text
+//! corpus ride + NMEA capture ─> fixture ─> ride.bin, gps.bin ─┐
+//! Scenario (faults) ─────────────────────> scenario.txt ──────┼─> run ─> QEMU ─> card.img ─> decode (wobblog)
+//! mkfs.fat ─────────────────────────────> card.img ───────────┘           └──> report lines (ALERT, END...)
+//! ```
+
+pub mod card;
+pub mod decode;
+pub mod fixture;
+pub mod run;
+
+pub use run::{image, run, Outcome, Scenario, Setup};
+
+use std::path::{Path, PathBuf};
+
+use fixture::{CorpusRide, GpsChunk};
+
+/// The bundled ride: the corpus fixture like the seed paper's Figure 6.
+pub const RIDE: &str = "wobble_fig6";
+/// The bundled GPS capture: a Quectel L76K at 5 Hz, 30 s (gpsd's test log).
+pub const GPS_CAPTURE: &str = "quectel-l76k-nmea.log";
+/// When the first GPS byte arrives, µs since boot.
+pub const GPS_START_US: u64 = 500_000;
+
+/// A ride's sensor rows, ground truth and GPS bytes.
+#[derive(Clone, Debug)]
+pub struct Bundle {
+    /// The corpus ride.
+    pub ride: CorpusRide,
+    /// The capture's bytes, scheduled.
+    pub gps: Vec<GpsChunk>,
+}
+
+/// The bundled ride and capture, for `frames` frames.
+///
+/// # Errors
+/// A fixture is missing.
+pub fn bundle(frames: u32) -> Result<Bundle, String> {
+    let end_us = u64::from(frames) * fixture::FRAME_US;
+    Ok(Bundle {
+        ride: fixture::corpus_ride(RIDE)?,
+        gps: fixture::gps_schedule(GPS_CAPTURE, GPS_START_US, end_us)?,
+    })
+}
+
+impl Bundle {
+    /// A setup for running this bundle with `scenario` in `dir`.
+    #[must_use]
+    pub fn setup(&self, dir: PathBuf, scenario: Scenario) -> Setup<'_> {
+        Setup {
+            dir,
+            scenario,
+            rows: &self.ride.rows,
+            gps: &self.gps,
+        }
+    }
+}
+
+/// Lines `fsck.fat -n` prints about a file that was being written when the
+/// power went: its directory entry holds the size of the last flush while
+/// its cluster chain already reaches further, and the free-cluster count in
+/// the FS info sector is behind. Anything else is corruption.
+pub const UNCLOSED_FILE_FSCK: [&str; 4] = [
+    "/RUN",
+    "File size is ",
+    "Truncating file to ",
+    "Free cluster summary wrong",
+];
+
+/// Whether an `fsck.fat` complaint is one of [`UNCLOSED_FILE_FSCK`].
+#[must_use]
+pub fn is_unclosed_file_state(problem: &str) -> bool {
+    UNCLOSED_FILE_FSCK
+        .iter()
+        .any(|p| problem.starts_with(p) || problem.contains(", cluster chain length is "))
+}
+
+/// A fresh working directory for run `name` under `base`.
+///
+/// # Errors
+/// It cannot be created.
+pub fn work_dir(base: &Path, name: &str) -> Result<PathBuf, String> {
+    let dir = base.join("qemu-runs").join(name);
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    Ok(dir)
+}

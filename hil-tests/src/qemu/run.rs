@@ -1,0 +1,242 @@
+//! Building the QEMU image once and running it on a scenario.
+
+use std::collections::BTreeMap;
+use std::io::{BufRead, BufReader};
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+use std::sync::OnceLock;
+use std::time::{Duration, Instant};
+
+use super::card;
+use super::fixture::{self, GpsChunk};
+use crate::corpus::Row;
+
+/// The MCU target of the image.
+pub const TARGET: &str = "thumbv7em-none-eabihf";
+/// A run taking longer than this on the wall clock has hung.
+pub const WALL_LIMIT: Duration = Duration::from_secs(180);
+
+/// Builds the image (once per process; a no-op when it is up to date) and
+/// returns its path.
+///
+/// # Errors
+/// The build failed (missing target: `rustup target add thumbv7em-none-eabihf`).
+pub fn image() -> Result<PathBuf, String> {
+    static IMAGE: OnceLock<Result<PathBuf, String>> = OnceLock::new();
+    IMAGE.get_or_init(build_image).clone()
+}
+
+fn build_image() -> Result<PathBuf, String> {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
+    let status = Command::new(cargo)
+        .current_dir(&root)
+        .args([
+            "build",
+            "--release",
+            "-p",
+            "wobble-qemu-image",
+            "--target",
+            TARGET,
+        ])
+        .status()
+        .map_err(|e| format!("cargo: {e}"))?;
+    if !status.success() {
+        return Err("building the QEMU image failed".into());
+    }
+    let target_dir =
+        std::env::var_os("CARGO_TARGET_DIR").map_or_else(|| root.join("target"), PathBuf::from);
+    Ok(target_dir
+        .join(TARGET)
+        .join("release")
+        .join("wobble-qemu-image"))
+}
+
+/// What the harness asks of a run (`scenario.txt`, see the image's
+/// `scenario.rs`).
+#[derive(Clone, Debug, Default)]
+pub struct Scenario {
+    /// Ride length, frames.
+    pub frames: u32,
+    /// (block write number, stall ms).
+    pub stalls: Vec<(u32, u32)>,
+    /// Power cut before this block write.
+    pub cut_at_write: Option<u32>,
+    /// Card absent from/to, ms.
+    pub card_absent_ms: Option<(u32, u32)>,
+    /// IMU dead from, ms.
+    pub imu_dead_from_ms: Option<u32>,
+    /// GPS noise from/to, ms.
+    pub gps_garbage_ms: Option<(u32, u32)>,
+}
+
+impl Scenario {
+    /// A plain ride of `frames` frames.
+    #[must_use]
+    pub fn ride(frames: u32) -> Self {
+        Self {
+            frames,
+            ..Self::default()
+        }
+    }
+
+    fn text(&self) -> String {
+        let mut s = format!("frames={}\n", self.frames);
+        for (w, ms) in &self.stalls {
+            s += &format!("stall={w}:{ms}\n");
+        }
+        if let Some(w) = self.cut_at_write {
+            s += &format!("cut={w}\n");
+        }
+        if let Some((a, b)) = self.card_absent_ms {
+            s += &format!("card_absent_ms={a}:{b}\n");
+        }
+        if let Some(t) = self.imu_dead_from_ms {
+            s += &format!("imu_dead_ms={t}\n");
+        }
+        if let Some((a, b)) = self.gps_garbage_ms {
+            s += &format!("gps_garbage_ms={a}:{b}\n");
+        }
+        s
+    }
+}
+
+/// The inputs of a run.
+pub struct Setup<'a> {
+    /// Working directory (created; holds the card image afterwards).
+    pub dir: PathBuf,
+    /// The scenario.
+    pub scenario: Scenario,
+    /// Sensor rows to replay.
+    pub rows: &'a [Row],
+    /// GPS bytes to replay.
+    pub gps: &'a [GpsChunk],
+}
+
+/// How a run went.
+#[derive(Clone, Debug)]
+pub struct Outcome {
+    /// QEMU's exit code (the image's: 0 done, 2 bad scenario, 3 power cut).
+    pub code: i32,
+    /// Report lines, in order.
+    pub lines: Vec<String>,
+    /// Wall-clock time of the QEMU process.
+    pub wall: Duration,
+    /// The card image.
+    pub card: PathBuf,
+}
+
+impl Outcome {
+    /// The `key=value` fields of the first line starting with `kind`.
+    #[must_use]
+    pub fn fields(&self, kind: &str) -> Option<BTreeMap<String, String>> {
+        self.lines
+            .iter()
+            .find(|l| l.split(' ').next() == Some(kind))
+            .map(|l| parse_fields(l))
+    }
+
+    /// A numeric field of the first `kind` line.
+    #[must_use]
+    pub fn number(&self, kind: &str, key: &str) -> Option<u64> {
+        self.fields(kind)?.get(key)?.parse().ok()
+    }
+
+    /// Alert switchings the image reported as they happened: (on, t_us).
+    #[must_use]
+    pub fn alerts(&self) -> Vec<(bool, u64)> {
+        self.lines
+            .iter()
+            .filter_map(|l| {
+                let rest = l.strip_prefix("ALERT ")?;
+                let f = parse_fields(l);
+                Some((rest.starts_with("on"), f.get("t_us")?.parse().ok()?))
+            })
+            .collect()
+    }
+}
+
+fn parse_fields(line: &str) -> BTreeMap<String, String> {
+    line.split(' ')
+        .filter_map(|kv| kv.split_once('='))
+        .map(|(k, v)| (k.to_owned(), v.to_owned()))
+        .collect()
+}
+
+/// Runs the image on `setup` with a fresh card (`prepare_card` may alter
+/// it first), passing each report line to `on_line` as it comes.
+///
+/// # Errors
+/// The image, QEMU or mkfs.fat is missing, or QEMU ran past [`WALL_LIMIT`].
+pub fn run(
+    setup: &Setup<'_>,
+    prepare_card: impl FnOnce(&Path) -> Result<(), String>,
+    mut on_line: impl FnMut(&str),
+) -> Result<Outcome, String> {
+    let image = image()?;
+    let dir = &setup.dir;
+    std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    let io = |e: std::io::Error| format!("{}: {e}", dir.display());
+    let card = dir.join("card.img");
+    card::mkfs(&card)?;
+    prepare_card(&card)?;
+    std::fs::write(dir.join("scenario.txt"), setup.scenario.text()).map_err(io)?;
+    fixture::write_ride(
+        &dir.join("ride.bin"),
+        setup.rows,
+        setup.scenario.frames as usize,
+    )
+    .map_err(io)?;
+    fixture::write_gps(&dir.join("gps.bin"), setup.gps).map_err(io)?;
+
+    let started = Instant::now();
+    let mut child = Command::new("qemu-system-arm")
+        .current_dir(dir)
+        .args([
+            "-machine",
+            "netduinoplus2",
+            "-nographic",
+            "-monitor",
+            "none",
+            "-serial",
+            "null",
+        ])
+        .args(["-semihosting-config", "enable=on,target=native"])
+        .args(["-icount", "shift=auto,sleep=off", "-kernel"])
+        .arg(&image)
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .spawn()
+        .map_err(|e| format!("qemu-system-arm: {e} (install qemu-system-arm)"))?;
+    let pid = child.id();
+    // A watchdog for a hung emulator: the only wall-clock limit in the harness.
+    let (done_tx, done_rx) = std::sync::mpsc::channel::<()>();
+    let watchdog = std::thread::spawn(move || {
+        if done_rx.recv_timeout(WALL_LIMIT).is_err() {
+            let _ = Command::new("kill").arg(pid.to_string()).status();
+            return true;
+        }
+        false
+    });
+    let mut lines = Vec::new();
+    if let Some(stdout) = child.stdout.take() {
+        for line in BufReader::new(stdout).lines().map_while(Result::ok) {
+            on_line(&line);
+            lines.push(line);
+        }
+    }
+    let status = child.wait().map_err(|e| format!("qemu: {e}"))?;
+    let _ = done_tx.send(());
+    if watchdog.join().unwrap_or(false) {
+        return Err(format!(
+            "QEMU ran longer than {WALL_LIMIT:?}; last lines: {:?}",
+            lines.iter().rev().take(5).collect::<Vec<_>>()
+        ));
+    }
+    Ok(Outcome {
+        code: status.code().unwrap_or(-1),
+        lines,
+        wall: started.elapsed(),
+        card,
+    })
+}
