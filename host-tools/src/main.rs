@@ -24,6 +24,14 @@ enum Command {
     Encode(cmd::encode::Args),
     /// Replay a raw NMEA capture through the firmware's GPS path; one JSON fix per line.
     Nmea(cmd::nmea::Args),
+    /// Plot a run like the seed paper's Figure 6: steering, roll, yaw rate, speed.
+    Plot(cmd::plot::Args),
+    /// Measure every wobble episode (frequency, growth rate, speed); Figure 8 with --plot.
+    Wobble(cmd::wobble::Args),
+    /// Write a run's GPS track as GPX.
+    Gpx(cmd::gpx::Args),
+    /// One row per run in a directory: duration, distance, episodes, wobble speed, losses.
+    Summary(cmd::summary::Args),
 }
 
 fn main() -> ExitCode {
@@ -33,6 +41,10 @@ fn main() -> ExitCode {
         Command::Decode(args) => cmd::decode::run(&args),
         Command::Encode(args) => cmd::encode::run(&args),
         Command::Nmea(args) => cmd::nmea::run(&args),
+        Command::Plot(args) => cmd::plot::run(&args),
+        Command::Wobble(args) => cmd::wobble::run(&args),
+        Command::Gpx(args) => cmd::gpx::run(&args),
+        Command::Summary(args) => cmd::summary::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

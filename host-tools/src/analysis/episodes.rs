@@ -53,11 +53,16 @@ const FIT_FLOOR_MIN_DEG: f64 = 0.1;
 const FIT_TOP_OF_PEAK: f64 = 0.85;
 /// A growth fit must span this long to call the wobble unstable, s:
 /// a struck oscillation rises within a cycle or two.
-const MIN_GROWTH_FIT_S: f64 = 0.4;
+const MIN_GROWTH_FIT_S: f64 = 0.3;
 /// A decay fit must span at least this long, s.
 const MIN_DECAY_FIT_S: f64 = 0.15;
-/// Least coefficient of determination of a fit on the log envelope.
-const MIN_FIT_R2: f64 = 0.9;
+/// Largest unexplained share (RMS) of the signal for a mode fit to count:
+/// a struck oscillation fitted as growth leaves most of it.
+const MAX_RESIDUAL_REL: f64 = 0.5;
+/// A growth fit starts this long before the wobble rises, s.
+const TONE_LOOKBACK_S: f64 = 4.0;
+/// A steady tone is looked for within this of the wobble's frequency, Hz.
+const TONE_SEARCH_HZ: f64 = 1.5;
 /// Speed at onset is the mean over onset ± this, s.
 const SPEED_HALF_WIDTH_S: f64 = 0.25;
 /// Spans shorter than this (between gaps in the data) are not analysed, s.
@@ -204,29 +209,52 @@ impl<'a> Span<'a> {
             return None;
         }
 
-        let growth = growth_range(&clean, top, floor, ceiling)
-            .and_then(|r| fit_log(&t[r.clone()], &clean[r.clone()]).map(|f| (r, f)))
-            .filter(|(r, f)| {
-                f.slope > 0.0 && f.r2 >= MIN_FIT_R2 && f.span_s(t, r) >= MIN_GROWTH_FIT_S
-            });
-        let (stability, range, fit) = match growth {
-            Some((r, f)) => (Stability::Unstable, r, f),
+        let band = &self.band[window.clone()];
+        // The mode fitted over `range` if it grows (or decays) as asked and
+        // explains the signal there. A growth fit reaches back to before the
+        // wobble rose, where a steady tone near it (a wheel harmonic) shows
+        // alone, and fits that tone alongside.
+        let fit = |range: Range<usize>, growing: bool| {
+            let min_s = if growing {
+                MIN_GROWTH_FIT_S
+            } else {
+                MIN_DECAY_FIT_S
+            };
+            if t[range.end - 1] - t[range.start] < min_s {
+                return None;
+            }
+            let slope = log_slope(&t[range.clone()], &clean[range.clone()])?;
+            let f1_hz = crossing_freq_hz(&t[range.clone()], &band[range.clone()]).unwrap_or(f0_hz);
+            let (from, tone) = if growing {
+                let from = range.start.saturating_sub(self.samples(TONE_LOOKBACK_S));
+                let before = from..range.start;
+                (
+                    from,
+                    strongest_tone(&t[before.clone()], &band[before], f1_hz, self.fs_hz),
+                )
+            } else {
+                (range.start, None)
+            };
+            let fitted = from..range.end;
+            let mode = fit_mode(
+                &t[fitted.clone()],
+                &band[fitted.clone()],
+                slope,
+                TAU * f1_hz,
+                tone,
+            )?;
+            let ok = (mode.sigma_per_s > 0.0) == growing && mode.residual_rel <= MAX_RESIDUAL_REL;
+            ok.then_some((fitted, mode))
+        };
+        let (stability, range, mode) = match growth_range(&clean, local.clone(), floor, ceiling)
+            .and_then(|r| fit(r, true))
+        {
+            Some((r, mode)) => (Stability::Unstable, r, mode),
             None => {
-                let r = decay_range(&clean, top, floor, ceiling)?;
-                let f = fit_log(&t[r.clone()], &clean[r.clone()])?;
-                if f.slope >= 0.0 || f.r2 < MIN_FIT_R2 || f.span_s(t, &r) < MIN_DECAY_FIT_S {
-                    return None;
-                }
-                (Stability::Stable, r, f)
+                let (r, mode) = fit(decay_range(&clean, local.clone(), floor, ceiling)?, false)?;
+                (Stability::Stable, r, mode)
             }
         };
-        let band = &self.band[window.clone()][range.clone()];
-        let f1_hz = crossing_freq_hz(&t[range.clone()], band).unwrap_or(f0_hz);
-        let mode = fit_mode(&t[range.clone()], band, fit.slope, TAU * f1_hz)?;
-        let same_sign = (mode.sigma_per_s > 0.0) == (stability == Stability::Unstable);
-        if !same_sign {
-            return None;
-        }
         let freq_hz = mode.omega_rad_s / TAU;
         let onset_s = match stability {
             Stability::Unstable => {
@@ -268,15 +296,21 @@ impl<'a> Span<'a> {
             &filtered[range],
             mode.sigma_per_s,
             mode.omega_rad_s,
+            None,
         )
         .map_or(0.0, |f| f.log_amp - mode.log_amp)
     }
 }
 
-/// The last stretch before `top` where the envelope climbs from `floor` to
-/// `ceiling` without falling back under `floor`.
-fn growth_range(env: &[f64], top: usize, floor: f64, ceiling: f64) -> Option<Range<usize>> {
-    let end = env[..=top].iter().rposition(|&e| e <= ceiling)? + 1;
+/// Within `region`, the climb to the first time the envelope reaches
+/// `ceiling`, from the last time before it was under `floor`.
+fn growth_range(
+    env: &[f64],
+    region: Range<usize>,
+    floor: f64,
+    ceiling: f64,
+) -> Option<Range<usize>> {
+    let end = region.start + env[region.clone()].iter().position(|&e| e >= ceiling)?;
     let start = env[..end]
         .iter()
         .rposition(|&e| e < floor)
@@ -284,10 +318,15 @@ fn growth_range(env: &[f64], top: usize, floor: f64, ceiling: f64) -> Option<Ran
     (end > start + 2).then_some(start..end)
 }
 
-/// The first stretch after `top` where the envelope falls from `ceiling`
-/// to `floor`.
-fn decay_range(env: &[f64], top: usize, floor: f64, ceiling: f64) -> Option<Range<usize>> {
-    let start = top + env[top..].iter().position(|&e| e <= ceiling)?;
+/// Within `region`, the fall from the last time the envelope was at
+/// `ceiling` to the first time after it is under `floor`.
+fn decay_range(
+    env: &[f64],
+    region: Range<usize>,
+    floor: f64,
+    ceiling: f64,
+) -> Option<Range<usize>> {
+    let start = region.start + env[region.clone()].iter().rposition(|&e| e >= ceiling)?;
     let end = env[start..]
         .iter()
         .position(|&e| e < floor)
@@ -295,47 +334,22 @@ fn decay_range(env: &[f64], top: usize, floor: f64, ceiling: f64) -> Option<Rang
     (end > start + 2).then_some(start..end)
 }
 
-/// A straight line through `(t, ln env)`.
-#[derive(Clone, Copy, Debug)]
-struct LogFit {
-    /// 1/s.
-    slope: f64,
-    /// Coefficient of determination.
-    r2: f64,
-}
-
-impl LogFit {
-    fn span_s(&self, t: &[f64], r: &Range<usize>) -> f64 {
-        t[r.end - 1] - t[r.start]
-    }
-}
-
-/// Least squares on the log envelope; `None` without two distinct times or
-/// with a non-positive envelope.
-fn fit_log(t: &[f64], env: &[f64]) -> Option<LogFit> {
-    let t0_s = *t.first()?;
+/// Slope of the least-squares line through `(t, ln env)`, 1/s: the
+/// starting guess of a mode fit. `None` without two distinct times or with
+/// a non-positive envelope.
+fn log_slope(t: &[f64], env: &[f64]) -> Option<f64> {
     let n = t.len() as f64;
     let ys: Vec<f64> = env.iter().map(|e| e.ln()).collect();
-    if ys.iter().any(|y| !y.is_finite()) {
+    if n < 2.0 || ys.iter().any(|y| !y.is_finite()) {
         return None;
     }
-    let mean_t = t.iter().map(|v| v - t0_s).sum::<f64>() / n;
+    let mean_t = t.iter().sum::<f64>() / n;
     let mean_y = ys.iter().sum::<f64>() / n;
-    let (mut stt, mut sty, mut syy) = (0.0, 0.0, 0.0);
-    for (tv, y) in t.iter().zip(&ys) {
-        let (dt, dy) = (tv - t0_s - mean_t, y - mean_y);
-        stt += dt * dt;
-        sty += dt * dy;
-        syy += dy * dy;
-    }
-    if stt <= 0.0 || syy <= 0.0 {
-        return None;
-    }
-    let slope = sty / stt;
-    Some(LogFit {
-        slope,
-        r2: sty * sty / (stt * syy),
-    })
+    let (stt, sty) = t.iter().zip(&ys).fold((0.0, 0.0), |(stt, sty), (tv, y)| {
+        let dt = tv - mean_t;
+        (stt + dt * dt, sty + dt * (y - mean_y))
+    });
+    (stt > 0.0).then(|| sty / stt)
 }
 
 /// Envelope of `band` at `freq_hz`: mixed down to 0 Hz and low-passed
@@ -368,6 +382,27 @@ fn crossing_freq_hz(t: &[f64], x: &[f64]) -> Option<f64> {
     (count >= 4 && last > first).then(|| (count - 1) as f64 / (2.0 * (last - first)))
 }
 
+/// The frequency of the strongest steady tone in `x` within
+/// [`TONE_SEARCH_HZ`] of `near_hz`, rad/s (a periodogram peak in 0.02 Hz
+/// steps); `None` on less than a second of samples.
+fn strongest_tone(t: &[f64], x: &[f64], near_hz: f64, fs_hz: f64) -> Option<f64> {
+    if (x.len() as f64) < fs_hz {
+        return None;
+    }
+    let steps = (2.0 * TONE_SEARCH_HZ / 0.02).round() as usize;
+    (0..=steps)
+        .map(|k| TAU * (near_hz - TONE_SEARCH_HZ + 0.02 * k as f64))
+        .map(|omega| {
+            let (re, im) = t.iter().zip(x).fold((0.0, 0.0), |(re, im), (ts, v)| {
+                let (s, c) = (omega * ts).sin_cos();
+                (re + v * c, im + v * s)
+            });
+            (omega, re * re + im * im)
+        })
+        .max_by(|a, b| a.1.total_cmp(&b.1))
+        .map(|(omega, _)| omega)
+}
+
 fn argmax(x: &[f64]) -> Option<usize> {
     x.iter()
         .enumerate()
@@ -398,11 +433,11 @@ mod tests {
     }
 
     #[test]
-    fn log_fit_recovers_an_exponential() {
+    fn log_slope_of_an_exponential() {
         let t: Vec<f64> = (0..100).map(|i| 3.0 + f64::from(i) / 100.0).collect();
         let env: Vec<f64> = t.iter().map(|t| 0.1 * (1.7 * (t - 3.0)).exp()).collect();
-        let f = fit_log(&t, &env).unwrap();
-        assert!((f.slope - 1.7).abs() < 1e-9);
-        assert!(f.r2 > 0.999_999);
+        let slope = log_slope(&t, &env).unwrap();
+        assert!((slope - 1.7).abs() < 1e-9);
+        assert_eq!(log_slope(&t[..1], &env[..1]), None);
     }
 }

@@ -1,7 +1,7 @@
-//! `wobblog decode`: one row per 100 Hz frame, as CSV or JSON lines.
+//! `wobblog decode`: one row per 100 Hz frame, as CSV, JSON lines or Parquet.
 
 use std::fs::File;
-use std::io::{BufWriter, Write};
+use std::io::{BufWriter, IsTerminal, Write};
 use std::path::{Path, PathBuf};
 
 use crate::export::{Format, RowWriter};
@@ -15,7 +15,8 @@ use crate::CliError;
 pub struct Args {
     /// The card log (`RUNnnnnn.WBL`).
     pub log: PathBuf,
-    /// Output format.
+    /// Output format. Parquet is binary: it goes to the `-o` file, or to
+    /// standard output only when that is redirected (not a terminal).
     #[arg(long, value_enum, default_value_t = Format::Csv)]
     pub format: Format,
     /// Output file; standard output if absent.
@@ -25,9 +26,14 @@ pub struct Args {
 
 /// Runs `wobblog decode`.
 pub fn run(args: &Args) -> Result<(), CliError> {
-    let out: Box<dyn Write> = match &args.output {
+    if args.format == Format::Parquet && args.output.is_none() && std::io::stdout().is_terminal() {
+        return Err(CliError::Usage(
+            "parquet output is binary: give -o FILE or redirect standard output".into(),
+        ));
+    }
+    let out: Box<dyn Write + Send> = match &args.output {
         Some(path) => Box::new(File::create(path).map_err(|e| CliError::file(path, e))?),
-        None => Box::new(std::io::stdout().lock()),
+        None => Box::new(std::io::stdout()),
     };
     let out_name = args.output.as_deref().unwrap_or(Path::new("<stdout>"));
     let losses = decode_to(
@@ -46,7 +52,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
 pub fn decode_to(
     log: &Path,
     format: Format,
-    out: impl Write,
+    out: impl Write + Send,
     out_name: &Path,
 ) -> Result<Losses, CliError> {
     let write_err = |e: &dyn std::fmt::Display| CliError::file(out_name, e);

@@ -2,5 +2,10 @@
 
 pub mod decode;
 pub mod encode;
+pub mod gpx;
 pub mod info;
+pub mod logs;
 pub mod nmea;
+pub mod plot;
+pub mod summary;
+pub mod wobble;

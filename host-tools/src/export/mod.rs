@@ -1,4 +1,6 @@
-//! Writing rows as CSV or JSON lines.
+//! Writing rows as CSV, JSON lines or Parquet.
+
+pub mod parquet;
 
 use std::io::Write;
 
@@ -30,23 +32,30 @@ pub enum Format {
     Csv,
     /// One JSON object per line.
     Jsonl,
+    /// Apache Parquet (binary; typed columns, GPS columns nullable).
+    Parquet,
 }
 
 /// Writes rows in one format.
-pub enum RowWriter<W: Write> {
+// One writer per export: the variants' sizes do not matter.
+#[allow(clippy::large_enum_variant)]
+pub enum RowWriter<W: Write + Send> {
     /// CSV; the flag says whether the header line is out.
     Csv(csv::Writer<W>, bool),
     /// JSON lines.
     Jsonl(W),
+    /// Parquet.
+    Parquet(parquet::ParquetWriter<W>),
 }
 
-impl<W: Write> RowWriter<W> {
+impl<W: Write + Send> RowWriter<W> {
     /// A writer. Nothing is written until the first row or [`Self::flush`],
     /// so a log that cannot be read leaves no half output.
     pub fn new(format: Format, out: W) -> Self {
         match format {
             Format::Csv => Self::Csv(csv::Writer::from_writer(out), false),
             Format::Jsonl => Self::Jsonl(out),
+            Format::Parquet => Self::Parquet(parquet::ParquetWriter::new(out)),
         }
     }
 
@@ -67,15 +76,18 @@ impl<W: Write> RowWriter<W> {
                 serde_json::to_writer(&mut *w, &JsonRow::from(row))?;
                 w.write_all(b"\n")
             }
+            Self::Parquet(w) => w.write(row).map_err(std::io::Error::other),
         }
     }
 
-    /// Writes the CSV header if no row came, and flushes buffered output.
+    /// Writes the CSV header if no row came (the Parquet footer), and
+    /// flushes buffered output.
     pub fn flush(&mut self) -> std::io::Result<()> {
         self.header().map_err(csv_io_error)?;
         match self {
             Self::Csv(w, _) => w.flush(),
             Self::Jsonl(w) => w.flush(),
+            Self::Parquet(w) => w.finish().map_err(std::io::Error::other),
         }
     }
 }

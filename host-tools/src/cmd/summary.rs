@@ -1,0 +1,202 @@
+//! `wobblog summary`: one row per run in a directory of logs.
+
+use std::path::{Path, PathBuf};
+
+use serde::Serialize;
+
+use crate::analysis::filter::contiguous_spans;
+use crate::analysis::{find_episodes, wobble_speed_mps, Run, Stability};
+use crate::CliError;
+
+/// Output formats of `wobblog summary`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum SummaryFormat {
+    /// Aligned columns for reading.
+    Table,
+    /// Comma-separated values with a header line.
+    Csv,
+    /// One JSON object per line.
+    Jsonl,
+}
+
+/// Arguments of `wobblog summary`.
+#[derive(clap::Args)]
+pub struct Args {
+    /// Directory holding card logs (`*.WBL`, any case); not searched recursively.
+    pub dir: PathBuf,
+    /// Output format.
+    #[arg(long, value_enum, default_value_t = SummaryFormat::Table)]
+    pub format: SummaryFormat,
+}
+
+/// One run's row.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct RunRow {
+    /// Log file name.
+    pub log: String,
+    /// Frames times the frame period, s.
+    pub duration_s: f64,
+    /// Wheel distance over the frames present, m.
+    pub distance_m: f64,
+    /// Highest wheel speed, m/s.
+    pub max_speed_mps: f64,
+    /// Wobble episodes, stable and unstable.
+    pub episodes: usize,
+    /// Of which unstable.
+    pub unstable_episodes: usize,
+    /// Lowest speed at onset of an unstable episode, m/s.
+    pub wobble_speed_mps: Option<f64>,
+    /// Frames lost: dropped by the logger plus held by blocks missing from
+    /// the file.
+    pub frames_lost: u64,
+    /// Blocks missing from the file.
+    pub lost_blocks: u64,
+}
+
+impl RunRow {
+    /// The row of `run`.
+    #[must_use]
+    pub fn of(run: &Run) -> Self {
+        let episodes = find_episodes(run);
+        let period_s = 1.0 / run.sample_rate_hz();
+        let distance_m = contiguous_spans(&run.t_s, period_s)
+            .into_iter()
+            .map(|span| {
+                span.clone()
+                    .skip(1)
+                    .map(|i| {
+                        0.5 * (run.speed_mps[i] + run.speed_mps[i - 1])
+                            * (run.t_s[i] - run.t_s[i - 1])
+                    })
+                    .sum::<f64>()
+            })
+            .sum();
+        let s = &run.summary;
+        Self {
+            log: run.name(),
+            duration_s: s.duration_s,
+            distance_m,
+            max_speed_mps: run.speed_mps.iter().copied().fold(0.0, f64::max),
+            episodes: episodes.len(),
+            unstable_episodes: episodes
+                .iter()
+                .filter(|e| e.stability == Stability::Unstable)
+                .count(),
+            wobble_speed_mps: wobble_speed_mps(&episodes),
+            frames_lost: s.frames_dropped + s.frames_lost,
+            lost_blocks: s.lost_blocks,
+        }
+    }
+}
+
+/// The card logs in `dir`, sorted by name.
+pub fn logs_in(dir: &Path) -> Result<Vec<PathBuf>, CliError> {
+    let entries = std::fs::read_dir(dir).map_err(|e| CliError::file(dir, e))?;
+    let mut logs = Vec::new();
+    for entry in entries {
+        let path = entry.map_err(|e| CliError::file(dir, e))?.path();
+        let is_log = path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("wbl"));
+        if is_log && path.is_file() {
+            logs.push(path);
+        }
+    }
+    logs.sort();
+    Ok(logs)
+}
+
+/// Runs `wobblog summary`: rows for every readable log, even when some are not.
+pub fn run(args: &Args) -> Result<(), CliError> {
+    let logs = logs_in(&args.dir)?;
+    if logs.is_empty() {
+        return Err(CliError::file(&args.dir, "no *.WBL logs in this directory"));
+    }
+    let mut rows = Vec::new();
+    let result = crate::cmd::logs::for_each_log(&logs, "summarising", |log| {
+        let run = Run::load(log)?;
+        crate::cmd::logs::warn_losses(&run);
+        rows.push(RunRow::of(&run));
+        Ok(())
+    });
+    print!("{}", render(&rows, args.format));
+    result
+}
+
+fn opt(v: Option<f64>) -> String {
+    v.map_or(String::new(), |v| format!("{v:.2}"))
+}
+
+fn cells(r: &RunRow) -> [String; 9] {
+    [
+        r.log.clone(),
+        format!("{:.2}", r.duration_s),
+        format!("{:.1}", r.distance_m),
+        format!("{:.2}", r.max_speed_mps),
+        r.episodes.to_string(),
+        r.unstable_episodes.to_string(),
+        opt(r.wobble_speed_mps),
+        r.frames_lost.to_string(),
+        r.lost_blocks.to_string(),
+    ]
+}
+
+const HEADER: [&str; 9] = [
+    "log",
+    "duration_s",
+    "distance_m",
+    "max_speed_mps",
+    "episodes",
+    "unstable_episodes",
+    "wobble_speed_mps",
+    "frames_lost",
+    "lost_blocks",
+];
+
+/// The rows in `format`.
+#[must_use]
+pub fn render(rows: &[RunRow], format: SummaryFormat) -> String {
+    match format {
+        SummaryFormat::Jsonl => rows
+            .iter()
+            .filter_map(|r| serde_json::to_string(r).ok())
+            .map(|line| line + "\n")
+            .collect(),
+        SummaryFormat::Csv => {
+            let mut w = csv::Writer::from_writer(Vec::new());
+            let written = std::iter::once(HEADER.map(String::from))
+                .chain(rows.iter().map(cells))
+                .try_for_each(|record| w.write_record(&record));
+            match (written, w.into_inner()) {
+                (Ok(()), Ok(bytes)) => String::from_utf8_lossy(&bytes).into_owned(),
+                _ => String::new(),
+            }
+        }
+        SummaryFormat::Table => {
+            let table: Vec<[String; 9]> = std::iter::once(HEADER.map(String::from))
+                .chain(rows.iter().map(cells))
+                .collect();
+            let widths: Vec<usize> = (0..HEADER.len())
+                .map(|c| table.iter().map(|r| r[c].len()).max().unwrap_or(0))
+                .collect();
+            let mut out = String::new();
+            for row in &table {
+                let line: Vec<String> = row
+                    .iter()
+                    .zip(&widths)
+                    .enumerate()
+                    .map(|(c, (v, &w))| {
+                        if c == 0 {
+                            format!("{v:<w$}")
+                        } else {
+                            format!("{v:>w$}")
+                        }
+                    })
+                    .collect();
+                out.push_str(line.join("  ").trim_end());
+                out.push('\n');
+            }
+            out
+        }
+    }
+}

@@ -1,0 +1,104 @@
+//! `wobblog wobble`: every wobble episode of one or more runs, the wobble
+//! speed of each, and optionally the seed paper's Figure 8 across them.
+
+use std::path::PathBuf;
+
+use serde::Serialize;
+
+use crate::analysis::{find_episodes, wobble_speed_mps, Episode, Run};
+use crate::plot::modes::ModePlot;
+use crate::plot::{render, ImageKind};
+use crate::CliError;
+
+/// Arguments of `wobblog wobble`.
+#[derive(clap::Args)]
+pub struct Args {
+    /// Card logs (`RUNnnnnn.WBL`).
+    #[arg(required = true)]
+    pub logs: Vec<PathBuf>,
+    /// Print one JSON object per run (one per line) instead of a table.
+    #[arg(long)]
+    pub json: bool,
+    /// Also draw every episode as a point of sigma against 2 pi f into this
+    /// `.png` or `.svg` file.
+    #[arg(long, value_name = "OUT")]
+    pub plot: Option<PathBuf>,
+}
+
+/// The episodes of one run, as printed.
+#[derive(Serialize)]
+pub struct RunEpisodes {
+    /// The log.
+    pub log: String,
+    /// Lowest speed at onset of an unstable episode, m/s.
+    pub wobble_speed_mps: Option<f64>,
+    /// Every episode, in time order.
+    pub episodes: Vec<Episode>,
+}
+
+/// Runs `wobblog wobble`. A log that cannot be read is reported and
+/// skipped; the others are still analysed, and the exit code says one failed.
+pub fn run(args: &Args) -> Result<(), CliError> {
+    if let Some(plot) = &args.plot {
+        ImageKind::of(plot)?;
+    }
+    let mut figure_runs = Vec::new();
+    let result = crate::cmd::logs::for_each_log(&args.logs, "analysing", |log| {
+        let run = Run::load(log)?;
+        crate::cmd::logs::warn_losses(&run);
+        let episodes = find_episodes(&run);
+        let report = RunEpisodes {
+            log: log.display().to_string(),
+            wobble_speed_mps: wobble_speed_mps(&episodes),
+            episodes,
+        };
+        if args.json {
+            let line = serde_json::to_string(&report).map_err(|e| CliError::file(log, e))?;
+            println!("{line}");
+        } else {
+            print!("{}", render_text(&report));
+        }
+        figure_runs.push((run.name(), report.episodes));
+        Ok(())
+    });
+    if let Some(plot) = &args.plot {
+        render(&ModePlot::new(figure_runs), plot)?;
+    }
+    result
+}
+
+fn render_text(r: &RunEpisodes) -> String {
+    use std::fmt::Write;
+    let mut o = String::new();
+    let speed = r
+        .wobble_speed_mps
+        .map_or("none (no unstable episode)".into(), |v| {
+            format!("{v:.2} m/s")
+        });
+    let _ = writeln!(
+        o,
+        "{}: {} episodes, wobble speed {speed}",
+        r.log,
+        r.episodes.len()
+    );
+    if !r.episodes.is_empty() {
+        let _ = writeln!(
+            o,
+            "  onset_s    end_s  freq_hz  sigma_per_s  peak_deg  speed_mps  stability"
+        );
+    }
+    for e in &r.episodes {
+        let _ = writeln!(
+            o,
+            "  {:7.2}  {:7.2}  {:7.2}  {:11.2}  {:8.2}  {:9.2}  {:?}",
+            e.onset_s,
+            e.end_s,
+            e.freq_hz,
+            e.sigma_per_s,
+            e.peak_amp_deg,
+            e.speed_at_onset_mps,
+            e.stability
+        );
+    }
+    o
+}

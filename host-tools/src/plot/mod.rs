@@ -1,0 +1,154 @@
+//! Figures as PNG or SVG files: the seed paper's Figure 6 (time plots of a
+//! run) and Figure 8 (wobble modes in the complex plane).
+//!
+//! Text is drawn with the DejaVu Sans font compiled into the program, so
+//! plotting needs no system font libraries.
+
+pub mod modes;
+pub mod timeplot;
+
+use std::path::Path;
+use std::sync::Once;
+
+use plotters::coord::Shift;
+use plotters::prelude::*;
+
+use crate::CliError;
+
+/// The font every figure uses.
+pub const FONT: &str = "sans-serif";
+static FONT_BYTES: &[u8] = include_bytes!("../../assets/DejaVuSans.ttf");
+
+/// A figure that can draw itself on any plotters backend.
+pub trait Figure {
+    /// Pixel size of the figure.
+    fn size_px(&self) -> (u32, u32);
+    /// Draws the figure on `root`.
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String>;
+}
+
+/// Image file types, chosen by the output file's extension.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ImageKind {
+    /// `.png`
+    Png,
+    /// `.svg`
+    Svg,
+}
+
+impl ImageKind {
+    /// The kind for `path`, or a usage error naming the accepted extensions.
+    pub fn of(path: &Path) -> Result<Self, CliError> {
+        let ext = path
+            .extension()
+            .map(|e| e.to_string_lossy().to_ascii_lowercase());
+        match ext.as_deref() {
+            Some("png") => Ok(Self::Png),
+            Some("svg") => Ok(Self::Svg),
+            _ => Err(CliError::Usage(format!(
+                "{}: plot files must end in .png or .svg",
+                path.display()
+            ))),
+        }
+    }
+}
+
+/// Draws `figure` into the file at `path` (PNG or SVG by its extension).
+pub fn render(figure: &impl Figure, path: &Path) -> Result<(), CliError> {
+    let kind = ImageKind::of(path)?;
+    register_font();
+    let size = figure.size_px();
+    let drawn = match kind {
+        ImageKind::Png => {
+            let root = BitMapBackend::new(path, size).into_drawing_area();
+            figure
+                .draw(&root)
+                .and_then(|()| root.present().map_err(|e| e.to_string()))
+        }
+        ImageKind::Svg => {
+            let root = SVGBackend::new(path, size).into_drawing_area();
+            figure
+                .draw(&root)
+                .and_then(|()| root.present().map_err(|e| e.to_string()))
+        }
+    };
+    drawn.map_err(|e| CliError::file(path, format!("cannot draw the plot: {e}")))
+}
+
+fn register_font() {
+    static ONCE: Once = Once::new();
+    ONCE.call_once(|| {
+        // The bytes are the committed font file; if they ever failed to
+        // parse, text would be missing and plotters would report it.
+        let _ = plotters::style::register_font(FONT, FontStyle::Normal, FONT_BYTES);
+    });
+}
+
+/// At most two points (the lowest and highest) per bucket of `bucket_s`:
+/// what a line drawn at the figure's resolution shows, in a file that stays
+/// small for hours of data.
+#[must_use]
+pub fn decimate(points: &[(f64, f64)], bucket_s: f64) -> Vec<(f64, f64)> {
+    let mut out = Vec::new();
+    let mut i = 0;
+    while i < points.len() {
+        let bucket = (points[i].0 / bucket_s).floor();
+        let len = points[i..]
+            .iter()
+            .position(|p| (p.0 / bucket_s).floor() != bucket)
+            .unwrap_or(points.len() - i);
+        let chunk = &points[i..i + len];
+        let lo = chunk.iter().min_by(|a, b| a.1.total_cmp(&b.1));
+        let hi = chunk.iter().max_by(|a, b| a.1.total_cmp(&b.1));
+        if let (Some(&lo), Some(&hi)) = (lo, hi) {
+            if lo == hi {
+                out.push(lo);
+            } else if lo.0 <= hi.0 {
+                out.extend([lo, hi]);
+            } else {
+                out.extend([hi, lo]);
+            }
+        }
+        i += len;
+    }
+    out
+}
+
+/// A range covering `values` with a margin, never empty.
+#[must_use]
+pub fn padded_range(values: impl Iterator<Item = f64>, min_span: f64) -> std::ops::Range<f64> {
+    let (lo, hi) = values
+        .filter(|v| v.is_finite())
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+            (lo.min(v), hi.max(v))
+        });
+    if lo > hi {
+        return -min_span / 2.0..min_span / 2.0;
+    }
+    let mid = 0.5 * (lo + hi);
+    let half = (0.5 * (hi - lo)).max(min_span / 2.0) * 1.08;
+    mid - half..mid + half
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    proptest! {
+        /// Decimation keeps every bucket's extremes, in time order, and
+        /// never more than two points per bucket.
+        #[test]
+        fn decimation_keeps_extremes(ys in proptest::collection::vec(-100.0..100.0f64, 1..500)) {
+            let points: Vec<(f64, f64)> =
+                ys.iter().enumerate().map(|(i, &y)| (i as f64, y)).collect();
+            let out = decimate(&points, 10.0);
+            prop_assert!(out.windows(2).all(|w| w[0].0 <= w[1].0));
+            prop_assert!(out.len() <= 2 * (points.len() / 10 + 2));
+            for chunk in points.chunks(10) {
+                let max = chunk.iter().map(|p| p.1).fold(f64::MIN, f64::max);
+                prop_assert!(out.iter().any(|p| p.1 == max));
+            }
+        }
+    }
+}

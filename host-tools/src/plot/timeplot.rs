@@ -1,0 +1,166 @@
+//! The seed paper's Figure 6: steering angle, roll angle, yaw rate and speed
+//! stacked on one time axis, alert periods shaded, rider markers drawn.
+
+use plotters::coord::Shift;
+use plotters::prelude::*;
+
+use super::{decimate, padded_range, Figure, FONT};
+use crate::analysis::filter::contiguous_spans;
+use crate::analysis::{estimate_roll_deg, Run};
+
+/// Panel titles (y-axis labels), top to bottom.
+pub const PANELS: [&str; 4] = [
+    "steering angle (deg)",
+    "roll angle (deg)",
+    "yaw rate (deg/s)",
+    "speed (m/s)",
+];
+/// Colour of the signal lines.
+pub const LINE_COLOUR: RGBColor = RGBColor(0x1f, 0x4e, 0x9a);
+/// Colour of alert shading (drawn with transparency).
+pub const ALERT_COLOUR: RGBColor = RGBColor(0xe0, 0x30, 0x30);
+/// Colour of rider markers.
+pub const MARKER_COLOUR: RGBColor = RGBColor(0x20, 0x90, 0x30);
+
+/// Figure 6 of one run over a time window.
+pub struct TimePlot {
+    title: String,
+    window_s: std::ops::Range<f64>,
+    /// One list of contiguous stretches per panel.
+    series: [Vec<Vec<(f64, f64)>>; 4],
+    alerts_s: Vec<(f64, f64)>,
+    markers_s: Vec<f64>,
+}
+
+/// Figure width, px.
+const WIDTH_PX: u32 = 1200;
+/// Height of each panel, px.
+const PANEL_HEIGHT_PX: u32 = 220;
+
+impl TimePlot {
+    /// The figure of `run` between `from_s` and `to_s` (the whole run where
+    /// absent). `None` if no frame falls in the window.
+    #[must_use]
+    pub fn new(run: &Run, from_s: Option<f64>, to_s: Option<f64>) -> Option<Self> {
+        let first = *run.t_s.first()?;
+        let last = *run.t_s.last()?;
+        let window_s = from_s.unwrap_or(first).max(first)..to_s.unwrap_or(last).min(last);
+        if window_s.start >= window_s.end {
+            return None;
+        }
+        let roll_deg = estimate_roll_deg(run);
+        let channels: [Box<dyn Fn(usize) -> f64>; 4] = [
+            Box::new(|i| run.steer_deg[i]),
+            Box::new(|i| roll_deg[i]),
+            Box::new(|i| run.gyro_dps[i][2]),
+            Box::new(|i| run.speed_mps[i]),
+        ];
+        let bucket_s = (window_s.end - window_s.start) / f64::from(2 * WIDTH_PX);
+        let spans = contiguous_spans(&run.t_s, 1.0 / run.sample_rate_hz());
+        let series = channels.map(|value| {
+            spans
+                .iter()
+                .map(|span| {
+                    let points: Vec<(f64, f64)> = span
+                        .clone()
+                        .filter(|&i| window_s.contains(&run.t_s[i]) || run.t_s[i] == window_s.end)
+                        .map(|i| (run.t_s[i], value(i)))
+                        .collect();
+                    decimate(&points, bucket_s)
+                })
+                .filter(|points| !points.is_empty())
+                .collect()
+        });
+        let overlaps = |a: f64, b: f64| a < window_s.end && b > window_s.start;
+        let alerts_s = run
+            .summary
+            .alerts
+            .iter()
+            .map(|a| (a.on_s, a.off_s.unwrap_or(last)))
+            .filter(|&(a, b)| overlaps(a, b))
+            .map(|(a, b)| (a.max(window_s.start), b.min(window_s.end)))
+            .collect();
+        let markers_s = run
+            .summary
+            .markers
+            .iter()
+            .copied()
+            .filter(|t| window_s.contains(t))
+            .collect();
+        Some(Self {
+            title: format!(
+                "{}: {:.1} to {:.1} s",
+                run.name(),
+                window_s.start,
+                window_s.end
+            ),
+            window_s,
+            series,
+            alerts_s,
+            markers_s,
+        })
+    }
+
+    /// Alert periods drawn, s.
+    #[must_use]
+    pub fn alerts_s(&self) -> &[(f64, f64)] {
+        &self.alerts_s
+    }
+
+    /// Markers drawn, s.
+    #[must_use]
+    pub fn markers_s(&self) -> &[f64] {
+        &self.markers_s
+    }
+}
+
+impl Figure for TimePlot {
+    fn size_px(&self) -> (u32, u32) {
+        (WIDTH_PX, 40 + PANEL_HEIGHT_PX * PANELS.len() as u32)
+    }
+
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String> {
+        let err = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
+        root.fill(&WHITE).map_err(err)?;
+        let root = root.titled(&self.title, (FONT, 20)).map_err(err)?;
+        let panels = root.split_evenly((PANELS.len(), 1));
+        for ((area, label), series) in panels.iter().zip(PANELS).zip(&self.series) {
+            let y = padded_range(series.iter().flatten().map(|p| p.1), 1.0);
+            let mut chart = ChartBuilder::on(area)
+                .margin_right(20)
+                .margin_top(6)
+                .x_label_area_size(28)
+                .y_label_area_size(70)
+                .build_cartesian_2d(self.window_s.clone(), y.clone())
+                .map_err(err)?;
+            chart
+                .configure_mesh()
+                .y_desc(label)
+                .x_desc("time since boot (s)")
+                .label_style((FONT, 13))
+                .axis_desc_style((FONT, 14))
+                .light_line_style(WHITE.mix(0.0))
+                .draw()
+                .map_err(err)?;
+            chart
+                .draw_series(self.alerts_s.iter().map(|&(a, b)| {
+                    Rectangle::new([(a, y.start), (b, y.end)], ALERT_COLOUR.mix(0.18).filled())
+                }))
+                .map_err(err)?;
+            chart
+                .draw_series(self.markers_s.iter().map(|&t| {
+                    PathElement::new(
+                        vec![(t, y.start), (t, y.end)],
+                        MARKER_COLOUR.stroke_width(2),
+                    )
+                }))
+                .map_err(err)?;
+            for points in series {
+                chart
+                    .draw_series(LineSeries::new(points.iter().copied(), LINE_COLOUR))
+                    .map_err(err)?;
+            }
+        }
+        Ok(())
+    }
+}

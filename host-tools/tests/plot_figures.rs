@@ -1,0 +1,181 @@
+//! `wobblog plot` and `wobblog wobble --plot`: the files are written, with
+//! the panels, series, shading and markers the figures promise.
+
+mod analysis_support;
+
+use std::path::Path;
+
+use assert_cmd::Command;
+use wobblog::plot::timeplot::{ALERT_COLOUR, LINE_COLOUR, MARKER_COLOUR, PANELS};
+
+fn wobblog() -> Command {
+    Command::cargo_bin("wobblog").unwrap()
+}
+
+fn hex(c: plotters::style::RGBColor) -> String {
+    format!("#{:02X}{:02X}{:02X}", c.0, c.1, c.2)
+}
+
+/// Elements of `svg` of kind `tag` whose attributes mention `colour`.
+fn count(svg: &str, tag: &str, colour: &str) -> usize {
+    svg.split('<')
+        .filter(|e| e.starts_with(tag) && e.to_uppercase().contains(colour))
+        .count()
+}
+
+/// The text of every `<text>` element of `svg`.
+fn texts(svg: &str) -> Vec<&str> {
+    svg.split("<text")
+        .skip(1)
+        .filter_map(|e| Some(e[e.find('>')? + 1..e.find("</text>")?].trim()))
+        .collect()
+}
+
+fn plot_svg(log: &Path, out: &Path, extra: &[&str]) -> String {
+    wobblog()
+        .arg("plot")
+        .arg(log)
+        .arg("-o")
+        .arg(out)
+        .args(extra)
+        .assert()
+        .success();
+    std::fs::read_to_string(out).unwrap()
+}
+
+#[test]
+fn figure_6_has_four_panels_alerts_and_markers() {
+    let dir = tempfile::tempdir().unwrap();
+    let log = dir.path().join("RUN00003.WBL");
+    analysis_support::standard_log(&log);
+    let svg = plot_svg(&log, &dir.path().join("fig6.svg"), &[]);
+    let labels = texts(&svg);
+    for panel in PANELS {
+        assert!(labels.contains(&panel), "no panel {panel:?} in {labels:?}");
+    }
+    // One line per panel (the log has no gaps), one shaded alert and two
+    // markers in each of the four panels.
+    assert_eq!(count(&svg, "polyline", &hex(LINE_COLOUR)), 4);
+    assert_eq!(count(&svg, "rect", &hex(ALERT_COLOUR)), 4);
+    assert_eq!(count(&svg, "polyline", &hex(MARKER_COLOUR)), 8);
+}
+
+#[test]
+fn time_window_keeps_only_what_falls_in_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let log = dir.path().join("RUN00003.WBL");
+    analysis_support::standard_log(&log);
+    let svg = plot_svg(
+        &log,
+        &dir.path().join("w.svg"),
+        &["--from", "8", "--to", "15"],
+    );
+    assert_eq!(count(&svg, "rect", &hex(ALERT_COLOUR)), 0);
+    assert_eq!(count(&svg, "polyline", &hex(MARKER_COLOUR)), 0);
+    assert!(texts(&svg).contains(&"RUN00003.WBL: 8.0 to 15.0 s"));
+    let svg = plot_svg(
+        &log,
+        &dir.path().join("w2.svg"),
+        &["--from", "15", "--to", "21"],
+    );
+    assert_eq!(count(&svg, "rect", &hex(ALERT_COLOUR)), 4);
+    assert_eq!(count(&svg, "polyline", &hex(MARKER_COLOUR)), 4);
+}
+
+#[test]
+fn png_is_written_at_the_figure_size() {
+    let dir = tempfile::tempdir().unwrap();
+    let log = dir.path().join("RUN00003.WBL");
+    analysis_support::standard_log(&log);
+    let png = dir.path().join("fig6.png");
+    wobblog()
+        .arg("plot")
+        .arg(&log)
+        .arg("-o")
+        .arg(&png)
+        .assert()
+        .success();
+    let bytes = std::fs::read(&png).unwrap();
+    assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n");
+    let be = |i: usize| u32::from_be_bytes([bytes[i], bytes[i + 1], bytes[i + 2], bytes[i + 3]]);
+    assert_eq!((be(16), be(20)), (1200, 40 + 4 * 220));
+    // Text was rendered: a plot without glyphs would be far smaller.
+    assert!(bytes.len() > 20_000, "{} bytes", bytes.len());
+}
+
+#[test]
+fn figure_8_has_a_dot_per_episode_and_a_legend_per_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let a = dir.path().join("A.WBL");
+    let b = dir.path().join("B.WBL");
+    analysis_support::standard_log(&a);
+    analysis_support::standard_log(&b);
+    let svg_path = dir.path().join("modes.svg");
+    let out = wobblog()
+        .args(["wobble", "--json", "--plot"])
+        .arg(&svg_path)
+        .arg(&a)
+        .arg(&b)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let episodes: usize = String::from_utf8(out.stdout)
+        .unwrap()
+        .lines()
+        .map(|l| {
+            serde_json::from_str::<serde_json::Value>(l).unwrap()["episodes"]
+                .as_array()
+                .unwrap()
+                .len()
+        })
+        .sum();
+    assert!(episodes >= 2);
+    let svg = std::fs::read_to_string(&svg_path).unwrap();
+    assert_eq!(svg.matches("<circle").count(), episodes + 2);
+    let labels = texts(&svg);
+    for label in [
+        "A.WBL",
+        "B.WBL",
+        wobblog::plot::modes::X_LABEL,
+        wobblog::plot::modes::Y_LABEL,
+    ] {
+        assert!(labels.contains(&label), "no {label:?} in {labels:?}");
+    }
+}
+
+#[test]
+fn bad_requests_are_usage_errors() {
+    let dir = tempfile::tempdir().unwrap();
+    let log = dir.path().join("RUN00003.WBL");
+    analysis_support::standard_log(&log);
+    let jpg = dir.path().join("x.jpg");
+    wobblog()
+        .arg("plot")
+        .arg(&log)
+        .arg("-o")
+        .arg(&jpg)
+        .assert()
+        .code(2);
+    let svg = dir.path().join("x.svg");
+    wobblog()
+        .arg("plot")
+        .arg(&log)
+        .arg("-o")
+        .arg(&svg)
+        .args(["--from", "9", "--to", "3"])
+        .assert()
+        .code(2);
+    // A window outside the run is a failure about the log, not a panic.
+    wobblog()
+        .arg("plot")
+        .arg(&log)
+        .arg("-o")
+        .arg(&svg)
+        .args(["--from", "500"])
+        .assert()
+        .code(1);
+}
