@@ -186,6 +186,9 @@ mod tests {
     }
 
     proptest! {
+        // Each case fits a few hundred samples some dozens of times.
+        #![proptest_config(ProptestConfig::with_cases(48))]
+
         /// From a start 0.15 Hz and 30 % off, the fit finds the mode of a
         /// clean damped or growing sinusoid.
         #[test]

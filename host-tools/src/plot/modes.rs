@@ -15,6 +15,18 @@ pub const Y_LABEL: &str = "imaginary part 2 pi f (rad/s)";
 /// Radius of an episode's dot, px.
 pub const DOT_PX: i32 = 5;
 
+/// One colour per run, in turn: dark enough on white to tell apart.
+const RUN_COLOURS: [RGBColor; 8] = [
+    RGBColor(0x1f, 0x4e, 0x9a),
+    RGBColor(0xd6, 0x27, 0x28),
+    RGBColor(0x2c, 0xa0, 0x2c),
+    RGBColor(0xff, 0x7f, 0x0e),
+    RGBColor(0x94, 0x67, 0xbd),
+    RGBColor(0x8c, 0x56, 0x4b),
+    RGBColor(0x17, 0xbe, 0xcf),
+    RGBColor(0x7f, 0x7f, 0x7f),
+];
+
 /// Figure 8 over any number of runs.
 pub struct ModePlot {
     runs: Vec<(String, Vec<Episode>)>,
@@ -65,7 +77,7 @@ impl Figure for ModePlot {
             )))
             .map_err(err)?;
         for (k, (name, episodes)) in self.runs.iter().enumerate() {
-            let colour = Palette99::pick(k).to_rgba();
+            let colour = RUN_COLOURS[k % RUN_COLOURS.len()];
             chart
                 .draw_series(episodes.iter().map(|e| {
                     let style = match e.stability {

@@ -124,7 +124,9 @@ impl Figure for TimePlot {
         root.fill(&WHITE).map_err(err)?;
         let root = root.titled(&self.title, (FONT, 20)).map_err(err)?;
         let panels = root.split_evenly((PANELS.len(), 1));
-        for ((area, label), series) in panels.iter().zip(PANELS).zip(&self.series) {
+        let last = PANELS.len() - 1;
+        for (k, ((area, label), series)) in panels.iter().zip(PANELS).zip(&self.series).enumerate()
+        {
             let y = padded_range(series.iter().flatten().map(|p| p.1), 1.0);
             let mut chart = ChartBuilder::on(area)
                 .margin_right(20)
@@ -136,7 +138,7 @@ impl Figure for TimePlot {
             chart
                 .configure_mesh()
                 .y_desc(label)
-                .x_desc("time since boot (s)")
+                .x_desc(if k == last { "time since boot (s)" } else { "" })
                 .label_style((FONT, 13))
                 .axis_desc_style((FONT, 14))
                 .light_line_style(WHITE.mix(0.0))

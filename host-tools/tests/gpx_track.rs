@@ -1,0 +1,103 @@
+//! `wobblog gpx`: the GPS track as GPX 1.1, split where the fix was lost.
+
+mod analysis_support;
+
+use analysis_support::{Extras, Ride, LON_DEG, START_LAT_DEG};
+use assert_cmd::Command;
+use quick_xml::events::Event;
+use quick_xml::Reader;
+
+/// Track points of each segment: (lat, lon, has time, has ele).
+fn segments(gpx: &str) -> Vec<Vec<(f64, f64, bool, bool)>> {
+    let mut reader = Reader::from_str(gpx);
+    let mut out: Vec<Vec<(f64, f64, bool, bool)>> = Vec::new();
+    let mut inside = String::new();
+    loop {
+        match reader.read_event().unwrap() {
+            Event::Start(e) => {
+                let name = String::from_utf8(e.name().as_ref().to_vec()).unwrap();
+                match name.as_str() {
+                    "trkseg" => out.push(Vec::new()),
+                    "trkpt" => {
+                        let attr = |k: &str| -> f64 {
+                            let a = e.try_get_attribute(k).unwrap().unwrap();
+                            std::str::from_utf8(&a.value).unwrap().parse().unwrap()
+                        };
+                        out.last_mut()
+                            .unwrap()
+                            .push((attr("lat"), attr("lon"), false, false));
+                    }
+                    _ => {}
+                }
+                inside = name;
+            }
+            Event::Text(_) => {
+                if let Some(p) = out.last_mut().and_then(|s| s.last_mut()) {
+                    p.2 |= inside == "time";
+                    p.3 |= inside == "ele";
+                }
+            }
+            Event::Eof => return out,
+            _ => {}
+        }
+    }
+}
+
+#[test]
+fn track_has_every_fix_and_splits_at_the_outage() {
+    let dir = tempfile::tempdir().unwrap();
+    let log = dir.path().join("RUN00003.WBL");
+    let (ride, extras) = analysis_support::standard_log(&log);
+    let out = Command::cargo_bin("wobblog")
+        .unwrap()
+        .arg("gpx")
+        .arg(&log)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let gpx = String::from_utf8(out.stdout).unwrap();
+    assert!(gpx.contains("http://www.topografix.com/GPX/1/1"));
+    let segs = segments(&gpx);
+    assert_eq!(segs.len(), 2, "one segment before the outage, one after");
+    let expected = (0..ride.t_s.len())
+        .filter_map(|i| analysis_support::gps_fix(&ride, i, &extras))
+        .filter(|f| f.lat_e7.is_some())
+        .count();
+    let points: Vec<_> = segs.iter().flatten().collect();
+    assert_eq!(points.len(), expected);
+    assert!(
+        points.iter().all(|p| p.2 && p.3),
+        "every point has time and elevation"
+    );
+    assert!(points.iter().all(|p| (p.1 - LON_DEG).abs() < 1e-7));
+    // Due north at 5 m/s: latitude grows steadily from the start.
+    assert!((points[0].0 - START_LAT_DEG).abs() < 1e-6);
+    assert!(points.windows(2).all(|w| w[1].0 > w[0].0));
+}
+
+#[test]
+fn log_without_gps_gives_an_empty_track_and_a_warning() {
+    let dir = tempfile::tempdir().unwrap();
+    let log = dir.path().join("NOGPS.WBL");
+    analysis_support::write_log(
+        &log,
+        &Ride::new(5.0, 4.0, 0.0, 0.0, 0.0),
+        &Extras::default(),
+    );
+    let gpx_path = dir.path().join("t.gpx");
+    let out = Command::cargo_bin("wobblog")
+        .unwrap()
+        .arg("gpx")
+        .arg(&log)
+        .arg("-o")
+        .arg(&gpx_path)
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("no GPS fix"));
+    assert!(segments(&std::fs::read_to_string(&gpx_path).unwrap()).is_empty());
+}

@@ -1,0 +1,114 @@
+//! `wobblog decode --format parquet`: read back with the parquet crate, the
+//! file holds the CSV's rows and columns with the same values.
+
+mod analysis_support;
+
+use std::fs::File;
+use std::path::Path;
+
+use assert_cmd::Command;
+use parquet::file::reader::{FileReader, SerializedFileReader};
+use parquet::record::Field;
+use wobblog::export::CSV_COLUMNS;
+
+fn wobblog() -> Command {
+    Command::cargo_bin("wobblog").unwrap()
+}
+
+fn decode(log: &Path, format: &str, out: &Path) {
+    wobblog()
+        .arg("decode")
+        .arg(log)
+        .args(["--format", format, "-o"])
+        .arg(out)
+        .assert()
+        .success();
+}
+
+/// A CSV cell as the Parquet field it must equal.
+fn same(cell: &str, field: &Field) -> bool {
+    match field {
+        Field::Null => cell.is_empty(),
+        Field::Double(v) => cell.parse::<f64>().is_ok_and(|c| c == *v),
+        Field::Str(s) => cell == s,
+        _ => false,
+    }
+}
+
+#[test]
+fn parquet_matches_csv_row_for_row() {
+    let dir = tempfile::tempdir().unwrap();
+    let log = dir.path().join("RUN00003.WBL");
+    analysis_support::standard_log(&log);
+    let (csv_path, pq_path) = (dir.path().join("run.csv"), dir.path().join("run.parquet"));
+    decode(&log, "csv", &csv_path);
+    decode(&log, "parquet", &pq_path);
+
+    let mut csv = csv::Reader::from_path(&csv_path).unwrap();
+    let header: Vec<String> = csv.headers().unwrap().iter().map(String::from).collect();
+    let csv_rows: Vec<csv::StringRecord> = csv.records().map(Result::unwrap).collect();
+
+    let reader = SerializedFileReader::new(File::open(&pq_path).unwrap()).unwrap();
+    let meta = reader.metadata().file_metadata();
+    assert_eq!(meta.num_rows() as usize, csv_rows.len());
+    let names: Vec<&str> = meta
+        .schema_descr()
+        .columns()
+        .iter()
+        .map(|c| c.name())
+        .collect();
+    assert_eq!(names, header);
+    assert_eq!(names, CSV_COLUMNS);
+
+    let mut rows = 0;
+    let mut with_gps = 0;
+    for (row, csv_row) in reader.get_row_iter(None).unwrap().zip(&csv_rows) {
+        let row = row.unwrap();
+        for ((name, field), cell) in row.get_column_iter().zip(csv_row.iter()) {
+            assert!(
+                same(cell, field),
+                "row {rows} {name}: csv {cell:?}, parquet {field:?}"
+            );
+        }
+        with_gps += usize::from(!csv_row[9].is_empty());
+        rows += 1;
+    }
+    assert_eq!(rows, csv_rows.len());
+    // The log has GPS and a GPS outage: both kinds of rows were compared.
+    assert!(
+        with_gps > 0 && with_gps < rows,
+        "{with_gps} of {rows} rows with GPS"
+    );
+}
+
+#[test]
+fn long_run_spans_several_row_groups() {
+    let dir = tempfile::tempdir().unwrap();
+    let log = dir.path().join("LONG.WBL");
+    let ride = analysis_support::Ride::new(700.0, 5.0, 10.0, 1.0, 0.0);
+    analysis_support::write_log(&log, &ride, &analysis_support::Extras::default());
+    let pq_path = dir.path().join("long.parquet");
+    decode(&log, "parquet", &pq_path);
+    let reader = SerializedFileReader::new(File::open(&pq_path).unwrap()).unwrap();
+    assert!(reader.metadata().num_row_groups() > 1);
+    assert_eq!(
+        reader.metadata().file_metadata().num_rows() as usize,
+        ride.t_s.len()
+    );
+}
+
+#[test]
+fn unreadable_log_leaves_no_parquet_bytes() {
+    let dir = tempfile::tempdir().unwrap();
+    let junk = dir.path().join("JUNK.WBL");
+    std::fs::write(&junk, vec![0u8; 2048]).unwrap();
+    let out = dir.path().join("out.parquet");
+    wobblog()
+        .arg("decode")
+        .arg(&junk)
+        .args(["--format", "parquet", "-o"])
+        .arg(&out)
+        .assert()
+        .code(1);
+    assert_eq!(std::fs::metadata(&out).map(|m| m.len()).unwrap_or(0), 0);
+}

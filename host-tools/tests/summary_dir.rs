@@ -1,0 +1,92 @@
+//! `wobblog summary DIR`: one row per run, every readable run even when
+//! some logs are not.
+
+mod analysis_support;
+
+use analysis_support::{Extras, Ride};
+use assert_cmd::Command;
+use serde_json::Value;
+
+#[test]
+fn one_row_per_run_and_unreadable_logs_named() {
+    let dir = tempfile::tempdir().unwrap();
+    analysis_support::standard_log(&dir.path().join("RUN00003.WBL"));
+    let mut calm = Ride::new(20.0, 3.0, 0.0, 0.0, 0.0);
+    calm.steer_deg.fill(0.0);
+    analysis_support::write_log(&dir.path().join("run00004.wbl"), &calm, &Extras::default());
+    std::fs::write(dir.path().join("RUN00005.WBL"), b"not a log").unwrap();
+    std::fs::write(dir.path().join("notes.txt"), b"ignored").unwrap();
+
+    let out = Command::cargo_bin("wobblog")
+        .unwrap()
+        .arg("summary")
+        .arg(dir.path())
+        .args(["--format", "jsonl"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains("RUN00005.WBL"), "{stderr}");
+    let rows: Vec<Value> = String::from_utf8(out.stdout)
+        .unwrap()
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    assert_eq!(rows.len(), 2);
+
+    let wobbly = &rows[0];
+    assert_eq!(wobbly["log"], "RUN00003.WBL");
+    assert_eq!(wobbly["duration_s"].as_f64(), Some(30.0));
+    let distance = wobbly["distance_m"].as_f64().unwrap();
+    assert!((distance - 5.0 * 29.99).abs() < 0.5, "{distance}");
+    assert_eq!(wobbly["max_speed_mps"].as_f64(), Some(5.0));
+    assert_eq!(wobbly["unstable_episodes"], 1);
+    assert!((wobbly["wobble_speed_mps"].as_f64().unwrap() - 5.0).abs() < 0.1);
+    assert_eq!(wobbly["frames_lost"], 0);
+
+    let calm_row = &rows[1];
+    assert_eq!(calm_row["log"], "run00004.wbl");
+    assert_eq!(calm_row["episodes"], 0);
+    assert_eq!(calm_row["wobble_speed_mps"], Value::Null);
+}
+
+#[test]
+fn lost_blocks_are_counted_and_csv_has_a_header() {
+    let dir = tempfile::tempdir().unwrap();
+    let log = dir.path().join("RUN00003.WBL");
+    analysis_support::standard_log(&log);
+    let mut bytes = std::fs::read(&log).unwrap();
+    bytes[30 * 512 + 9] ^= 0x01;
+    std::fs::write(&log, &bytes).unwrap();
+    let out = Command::cargo_bin("wobblog")
+        .unwrap()
+        .arg("summary")
+        .arg(dir.path())
+        .args(["--format", "csv"])
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    let mut csv = csv::Reader::from_reader(out.stdout.as_slice());
+    let header = csv.headers().unwrap().clone();
+    let row = csv.records().next().unwrap().unwrap();
+    let col = |name: &str| row[header.iter().position(|h| h == name).unwrap()].to_string();
+    assert_eq!(col("lost_blocks"), "1");
+    assert!(col("frames_lost").parse::<u64>().unwrap() > 10);
+}
+
+#[test]
+fn empty_or_missing_directory_fails_cleanly() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = |path: &std::path::Path| {
+        Command::cargo_bin("wobblog")
+            .unwrap()
+            .arg("summary")
+            .arg(path)
+            .output()
+            .unwrap()
+    };
+    let out = run(dir.path());
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("no *.WBL"));
+    assert_eq!(run(&dir.path().join("absent")).status.code(), Some(1));
+}
