@@ -19,6 +19,8 @@
 
 use core::fmt;
 
+use embedded_sdmmc::{BlockDevice, Mode, TimeSource, VolumeIdx, VolumeManager};
+
 use crate::detector::{DetectorConfig, PatternConfig};
 use crate::format::{Fault, FaultSource};
 use crate::imu::{AxisMap, Imu, ImuConfig, SignedAxis};
@@ -40,6 +42,9 @@ pub const FAULT_REJECTED: u8 = 4;
 pub const FAULT_UNREADABLE: u8 = 5;
 /// Number of config fault codes (`1..=FAULT_CODES`).
 pub const FAULT_CODES: usize = 5;
+
+/// The file's name in the card's root directory.
+pub const FILE_NAME: &str = "CONFIG.TXT";
 
 /// Line faults kept with their line numbers (the counts stay exact beyond).
 pub const MAX_LINE_FAULTS: usize = 8;
@@ -446,6 +451,76 @@ impl Config {
         }
         Ok(())
     }
+}
+
+/// Where the configuration in force came from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Source {
+    /// [`FILE_NAME`] on the card.
+    File,
+    /// The card has no [`FILE_NAME`]: the defaults, no fault.
+    NoFile,
+    /// No readable card or volume: the defaults (the logger reports the
+    /// card itself).
+    NoCard,
+}
+
+/// Reads [`FILE_NAME`] from the first volume of the card into `buf` and
+/// parses it. A file longer than `buf` is cut after its last whole line
+/// and the rest reported as [`FAULT_UNREADABLE`] (line 0).
+pub fn load<D: BlockDevice, T: TimeSource>(
+    volumes: &VolumeManager<D, T>,
+    buf: &mut [u8],
+) -> (Loaded, Source) {
+    let defaults = |source| (Config::parse(b""), source);
+    let Ok(volume) = volumes.open_raw_volume(VolumeIdx(0)) else {
+        return defaults(Source::NoCard);
+    };
+    let read = volumes.open_root_dir(volume).ok().map(|dir| {
+        let text = volumes
+            .open_file_in_dir(dir, FILE_NAME, Mode::ReadOnly)
+            .ok()
+            .map(|file| {
+                let (len, complete) = read_into(volumes, file, buf);
+                let _ = volumes.close_file(file);
+                (len, complete)
+            });
+        let _ = volumes.close_dir(dir);
+        text
+    });
+    let _ = volumes.close_volume(volume);
+    match read {
+        None => defaults(Source::NoCard),
+        Some(None) => defaults(Source::NoFile),
+        Some(Some((len, complete))) => {
+            let text = buf.get(..len).unwrap_or_default();
+            if complete {
+                return (Config::parse(text), Source::File);
+            }
+            let whole_lines = text.iter().rposition(|&b| b == b'\n').map_or(0, |i| i + 1);
+            let mut loaded = Config::parse(text.get(..whole_lines).unwrap_or_default());
+            loaded.faults.push(0, FAULT_UNREADABLE);
+            (loaded, Source::File)
+        }
+    }
+}
+
+/// Reads `file` into `buf`; returns the length read and whether that was
+/// the whole file. A read error ends the file there.
+fn read_into<D: BlockDevice, T: TimeSource>(
+    volumes: &VolumeManager<D, T>,
+    file: embedded_sdmmc::RawFile,
+    buf: &mut [u8],
+) -> (usize, bool) {
+    let mut len = 0;
+    while let Some(rest) = buf.get_mut(len..).filter(|r| !r.is_empty()) {
+        match volumes.read(file, rest) {
+            Ok(n) if n > 0 => len += n,
+            _ => return (len, true),
+        }
+    }
+    (len, volumes.file_eof(file).unwrap_or(true))
 }
 
 /// One line of the file that was not used.

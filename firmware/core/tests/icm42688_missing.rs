@@ -7,9 +7,8 @@ use embassy_futures::block_on;
 use embedded_hal_mock::eh1::delay::NoopDelay;
 use embedded_hal_mock::eh1::spi::Mock;
 use icm42688_support::{read_regs, write_reg};
-use wobble_core::drivers::icm42688::{
-    reg::*, Config, Error, Icm42688, FAULT_NO_RESPONSE, FAULT_WRONG_ID,
-};
+use wobble_core::app::ports::SensorError;
+use wobble_core::drivers::icm42688::{reg::*, Config, Error, Icm42688};
 
 fn init_with_who_am_i(answer: u8) -> Error<embedded_hal::spi::ErrorKind> {
     let expectations = [write_reg(REG_BANK_SEL, 0), read_regs(WHO_AM_I, &[answer])].concat();
@@ -26,7 +25,7 @@ fn floating_miso_reads_as_no_response() {
     for answer in [0xFF, 0x00] {
         let err = init_with_who_am_i(answer);
         assert_eq!(err, Error::NoResponse);
-        assert_eq!(err.fault_code(), FAULT_NO_RESPONSE);
+        assert_eq!(err.sensor_error(), SensorError::NoResponse);
     }
 }
 
@@ -35,5 +34,5 @@ fn another_part_is_named_by_its_id() {
     // 0x12: an ICM-20602 fitted instead.
     let err = init_with_who_am_i(0x12);
     assert_eq!(err, Error::WrongId(0x12));
-    assert_eq!(err.fault_code(), FAULT_WRONG_ID);
+    assert_eq!(err.sensor_error(), SensorError::NoResponse);
 }

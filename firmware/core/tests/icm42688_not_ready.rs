@@ -6,7 +6,8 @@ mod icm42688_support;
 use embassy_futures::block_on;
 use embedded_hal_mock::eh1::spi::Mock;
 use icm42688_support::data_read;
-use wobble_core::drivers::icm42688::{Config, Error, Icm42688, FAULT_NOT_READY};
+use wobble_core::app::ports::SensorError;
+use wobble_core::drivers::icm42688::{Config, Error, Icm42688};
 
 #[test]
 fn the_no_data_marker_is_not_ready() {
@@ -15,7 +16,7 @@ fn the_no_data_marker_is_not_ready() {
     let err = block_on(imu.read()).expect_err("no data");
     spi.done();
     assert_eq!(err, Error::NotReady);
-    assert_eq!(err.fault_code(), FAULT_NOT_READY);
+    assert_eq!(err.sensor_error(), SensorError::Stale);
 }
 
 #[test]

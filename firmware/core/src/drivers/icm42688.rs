@@ -22,12 +22,14 @@
 //! else ([`Error::WrongId`]). [`Icm42688::read`] reports a sensor whose
 //! registers hold the "no data" marker ([`Error::NotReady`]: it reset or
 //! powered down). A sensor that answers with frozen values is found one level
-//! up, by [`crate::imu::Imu`] ([`FAULT_STUCK`]). Each error maps to an IMU
-//! fault code ([`Error::fault_code`]); the caller re-runs `init` to recover.
+//! up, by [`crate::imu::Imu`]. Each error maps to the sampler's
+//! [`SensorError`] ([`Error::sensor_error`]), which records it as an IMU
+//! fault; the caller re-runs `init` to recover.
 
 use embedded_hal_async::delay::DelayNs;
 use embedded_hal_async::spi::{Operation, SpiDevice};
 
+use crate::app::ports::SensorError;
 use crate::imu::{ImuConfig, RawImu};
 
 /// Register addresses and fields (datasheet DS-000347, section 14).
@@ -107,17 +109,6 @@ pub const RESET_WAIT_US: u32 = 1_000;
 /// Wait after switching the sensors on: the gyro needs 45 ms before its
 /// output is valid (the accelerometer less); no register write for 200 µs.
 pub const STARTUP_WAIT_US: u32 = 45_000;
-
-/// Fault code (source IMU): the SPI bus reported an error.
-pub const FAULT_BUS: u8 = 1;
-/// Fault code: nothing answers (`WHO_AM_I` reads 0x00 or 0xFF).
-pub const FAULT_NO_RESPONSE: u8 = 2;
-/// Fault code: another part answers.
-pub const FAULT_WRONG_ID: u8 = 3;
-/// Fault code: the outputs stopped changing ([`crate::imu::ImuSample::stuck`]).
-pub const FAULT_STUCK: u8 = 4;
-/// Fault code: the data registers hold the "no data" marker.
-pub const FAULT_NOT_READY: u8 = 5;
 
 /// Accelerometer full scale: ±16 g, the only range of this part that
 /// covers the ±10 g the study needs.
@@ -200,14 +191,14 @@ pub enum Error<E> {
 }
 
 impl<E> Error<E> {
-    /// The IMU fault code (`FAULT_*`) recorded in the log.
+    /// How the sampler records it: a sensor that is absent, mute or not the
+    /// right part does not respond (an IMU fault, status bit set); one with
+    /// no data yet is stale.
     #[must_use]
-    pub const fn fault_code(&self) -> u8 {
+    pub const fn sensor_error(&self) -> SensorError {
         match self {
-            Self::Comm(_) => FAULT_BUS,
-            Self::NoResponse => FAULT_NO_RESPONSE,
-            Self::WrongId(_) => FAULT_WRONG_ID,
-            Self::NotReady => FAULT_NOT_READY,
+            Self::Comm(_) | Self::NoResponse | Self::WrongId(_) => SensorError::NoResponse,
+            Self::NotReady => SensorError::Stale,
         }
     }
 }

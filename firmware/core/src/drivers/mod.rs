@@ -2,5 +2,6 @@
 //! `embedded-hal(-async)` traits only, so they are tested on the host with
 //! mocked buses and run unchanged on any MCU.
 
+pub mod gnss_setup;
 pub mod icm42688;
 pub mod sdcard;

@@ -1,0 +1,302 @@
+//! The wobble logger on an STM32F405RG board: brings up the clocks and the
+//! peripherals of `pins.rs`, reads `CONFIG.TXT`, and hands everything to
+//! the core's tasks.
+//!
+//! | executor | priority | tasks |
+//! |---|---|---|
+//! | interrupt (UART4 vector) | high | 100 Hz sampler, wheel capture |
+//! | interrupt (UART5 vector) | medium | GPS |
+//! | thread mode | low | SD writer (blocking), watchdog feeder |
+#![no_std]
+#![no_main]
+
+mod adapters;
+mod clocks;
+mod pins;
+mod watchdog;
+
+use cortex_m_rt::entry;
+use embassy_executor::{Executor, InterruptExecutor};
+use embassy_stm32::adc::{Adc, AdcChannel, Exten, RingBufferedAdc, SampleTime, CONTINUOUS};
+use embassy_stm32::gpio::{Input, Level, Output, Pull, Speed};
+use embassy_stm32::interrupt;
+use embassy_stm32::interrupt::{InterruptExt, Priority};
+use embassy_stm32::mode::Async;
+use embassy_stm32::peripherals::{ADC1, IWDG, TIM5};
+use embassy_stm32::spi::Spi;
+use embassy_stm32::time::Hertz;
+use embassy_stm32::timer::input_capture::{CapturePin, InputCapture};
+use embassy_stm32::timer::low_level::CountingMode;
+use embassy_stm32::usart::{self, RingBufferedUartRx, Uart, UartTx};
+use embassy_stm32::Peri;
+use embassy_time::{Delay, Instant};
+use embedded_hal_bus::spi::ExclusiveDevice;
+use embedded_sdmmc::VolumeManager;
+use static_cell::StaticCell;
+use wobble_core::app::sampler::{Sampler, SamplerPorts};
+use wobble_core::app::{gps, sampler, writer};
+use wobble_core::channels::{RecordQueue, SharedStatus};
+use wobble_core::config::{self, Config, Loaded, KEY_COUNT, MAX_TEXT_LEN};
+use wobble_core::detector::Detector;
+use wobble_core::drivers::icm42688::{self, Icm42688};
+use wobble_core::format::Record;
+use wobble_core::gps::{GpsConfig, GpsReceiver};
+use wobble_core::imu::Imu;
+use wobble_core::logger::{CardLogger, FixedTime, HeaderSpec, LoggerConfig};
+use wobble_core::steering::Steering;
+use wobble_core::wheel::WheelSpeed;
+use {defmt_rtt as _, panic_probe as _};
+
+use adapters::card::SdCard;
+use adapters::gps::GpsAdapter;
+use adapters::imu::ImuAdapter;
+use adapters::rider::{AlertPins, MarkerButton, StatusLight};
+use adapters::steering::{SteeringAdapter, DMA_SAMPLES};
+use adapters::wheel::WheelAdapter;
+use pins::{Board, Irqs};
+
+/// Records from the sampler and the GPS task to the SD writer.
+static QUEUE: RecordQueue = RecordQueue::new();
+/// Fix age and card state, shared by the tasks.
+static SHARED: SharedStatus = SharedStatus::new();
+
+static EXECUTOR_HIGH: InterruptExecutor = InterruptExecutor::new();
+static EXECUTOR_MEDIUM: InterruptExecutor = InterruptExecutor::new();
+static EXECUTOR_THREAD: StaticCell<Executor> = StaticCell::new();
+
+/// The configuration in force as text, and its lines for the log header.
+static CONFIG_TEXT: StaticCell<heapless::String<MAX_TEXT_LEN>> = StaticCell::new();
+static CONFIG_LINES: StaticCell<heapless::Vec<&'static str, KEY_COUNT>> = StaticCell::new();
+/// Room for `CONFIG.TXT` while it is read at boot.
+static CONFIG_FILE: StaticCell<[u8; 4096]> = StaticCell::new();
+static ADC_RING: StaticCell<[u16; DMA_SAMPLES]> = StaticCell::new();
+static GPS_RING: StaticCell<[u8; adapters::gps::RING_BYTES]> = StaticCell::new();
+
+const FIRMWARE: &str = concat!(env!("CARGO_PKG_NAME"), " ", env!("CARGO_PKG_VERSION"));
+const FRAME_RATE_HZ: u16 = 100;
+
+type Ports =
+    SamplerPorts<ImuAdapter, SteeringAdapter, WheelAdapter, MarkerButton, AlertPins, StatusLight>;
+
+#[interrupt]
+unsafe fn UART4() {
+    // SAFETY: the vector belongs to this executor alone (UART4 is unused).
+    unsafe { EXECUTOR_HIGH.on_interrupt() }
+}
+
+#[interrupt]
+unsafe fn UART5() {
+    // SAFETY: the vector belongs to this executor alone (UART5 is unused).
+    unsafe { EXECUTOR_MEDIUM.on_interrupt() }
+}
+
+#[entry]
+fn main() -> ! {
+    let board = Board::new(embassy_stm32::init(clocks::config()));
+    defmt::info!("{} starting", FIRMWARE);
+
+    let (card, loaded) = card_and_config(board.card);
+    let config = loaded.config;
+    let t_us = Instant::now().as_micros();
+    for fault in loaded.faults.records(t_us) {
+        QUEUE.push(Record::Fault(fault));
+    }
+    let logger = CardLogger::new(
+        card,
+        FixedTime::EPOCH,
+        header(&config),
+        LoggerConfig::DEFAULT,
+    );
+
+    let (sampler, ports, capture) =
+        sampler_parts(board.imu, board.steering, board.wheel, board.rider, &config);
+    let (gps_tx, gps_rx) = gps_uart(board.gps);
+
+    interrupt::UART4.set_priority(Priority::P6);
+    let high = EXECUTOR_HIGH.start(interrupt::UART4);
+    high.spawn(defmt::unwrap!(sampler_task(sampler, ports)));
+    high.spawn(defmt::unwrap!(wheel_task(capture)));
+
+    interrupt::UART5.set_priority(Priority::P7);
+    let medium = EXECUTOR_MEDIUM.start(interrupt::UART5);
+    medium.spawn(defmt::unwrap!(gps_task(gps_tx, gps_rx)));
+
+    let watchdog = board.watchdog;
+    EXECUTOR_THREAD.init(Executor::new()).run(move |thread| {
+        thread.spawn(defmt::unwrap!(writer_task(logger)));
+        thread.spawn(defmt::unwrap!(watchdog_task(watchdog)));
+    })
+}
+
+/// Opens the card and reads `CONFIG.TXT` (defaults without a card).
+fn card_and_config(pins: pins::CardPins) -> (SdCard, Loaded) {
+    let bus = Spi::new_blocking(
+        pins.spi,
+        pins.sck,
+        pins.mosi,
+        pins.miso,
+        adapters::card::spi_config(wobble_core::drivers::sdcard::IDENTIFICATION_CLOCK_HZ),
+    );
+    let cs = Output::new(pins.cs, Level::High, Speed::VeryHigh);
+    let volumes = VolumeManager::new(adapters::card::card(bus, cs), FixedTime::EPOCH);
+    let (loaded, source) = config::load(&volumes, CONFIG_FILE.init([0; 4096]));
+    defmt::info!("config: {}, {} faults", source, loaded.faults.first().len());
+    for fault in loaded.faults.first() {
+        defmt::warn!("CONFIG.TXT line {}: fault {}", fault.line, fault.code);
+    }
+    let (card, _) = volumes.free();
+    (card, loaded)
+}
+
+/// The header of every log file: identity and the configuration in force.
+fn header(config: &Config) -> HeaderSpec<'static> {
+    let text = CONFIG_TEXT.init(heapless::String::new());
+    if config.write_lines(text).is_err() {
+        defmt::warn!("config text cut at {} bytes", MAX_TEXT_LEN);
+    }
+    let text: &'static heapless::String<MAX_TEXT_LEN> = text;
+    let lines = CONFIG_LINES.init(text.lines().take(KEY_COUNT).collect());
+    HeaderSpec {
+        firmware: FIRMWARE,
+        device_id: embassy_stm32::uid::uid(),
+        sample_rate_hz: FRAME_RATE_HZ,
+        config: lines,
+    }
+}
+
+/// The sensors, rider I/O and the sampler's state.
+fn sampler_parts(
+    imu: pins::ImuPins,
+    steering: pins::SteeringPins,
+    wheel: pins::WheelPins,
+    rider: pins::RiderPins,
+    config: &Config,
+) -> (Sampler, Ports, InputCapture<'static, TIM5>) {
+    let mut spi_config = embassy_stm32::spi::Config::default();
+    spi_config.frequency = Hertz(clocks::IMU_SPI_HZ);
+    let bus = Spi::new(
+        imu.spi, imu.sck, imu.mosi, imu.miso, imu.tx_dma, imu.rx_dma, Irqs, spi_config,
+    );
+    let cs = Output::new(imu.cs, Level::High, Speed::VeryHigh);
+    let device = ExclusiveDevice::new(bus, cs, Delay).unwrap_or_else(|e| match e {});
+    let driver_config = icm42688::Config::default();
+    // `Config::parse` only lets through what the core's modules accept.
+    let channel = defmt::unwrap!(Imu::try_new(driver_config.imu_config(config.imu)).ok());
+    let imu = ImuAdapter::new(Icm42688::new(device, driver_config), channel);
+
+    let steering = SteeringAdapter::new(
+        steering_adc(steering.adc, steering.wiper, steering.dma),
+        defmt::unwrap!(Steering::try_new(config.steering).ok()),
+    );
+
+    let capture = InputCapture::new(
+        wheel.timer,
+        Some(CapturePin::new(wheel.hall, Pull::Up)),
+        None,
+        None,
+        None,
+        Irqs,
+        Hertz(1_000_000),
+        CountingMode::EdgeAlignedUp,
+    );
+
+    let ports = SamplerPorts {
+        imu,
+        steering,
+        wheel: WheelAdapter::default(),
+        marker: MarkerButton(Input::new(rider.marker, Pull::Up)),
+        alert: AlertPins {
+            buzzer: Output::new(rider.buzzer, Level::Low, Speed::Low),
+            led: Output::new(rider.alert_led, Level::Low, Speed::Low),
+            enabled: config.alert.enabled,
+        },
+        status_led: StatusLight {
+            led: Output::new(rider.status_led, Level::Low, Speed::Low),
+            frames: 0,
+        },
+    };
+    let sampler = Sampler::new(
+        defmt::unwrap!(WheelSpeed::try_new(config.wheel).ok()),
+        defmt::unwrap!(Detector::new(config.detector).ok()),
+        config.alert.pattern,
+    );
+    (sampler, ports, capture)
+}
+
+/// ADC1 converting the wiper continuously into a DMA ring, the slowest
+/// sample time (480 cycles) for the pot's source impedance.
+fn steering_adc(
+    adc: Peri<'static, ADC1>,
+    wiper: Peri<'static, embassy_stm32::peripherals::PC0>,
+    dma: Peri<'static, embassy_stm32::peripherals::DMA2_CH4>,
+) -> RingBufferedAdc<'static, ADC1> {
+    Adc::new(adc).into_ring_buffered(
+        dma,
+        ADC_RING.init([0; DMA_SAMPLES]),
+        Irqs,
+        [(wiper.degrade_adc(), SampleTime::CYCLES480)].into_iter(),
+        CONTINUOUS,
+        Exten::DISABLED,
+    )
+}
+
+/// USART2 at the receivers' power-up rate; the GPS task raises it.
+fn gps_uart(pins: pins::GpsPins) -> (UartTx<'static, Async>, RingBufferedUartRx<'static>) {
+    let mut config = usart::Config::default();
+    config.baudrate = wobble_core::drivers::gnss_setup::BOOT_BAUDS[0];
+    let uart = defmt::unwrap!(Uart::new(
+        pins.uart,
+        pins.rx,
+        pins.tx,
+        pins.tx_dma,
+        pins.rx_dma,
+        Irqs,
+        config
+    )
+    .ok());
+    let (tx, rx) = uart.split();
+    (
+        tx,
+        rx.into_ring_buffered(GPS_RING.init([0; adapters::gps::RING_BYTES])),
+    )
+}
+
+#[embassy_executor::task]
+async fn sampler_task(mut sampler: Sampler, mut ports: Ports) {
+    sampler::run(
+        &mut sampler,
+        &mut ports,
+        &QUEUE,
+        &SHARED,
+        u32::MAX,
+        &mut |t_us, event| {
+            defmt::info!("alert at {} us: {}", t_us, event);
+        },
+    )
+    .await;
+}
+
+#[embassy_executor::task]
+async fn wheel_task(capture: InputCapture<'static, TIM5>) {
+    adapters::wheel::capture_edges(capture).await
+}
+
+#[embassy_executor::task]
+async fn gps_task(mut tx: UartTx<'static, Async>, rx: RingBufferedUartRx<'static>) {
+    adapters::gps::configure_receiver(&mut tx).await;
+    let mut port = GpsAdapter::new(rx);
+    let mut receiver = GpsReceiver::new(GpsConfig::default());
+    gps::run(&mut port, &mut receiver, &QUEUE, &SHARED).await;
+}
+
+#[embassy_executor::task]
+async fn writer_task(mut logger: CardLogger<'static, SdCard, FixedTime>) {
+    if let Err(e) = writer::run(&mut logger, &QUEUE, &SHARED).await {
+        defmt::error!("log not closed cleanly: {}", e);
+    }
+}
+
+#[embassy_executor::task]
+async fn watchdog_task(iwdg: Peri<'static, IWDG>) {
+    watchdog::feed(iwdg).await
+}
