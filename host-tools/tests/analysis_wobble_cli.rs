@@ -3,13 +3,8 @@
 
 mod analysis_support;
 
-use analysis_support::wobble;
-use assert_cmd::Command;
+use analysis_support::{stdout_of, wobble, wobblog};
 use serde_json::Value;
-
-fn wobblog() -> Command {
-    Command::cargo_bin("wobblog").unwrap()
-}
 
 fn unstable(report: &Value) -> Vec<&Value> {
     report["episodes"]
@@ -44,22 +39,11 @@ fn known_wobble_is_measured() {
     let dir = tempfile::tempdir().unwrap();
     let log = dir.path().join("RUN00003.WBL");
     analysis_support::standard_log(&log);
-    let out = wobblog()
-        .arg("wobble")
-        .arg(&log)
-        .arg("--json")
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let report: Value = serde_json::from_slice(&out.stdout).unwrap();
+    let json = stdout_of(wobblog().arg("wobble").arg(&log).arg("--json"));
+    let report: Value = serde_json::from_str(&json).unwrap();
     check_known_wobble(&report);
 
-    let text = wobblog().arg("wobble").arg(&log).output().unwrap();
-    let text = String::from_utf8(text.stdout).unwrap();
+    let text = stdout_of(wobblog().arg("wobble").arg(&log));
     assert!(text.contains("wobble speed 5.00 m/s"), "{text}");
     assert!(text.contains("Unstable"), "{text}");
 }

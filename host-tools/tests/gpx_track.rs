@@ -2,8 +2,7 @@
 
 mod analysis_support;
 
-use analysis_support::{Extras, Ride, LON_DEG, START_LAT_DEG};
-use assert_cmd::Command;
+use analysis_support::{stdout_of, wobblog, Extras, Ride, LON_DEG, START_LAT_DEG};
 use quick_xml::events::Event;
 use quick_xml::Reader;
 
@@ -48,18 +47,7 @@ fn track_has_every_fix_and_splits_at_the_outage() {
     let dir = tempfile::tempdir().unwrap();
     let log = dir.path().join("RUN00003.WBL");
     let (ride, extras) = analysis_support::standard_log(&log);
-    let out = Command::cargo_bin("wobblog")
-        .unwrap()
-        .arg("gpx")
-        .arg(&log)
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let gpx = String::from_utf8(out.stdout).unwrap();
+    let gpx = stdout_of(wobblog().arg("gpx").arg(&log));
     assert!(gpx.contains("http://www.topografix.com/GPX/1/1"));
     let segs = segments(&gpx);
     assert_eq!(segs.len(), 2, "one segment before the outage, one after");
@@ -89,8 +77,7 @@ fn log_without_gps_gives_an_empty_track_and_a_warning() {
         &Extras::default(),
     );
     let gpx_path = dir.path().join("t.gpx");
-    let out = Command::cargo_bin("wobblog")
-        .unwrap()
+    let out = wobblog()
         .arg("gpx")
         .arg(&log)
         .arg("-o")

@@ -6,14 +6,10 @@ mod analysis_support;
 use std::fs::File;
 use std::path::Path;
 
-use assert_cmd::Command;
+use analysis_support::wobblog;
 use parquet::file::reader::{FileReader, SerializedFileReader};
 use parquet::record::Field;
 use wobblog::export::CSV_COLUMNS;
-
-fn wobblog() -> Command {
-    Command::cargo_bin("wobblog").unwrap()
-}
 
 fn decode(log: &Path, format: &str, out: &Path) {
     wobblog()

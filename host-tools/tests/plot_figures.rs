@@ -5,12 +5,8 @@ mod analysis_support;
 
 use std::path::Path;
 
-use assert_cmd::Command;
+use analysis_support::{stdout_of, wobblog};
 use wobblog::plot::timeplot::{ALERT_COLOUR, LINE_COLOUR, MARKER_COLOUR, PANELS};
-
-fn wobblog() -> Command {
-    Command::cargo_bin("wobblog").unwrap()
-}
 
 fn hex(c: plotters::style::RGBColor) -> String {
     format!("#{:02X}{:02X}{:02X}", c.0, c.1, c.2)
@@ -111,20 +107,14 @@ fn figure_8_has_a_dot_per_episode_and_a_legend_per_run() {
     analysis_support::standard_log(&a);
     analysis_support::standard_log(&b);
     let svg_path = dir.path().join("modes.svg");
-    let out = wobblog()
-        .args(["wobble", "--json", "--plot"])
-        .arg(&svg_path)
-        .arg(&a)
-        .arg(&b)
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
+    let json = stdout_of(
+        wobblog()
+            .args(["wobble", "--json", "--plot"])
+            .arg(&svg_path)
+            .arg(&a)
+            .arg(&b),
     );
-    let episodes: usize = String::from_utf8(out.stdout)
-        .unwrap()
+    let episodes: usize = json
         .lines()
         .map(|l| {
             serde_json::from_str::<serde_json::Value>(l).unwrap()["episodes"]
@@ -178,4 +168,60 @@ fn bad_requests_are_usage_errors() {
         .args(["--from", "500"])
         .assert()
         .code(1);
+}
+
+/// The README's example figures, drawn from the synthetic ride (Figure 6)
+/// and from it plus its stable kicks (Figure 8). Written to a temporary
+/// directory; with `WOBBLOG_UPDATE_DOC_IMAGES` set, into `docs/images/`.
+#[test]
+fn example_images() {
+    let dir = tempfile::tempdir().unwrap();
+    let out_dir = if std::env::var_os("WOBBLOG_UPDATE_DOC_IMAGES").is_some() {
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/images")
+    } else {
+        dir.path().to_path_buf()
+    };
+    let log = dir.path().join("RUN00003.WBL");
+    analysis_support::standard_log(&log);
+    let fig6 = out_dir.join("figure6.png");
+    wobblog()
+        .arg("plot")
+        .arg(&log)
+        .arg("-o")
+        .arg(&fig6)
+        .args(["--from", "10", "--to", "22"])
+        .assert()
+        .success();
+    let fig8 = out_dir.join("figure8.png");
+    let corpus = analysis_support::corpus_dir();
+    let mut logs = vec![log];
+    for name in [
+        "wobble_g1.0",
+        "wobble_f8.3",
+        "ride_two_wobbles",
+        "ride_kicks",
+        "ride_potholes_kerbs",
+    ] {
+        let csv = corpus.join(format!("{name}.csv"));
+        if csv.exists() {
+            let wbl = dir.path().join(format!("{name}.wbl"));
+            wobblog()
+                .args(["encode", "--csv"])
+                .arg(&csv)
+                .arg("-o")
+                .arg(&wbl)
+                .assert()
+                .success();
+            logs.push(wbl);
+        }
+    }
+    wobblog()
+        .arg("wobble")
+        .arg("--plot")
+        .arg(&fig8)
+        .args(&logs)
+        .assert()
+        .success();
+    assert!(std::fs::metadata(&fig6).unwrap().len() > 20_000);
+    assert!(std::fs::metadata(&fig8).unwrap().len() > 20_000);
 }

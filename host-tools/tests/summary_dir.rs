@@ -3,8 +3,7 @@
 
 mod analysis_support;
 
-use analysis_support::{Extras, Ride};
-use assert_cmd::Command;
+use analysis_support::{wobblog, Extras, Ride};
 use serde_json::Value;
 
 #[test]
@@ -17,8 +16,7 @@ fn one_row_per_run_and_unreadable_logs_named() {
     std::fs::write(dir.path().join("RUN00005.WBL"), b"not a log").unwrap();
     std::fs::write(dir.path().join("notes.txt"), b"ignored").unwrap();
 
-    let out = Command::cargo_bin("wobblog")
-        .unwrap()
+    let out = wobblog()
         .arg("summary")
         .arg(dir.path())
         .args(["--format", "jsonl"])
@@ -58,8 +56,7 @@ fn lost_blocks_are_counted_and_csv_has_a_header() {
     let mut bytes = std::fs::read(&log).unwrap();
     bytes[30 * 512 + 9] ^= 0x01;
     std::fs::write(&log, &bytes).unwrap();
-    let out = Command::cargo_bin("wobblog")
-        .unwrap()
+    let out = wobblog()
         .arg("summary")
         .arg(dir.path())
         .args(["--format", "csv"])
@@ -77,14 +74,7 @@ fn lost_blocks_are_counted_and_csv_has_a_header() {
 #[test]
 fn empty_or_missing_directory_fails_cleanly() {
     let dir = tempfile::tempdir().unwrap();
-    let run = |path: &std::path::Path| {
-        Command::cargo_bin("wobblog")
-            .unwrap()
-            .arg("summary")
-            .arg(path)
-            .output()
-            .unwrap()
-    };
+    let run = |path: &std::path::Path| wobblog().arg("summary").arg(path).output().unwrap();
     let out = run(dir.path());
     assert_eq!(out.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&out.stderr).contains("no *.WBL"));

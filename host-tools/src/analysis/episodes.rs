@@ -190,7 +190,7 @@ impl<'a> Span<'a> {
         let window = region
             .start
             .saturating_sub(self.samples(BACKGROUND_WINDOW_S))
-            ..(region.end + self.samples(1.0)).min(self.band.len());
+            ..(region.end + self.samples(TONE_LOOKBACK_S)).min(self.band.len());
         let t = &self.t_s[window.clone()];
         let env = demod_envelope(&self.band[window.clone()], t, f0_hz, self.fs_hz);
         let before = region.start.saturating_sub(self.samples(0.3)) - window.start;
@@ -211,9 +211,7 @@ impl<'a> Span<'a> {
 
         let band = &self.band[window.clone()];
         // The mode fitted over `range` if it grows (or decays) as asked and
-        // explains the signal there. A growth fit reaches back to before the
-        // wobble rose, where a steady tone near it (a wheel harmonic) shows
-        // alone, and fits that tone alongside.
+        // explains the signal there.
         let fit = |range: Range<usize>, growing: bool| {
             let min_s = if growing {
                 MIN_GROWTH_FIT_S
@@ -225,17 +223,18 @@ impl<'a> Span<'a> {
             }
             let slope = log_slope(&t[range.clone()], &clean[range.clone()])?;
             let f1_hz = crossing_freq_hz(&t[range.clone()], &band[range.clone()]).unwrap_or(f0_hz);
-            let (from, tone) = if growing {
-                let from = range.start.saturating_sub(self.samples(TONE_LOOKBACK_S));
-                let before = from..range.start;
-                (
-                    from,
-                    strongest_tone(&t[before.clone()], &band[before], f1_hz, self.fs_hz),
-                )
+            // The fit reaches beyond the rise or the fall, to where a steady
+            // tone near the wobble (a wheel harmonic) shows alone, and fits
+            // that tone alongside: before a growth, after a decay.
+            let lookback = self.samples(TONE_LOOKBACK_S);
+            let (fitted, alone) = if growing {
+                let from = range.start.saturating_sub(lookback);
+                (from..range.end, from..range.start)
             } else {
-                (range.start, None)
+                let to = (range.end + lookback).min(t.len());
+                (range.start..to, range.end..to)
             };
-            let fitted = from..range.end;
+            let tone = strongest_tone(&t[alone.clone()], &band[alone], f1_hz, self.fs_hz);
             let mode = fit_mode(
                 &t[fitted.clone()],
                 &band[fitted.clone()],
@@ -246,15 +245,14 @@ impl<'a> Span<'a> {
             let ok = (mode.sigma_per_s > 0.0) == growing && mode.residual_rel <= MAX_RESIDUAL_REL;
             ok.then_some((fitted, mode))
         };
-        let (stability, range, mode) = match growth_range(&clean, local.clone(), floor, ceiling)
-            .and_then(|r| fit(r, true))
-        {
-            Some((r, mode)) => (Stability::Unstable, r, mode),
-            None => {
-                let (r, mode) = fit(decay_range(&clean, local.clone(), floor, ceiling)?, false)?;
-                (Stability::Stable, r, mode)
-            }
-        };
+        let (stability, range, mode) =
+            match growth_range(&clean, local.clone(), floor, ceiling).and_then(|r| fit(r, true)) {
+                Some((r, mode)) => (Stability::Unstable, r, mode),
+                None => {
+                    let (r, mode) = fit(decay_range(&clean, band, local.clone(), floor)?, false)?;
+                    (Stability::Stable, r, mode)
+                }
+            };
         let freq_hz = mode.omega_rad_s / TAU;
         let onset_s = match stability {
             Stability::Unstable => {
@@ -318,15 +316,17 @@ fn growth_range(
     (end > start + 2).then_some(start..end)
 }
 
-/// Within `region`, the fall from the last time the envelope was at
-/// `ceiling` to the first time after it is under `floor`.
+/// Within `region`, the fall from the largest swing of the band-passed
+/// signal (where the oscillation was struck) to the first time after it
+/// that the envelope is under `floor`.
 fn decay_range(
     env: &[f64],
+    band: &[f64],
     region: Range<usize>,
     floor: f64,
-    ceiling: f64,
 ) -> Option<Range<usize>> {
-    let start = region.start + env[region.clone()].iter().rposition(|&e| e >= ceiling)?;
+    let swings: Vec<f64> = band[region.clone()].iter().map(|v| v.abs()).collect();
+    let start = region.start + argmax(&swings)?;
     let end = env[start..]
         .iter()
         .position(|&e| e < floor)

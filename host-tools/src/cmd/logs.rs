@@ -1,6 +1,7 @@
 //! What the commands that analyse many logs share: a progress bar over the
 //! files, going on past a log that cannot be read, and loss warnings.
 
+use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use indicatif::{ProgressBar, ProgressStyle};
@@ -53,4 +54,13 @@ pub fn warn_losses(run: &Run) {
     for line in run.summary.losses.describe() {
         eprintln!("wobblog: {}: warning: {line}", run.path.display());
     }
+}
+
+/// Writes `text` to standard output; a closed pipe (`| head`) is an error
+/// to report, not a panic as with `print!`.
+pub fn print_stdout(text: &str) -> Result<(), CliError> {
+    let mut out = std::io::stdout().lock();
+    out.write_all(text.as_bytes())
+        .and_then(|()| out.flush())
+        .map_err(|e| CliError::file(Path::new("<stdout>"), e))
 }

@@ -3,6 +3,7 @@
 use std::path::PathBuf;
 
 use crate::analysis::Run;
+use crate::cmd::logs::warn_losses;
 use crate::plot::timeplot::TimePlot;
 use crate::plot::{render, ImageKind};
 use crate::CliError;
@@ -34,7 +35,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         }
     }
     let run = Run::load(&args.log)?;
-    crate::cmd::logs::warn_losses(&run);
+    warn_losses(&run);
     let figure = TimePlot::new(&run, args.from, args.to)
         .ok_or_else(|| CliError::file(&args.log, "no frames in the requested time window"))?;
     render(&figure, &args.output)

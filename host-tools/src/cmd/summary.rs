@@ -6,6 +6,7 @@ use serde::Serialize;
 
 use crate::analysis::filter::contiguous_spans;
 use crate::analysis::{find_episodes, wobble_speed_mps, Run, Stability};
+use crate::cmd::logs::{for_each_log, print_stdout, warn_losses};
 use crate::CliError;
 
 /// Output formats of `wobblog summary`.
@@ -113,13 +114,13 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         return Err(CliError::file(&args.dir, "no *.WBL logs in this directory"));
     }
     let mut rows = Vec::new();
-    let result = crate::cmd::logs::for_each_log(&logs, "summarising", |log| {
+    let result = for_each_log(&logs, "summarising", |log| {
         let run = Run::load(log)?;
-        crate::cmd::logs::warn_losses(&run);
+        warn_losses(&run);
         rows.push(RunRow::of(&run));
         Ok(())
     });
-    print!("{}", render(&rows, args.format));
+    print_stdout(&render(&rows, args.format))?;
     result
 }
 

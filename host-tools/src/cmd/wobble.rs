@@ -1,11 +1,12 @@
 //! `wobblog wobble`: every wobble episode of one or more runs, the wobble
 //! speed of each, and optionally the seed paper's Figure 8 across them.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use serde::Serialize;
 
 use crate::analysis::{find_episodes, wobble_speed_mps, Episode, Run};
+use crate::cmd::logs::{for_each_log, print_stdout, warn_losses};
 use crate::plot::modes::ModePlot;
 use crate::plot::{render, ImageKind};
 use crate::CliError;
@@ -42,27 +43,39 @@ pub fn run(args: &Args) -> Result<(), CliError> {
     if let Some(plot) = &args.plot {
         ImageKind::of(plot)?;
     }
-    let mut figure_runs = Vec::new();
-    let result = crate::cmd::logs::for_each_log(&args.logs, "analysing", |log| {
+    let mut reports = Vec::new();
+    let mut names = Vec::new();
+    let result = for_each_log(&args.logs, "analysing", |log| {
         let run = Run::load(log)?;
-        crate::cmd::logs::warn_losses(&run);
+        warn_losses(&run);
         let episodes = find_episodes(&run);
-        let report = RunEpisodes {
+        reports.push(RunEpisodes {
             log: log.display().to_string(),
             wobble_speed_mps: wobble_speed_mps(&episodes),
             episodes,
-        };
-        if args.json {
-            let line = serde_json::to_string(&report).map_err(|e| CliError::file(log, e))?;
-            println!("{line}");
-        } else {
-            print!("{}", render_text(&report));
-        }
-        figure_runs.push((run.name(), report.episodes));
+        });
+        names.push(run.name());
         Ok(())
     });
+    let mut text = String::new();
+    for report in &reports {
+        if args.json {
+            let line = serde_json::to_string(report)
+                .map_err(|e| CliError::file(Path::new(&report.log), e))?;
+            text.push_str(&line);
+            text.push('\n');
+        } else {
+            text.push_str(&render_text(report));
+        }
+    }
+    print_stdout(&text)?;
     if let Some(plot) = &args.plot {
-        render(&ModePlot::new(figure_runs), plot)?;
+        let runs = names
+            .into_iter()
+            .zip(reports)
+            .map(|(name, r)| (name, r.episodes))
+            .collect();
+        render(&ModePlot::new(runs), plot)?;
     }
     result
 }

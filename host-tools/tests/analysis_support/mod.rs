@@ -6,6 +6,7 @@
 use std::f64::consts::TAU;
 use std::path::Path;
 
+use assert_cmd::Command;
 use wobble_core::format::header::header_records;
 use wobble_core::format::{
     quantise_i16, quantise_i32, quantise_u16, Alert, BlockEncoder, FixMode, Frame, GpsFix, LogInfo,
@@ -13,6 +14,33 @@ use wobble_core::format::{
     STEER_COUNTS_PER_DEG,
 };
 use wobblog::analysis::Run;
+
+/// The `wobblog` binary.
+#[must_use]
+pub fn wobblog() -> Command {
+    Command::cargo_bin("wobblog").unwrap()
+}
+
+/// Runs `cmd`, which must succeed, and returns its standard output.
+pub fn stdout_of(cmd: &mut Command) -> String {
+    let out = cmd.output().unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8(out.stdout).unwrap()
+}
+
+/// The recorded-signal corpus: `hil-tests/fixtures/corpus`, or the
+/// directory `CORPUS_DIR` names (e.g. a freshly generated one).
+#[must_use]
+pub fn corpus_dir() -> std::path::PathBuf {
+    std::env::var_os("CORPUS_DIR").map_or_else(
+        || Path::new(env!("CARGO_MANIFEST_DIR")).join("../hil-tests/fixtures/corpus"),
+        std::path::PathBuf::from,
+    )
+}
 
 /// Standard gravity, m/s².
 pub const G_MPS2: f64 = 9.806_65;
