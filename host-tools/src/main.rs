@@ -18,7 +18,7 @@ struct Cli {
 enum Command {
     /// Summarise a log: duration, samples, dropouts, lost blocks, GPS coverage, alerts.
     Info(cmd::info::Args),
-    /// Decode a log into one row per 100 Hz frame (CSV or JSON lines).
+    /// Decode a log into one row per 100 Hz frame (CSV, JSON lines or Parquet).
     Decode(cmd::decode::Args),
     /// Build a log from a CSV through the firmware's encoder (tests and demos).
     Encode(cmd::encode::Args),

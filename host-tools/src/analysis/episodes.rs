@@ -422,6 +422,37 @@ fn median(mut v: Vec<f64>) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use proptest::prelude::*;
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(32))]
+
+        /// Any steering signal, with gaps and repeated times, gives episodes
+        /// (or none) without panicking, each ordered and finite.
+        #[test]
+        fn any_signal_is_analysed(
+            steps in proptest::collection::vec((-300.0..300.0f64, 0u8..40), 0..3000),
+            tone_deg in 0.0..5.0f64,
+        ) {
+            let mut run = Run::default();
+            let mut t = 0.0;
+            for (i, &(noise, step)) in steps.iter().enumerate() {
+                // Mostly 10 ms, sometimes a gap or a repeat.
+                t += match step { 0 => 0.0, 1 => 0.37, _ => 0.01 };
+                let x = tone_deg * (TAU * 7.0 * t).sin() * (i as f64 / 300.0).sin()
+                    + if step == 2 { noise } else { 0.0 };
+                run.t_s.push(t);
+                run.steer_deg.push(x);
+                run.speed_mps.push(4.0);
+                run.gyro_dps.push([0.0; 3]);
+                run.accel_g.push([0.0; 3]);
+            }
+            for e in find_episodes(&run) {
+                prop_assert!(e.onset_s <= e.peak_s && e.peak_s <= e.end_s, "{e:?}");
+                prop_assert!(e.sigma_per_s.is_finite() && e.freq_hz > 0.0, "{e:?}");
+            }
+        }
+    }
 
     #[test]
     fn crossings_give_the_tone_frequency() {
