@@ -1,7 +1,7 @@
 //! Wobble episodes found offline in the steering angle, each measured the
-//! way the seed paper measures its eigenvalues: the envelope of the free
-//! oscillation fitted with an exponential, `A e^(sigma t)`, and the
-//! frequency of the oscillation under it.
+//! way the seed paper measures its eigenvalues: the free oscillation fitted
+//! as `A e^(sigma t) sin(2 pi f t + phi)`, giving the real part sigma and the
+//! imaginary part 2 pi f of the mode.
 //!
 //! 1. The steering angle is band-passed around the wobble band (zero phase)
 //!    and its envelope taken from the smoothed signal energy. An episode is
@@ -11,10 +11,14 @@
 //!    is then demodulated at that frequency (narrow, zero-phase) for a clean
 //!    envelope, and the background in that narrow band (sensor noise, wheel
 //!    ripple) is measured before the episode and removed in power.
-//! 3. If the envelope rises exponentially to the peak for long enough, the
-//!    wobble is **unstable** and sigma is the fitted growth rate; otherwise
-//!    the oscillation was struck (a kick, a pothole) and rings down, the mode
-//!    is **stable**, and sigma is the fitted (negative) decay rate.
+//! 3. If the envelope climbs to the peak for long enough, the samples of
+//!    that climb are fitted directly (not their envelope) with a growing
+//!    sinusoid, plus a steady tone for a wheel harmonic beside it (see
+//!    [`super::sinefit`]). If that explains the signal, the wobble is
+//!    **unstable** and sigma is the fitted growth rate. Otherwise the
+//!    oscillation was struck (a kick, a pothole) and rings down: the fall
+//!    from its largest swing is fitted the same way, the mode is **stable**,
+//!    and sigma is the (negative) decay rate.
 //! 4. An unstable episode's onset is where the fitted exponential is
 //!    [`ONSET_AMP_DEG`]: the wobble's start "from nothing", independent of
 //!    where the noise floor happens to be. A stable episode starts where it
@@ -39,8 +43,8 @@ pub const QUIET_AMP_DEG: f64 = 0.25;
 
 /// Smoothing of the signal energy for detection, Hz.
 const ENERGY_SMOOTHING_HZ: f64 = 2.0;
-/// Low-pass after demodulation, Hz: passes a growth of 4/s with a constant
-/// gain (corrected), rejects the wheel harmonics a few hertz off.
+/// Low-pass after demodulation, Hz: the envelope only bounds the fits, so it
+/// needs to follow a growth of 4/s and to reject what lies a few hertz off.
 const DEMOD_LOWPASS_HZ: f64 = 2.0;
 /// Background is measured over this long before an episode, s.
 const BACKGROUND_WINDOW_S: f64 = 8.0;
