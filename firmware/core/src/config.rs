@@ -143,14 +143,134 @@ impl Field for f32 {
         text.parse::<f32>().ok().filter(|v| v.is_finite())
     }
     fn write(self, out: &mut dyn fmt::Write) -> fmt::Result {
-        // Both formats print the shortest text that parses back to the same
-        // value, so the header lines round-trip exactly. `Display` never
-        // uses an exponent (1e-38 would take 40 digits): keep it for the
-        // everyday range only.
-        if self == 0.0 || (1e-4..1e7).contains(&self.abs()) {
-            write!(out, "{self}")
+        let mut text = [0u8; FLOAT_TEXT_LEN];
+        let len = shortest_text(self, &mut text);
+        out.write_str(core::str::from_utf8(text.get(..len).unwrap_or_default()).unwrap_or("0"))
+    }
+}
+
+/// Longest text [`shortest_text`] writes: sign, 9 digits, point, `e-45`.
+const FLOAT_TEXT_LEN: usize = 16;
+
+/// Writes the shortest decimal text (1 to 9 significant digits) that reads
+/// back as exactly `v`, so the header lines round-trip; plain below 10^7
+/// and from 10^-4, with an exponent outside. Returns the length.
+///
+/// The core's float formatting would do this too, but it links about
+/// 10 KiB of tables and code into the firmware for a few dozen lines
+/// written once per boot: this searches digit counts with the parser the
+/// firmware has anyway.
+fn shortest_text(v: f32, out: &mut [u8; FLOAT_TEXT_LEN]) -> usize {
+    if v == 0.0 || !v.is_finite() {
+        out[0] = b'0';
+        return 1;
+    }
+    let magnitude = f64::from(v.abs());
+    // Decimal exponent: 10^exp <= magnitude < 10^(exp + 1).
+    let mut exp: i32 = 0;
+    while pow10(exp + 1) <= magnitude {
+        exp += 1;
+    }
+    while pow10(exp) > magnitude {
+        exp -= 1;
+    }
+    for digits in 1..=9 {
+        // `magnitude` scaled to `digits` integer digits, rounded; an f64
+        // holds it with 15 digits to spare.
+        let mut mantissa = (magnitude * pow10(digits - 1 - exp) + 0.5) as u64;
+        let mut e = exp;
+        if mantissa >= 10u64.pow(digits as u32) {
+            mantissa /= 10;
+            e += 1;
+        }
+        let len = layout(v < 0.0, mantissa, digits as usize, e, out);
+        let text = core::str::from_utf8(out.get(..len).unwrap_or_default()).unwrap_or("");
+        if text.parse::<f32>() == Ok(v) {
+            return len;
+        }
+    }
+    // Unreachable: 9 significant digits identify every f32.
+    out[0] = b'0';
+    1
+}
+
+/// 10^`exp` (the exponents used stay within -55..=48).
+fn pow10(exp: i32) -> f64 {
+    let mut p = 1.0f64;
+    for _ in 0..exp.unsigned_abs() {
+        p *= 10.0;
+    }
+    if exp < 0 {
+        1.0 / p
+    } else {
+        p
+    }
+}
+
+/// Writes `mantissa` (`digits` digits) × 10^(`exp` − `digits` + 1) into
+/// `out`; returns the length.
+fn layout(negative: bool, mantissa: u64, digits: usize, exp: i32, out: &mut [u8]) -> usize {
+    let mut ascii = [b'0'; 9];
+    let mut m = mantissa;
+    for slot in ascii.iter_mut().take(digits).rev() {
+        *slot = b'0' + (m % 10) as u8;
+        m /= 10;
+    }
+    // Trailing zeros carry nothing.
+    let mut used = digits;
+    while used > 1 && ascii[used - 1] == b'0' {
+        used -= 1;
+    }
+    let significant = ascii.get(..used).unwrap_or_default();
+    let mut w = Writer { out, len: 0 };
+    if negative {
+        w.push(b'-');
+    }
+    if (-4..7).contains(&exp) {
+        let point = exp + 1; // digits before the decimal point
+        if point <= 0 {
+            w.push(b'0');
+            w.push(b'.');
+            (0..-point).for_each(|_| w.push(b'0'));
+            significant.iter().for_each(|&d| w.push(d));
         } else {
-            write!(out, "{self:e}")
+            let point = point as usize;
+            (0..point).for_each(|i| w.push(significant.get(i).copied().unwrap_or(b'0')));
+            if used > point {
+                w.push(b'.');
+                significant.get(point..).unwrap_or_default().iter().for_each(|&d| w.push(d));
+            }
+        }
+    } else {
+        w.push(significant[0]);
+        if used > 1 {
+            w.push(b'.');
+            significant.get(1..).unwrap_or_default().iter().for_each(|&d| w.push(d));
+        }
+        w.push(b'e');
+        if exp < 0 {
+            w.push(b'-');
+        }
+        let e = exp.unsigned_abs();
+        if e >= 10 {
+            w.push(b'0' + (e / 10) as u8);
+        }
+        w.push(b'0' + (e % 10) as u8);
+    }
+    w.len
+}
+
+/// Appends bytes to a slice, dropping what does not fit.
+struct Writer<'a> {
+    out: &'a mut [u8],
+    len: usize,
+}
+
+impl Writer<'_> {
+    fn push(&mut self, byte: u8) {
+        if let Some(slot) = self.out.get_mut(self.len) {
+            *slot = byte;
+            self.len += 1;
         }
     }
 }
@@ -805,6 +925,25 @@ steering.three_point=1:2,3
         assert!(text.contains(&three_point));
         let mut bounded = heapless::String::<MAX_TEXT_LEN>::new();
         assert!(c.write_lines(&mut bounded).is_ok());
+    }
+
+    #[test]
+    fn floats_are_written_short_and_plain_in_the_everyday_range() {
+        let text = |v: f32| {
+            let mut out = String::new();
+            Field::write(v, &mut out).expect("String grows");
+            out
+        };
+        assert_eq!(text(2.18), "2.18");
+        assert_eq!(text(-0.25), "-0.25");
+        assert_eq!(text(100.0), "100");
+        assert_eq!(text(0.0), "0");
+        assert_eq!(text(270.0 / 4096.0), "0.06591797");
+        assert_eq!(text(0.0001), "0.0001");
+        assert_eq!(text(1234567.0), "1234567");
+        assert_eq!(text(12345678.0), "1.2345678e7");
+        assert_eq!(text(-1.1754942e-38), "-1.1754942e-38");
+        assert_eq!(text(f32::MAX), "3.4028235e38");
     }
 
     #[test]

@@ -111,3 +111,27 @@ proptest! {
         }
     }
 }
+
+proptest! {
+    #[test]
+    fn every_finite_float_value_reads_back_exactly(bits in any::<u32>()) {
+        let v = f32::from_bits(bits);
+        prop_assume!(v.is_finite());
+        // The steering centre accepts any finite number.
+        let loaded = Config::parse(format!("steering.center_counts={v:?}\n").as_bytes());
+        prop_assert!(loaded.faults.is_empty(), "{:?}", loaded.faults);
+        prop_assert_eq!(loaded.config.steering.center_counts.to_bits(), v.to_bits());
+        let text = emitted(&loaded.config);
+        let line = text.lines().find(|l| l.starts_with("steering.center_counts=")).unwrap();
+        let written: f32 = line.split_once('=').unwrap().1.parse().unwrap();
+        prop_assert_eq!(written.to_bits(), v.to_bits(), "{}", line);
+        // As short as the standard library's shortest form, or shorter.
+        let digits = |t: &str| {
+            let mantissa = t.split('e').next().unwrap_or_default();
+            let all: String = mantissa.chars().filter(char::is_ascii_digit).collect();
+            all.trim_matches('0').len()
+        };
+        let ours = line.split_once('=').unwrap().1;
+        prop_assert!(digits(ours) <= digits(&format!("{v:e}")), "{} vs {:e}", ours, v);
+    }
+}

@@ -203,6 +203,55 @@ impl<E> Error<E> {
     }
 }
 
+/// One step of the configuration sequence.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Step {
+    /// Write a register.
+    Write(u8, u8),
+    /// Replace the `mask` bits of a register, keeping the others.
+    Modify(u8, u8, u8),
+    /// Wait.
+    WaitUs(u32),
+}
+
+/// The datasheet's configuration sequence after the identity check, with
+/// `gyro_config0` (range and rate) for GYRO_CONFIG0.
+const fn configuration(gyro_config0: u8) -> [Step; 18] {
+    use reg::*;
+    let [deltsqr_hi, deltsqr_lo] = AAF_42HZ_DELTSQR.to_be_bytes();
+    let shift_and_hi = (AAF_42HZ_BITSHIFT << 4) | deltsqr_hi;
+    [
+        Step::Write(DEVICE_CONFIG, SOFT_RESET),
+        Step::WaitUs(RESET_WAIT_US),
+        // Anti-alias filters, banks 1 (gyro) and 2 (accel); the sensors are
+        // off after the reset, as the filter registers require.
+        Step::Write(REG_BANK_SEL, 1),
+        Step::Write(GYRO_CONFIG_STATIC3, AAF_42HZ_DELT),
+        Step::Write(GYRO_CONFIG_STATIC4, deltsqr_lo),
+        Step::Write(GYRO_CONFIG_STATIC5, shift_and_hi),
+        Step::Write(REG_BANK_SEL, 2),
+        // ACCEL_AAF_DIS (bit 0) stays clear: the filter is on.
+        Step::Write(ACCEL_CONFIG_STATIC2, AAF_42HZ_DELT << 1),
+        Step::Write(ACCEL_CONFIG_STATIC3, deltsqr_lo),
+        Step::Write(ACCEL_CONFIG_STATIC4, shift_and_hi),
+        Step::Write(REG_BANK_SEL, 0),
+        Step::Write(GYRO_CONFIG0, gyro_config0),
+        Step::Write(
+            ACCEL_CONFIG0,
+            (ACCEL_FS_SEL_16G << FS_SEL_SHIFT) | ODR_100HZ,
+        ),
+        // The filter-order registers hold reserved bits: read-modify-write.
+        Step::Modify(GYRO_CONFIG1, GYRO_UI_FILT_ORD_MASK, UI_FILT_ORD_3RD << 2),
+        Step::Modify(ACCEL_CONFIG1, ACCEL_UI_FILT_ORD_MASK, UI_FILT_ORD_3RD << 3),
+        Step::Write(
+            GYRO_ACCEL_CONFIG0,
+            (UI_FILT_BW_DIV10 << 4) | UI_FILT_BW_DIV10,
+        ),
+        Step::Write(PWR_MGMT0, PWR_GYRO_ACCEL_LOW_NOISE),
+        Step::WaitUs(STARTUP_WAIT_US),
+    ]
+}
+
 /// Bytes of one accel + gyro burst.
 const DATA_LEN: usize = 12;
 
@@ -240,41 +289,16 @@ impl<SPI: SpiDevice> Icm42688<SPI> {
             0x00 | 0xFF => return Err(Error::NoResponse),
             other => return Err(Error::WrongId(other)),
         }
-        self.write(DEVICE_CONFIG, SOFT_RESET).await?;
-        delay.delay_us(RESET_WAIT_US).await;
-
-        // Anti-alias filters, banks 1 (gyro) and 2 (accel); the sensors are
-        // off after the reset, as the filter registers require.
-        let [deltsqr_hi, deltsqr_lo] = AAF_42HZ_DELTSQR.to_be_bytes();
-        let shift_and_hi = (AAF_42HZ_BITSHIFT << 4) | deltsqr_hi;
-        self.write(REG_BANK_SEL, 1).await?;
-        self.write(GYRO_CONFIG_STATIC3, AAF_42HZ_DELT).await?;
-        self.write(GYRO_CONFIG_STATIC4, deltsqr_lo).await?;
-        self.write(GYRO_CONFIG_STATIC5, shift_and_hi).await?;
-        self.write(REG_BANK_SEL, 2).await?;
-        // ACCEL_AAF_DIS (bit 0) stays clear: the filter is on.
-        self.write(ACCEL_CONFIG_STATIC2, AAF_42HZ_DELT << 1).await?;
-        self.write(ACCEL_CONFIG_STATIC3, deltsqr_lo).await?;
-        self.write(ACCEL_CONFIG_STATIC4, shift_and_hi).await?;
-        self.write(REG_BANK_SEL, 0).await?;
-
-        let gyro_fs = self.config.gyro_range.fs_sel() << FS_SEL_SHIFT;
-        let accel_fs = ACCEL_FS_SEL_16G << FS_SEL_SHIFT;
-        self.write(GYRO_CONFIG0, gyro_fs | ODR_100HZ).await?;
-        self.write(ACCEL_CONFIG0, accel_fs | ODR_100HZ).await?;
-        // The filter-order registers hold reserved bits: read-modify-write.
-        self.modify(GYRO_CONFIG1, GYRO_UI_FILT_ORD_MASK, UI_FILT_ORD_3RD << 2)
-            .await?;
-        self.modify(ACCEL_CONFIG1, ACCEL_UI_FILT_ORD_MASK, UI_FILT_ORD_3RD << 3)
-            .await?;
-        self.write(
-            GYRO_ACCEL_CONFIG0,
-            (UI_FILT_BW_DIV10 << 4) | UI_FILT_BW_DIV10,
-        )
-        .await?;
-
-        self.write(PWR_MGMT0, PWR_GYRO_ACCEL_LOW_NOISE).await?;
-        delay.delay_us(STARTUP_WAIT_US).await;
+        let gyro_config0 = (self.config.gyro_range.fs_sel() << FS_SEL_SHIFT) | ODR_100HZ;
+        // One loop over the table: a single await point per kind of step
+        // keeps the async state machine (and the flash) small.
+        for step in configuration(gyro_config0) {
+            match step {
+                Step::Write(register, value) => self.write(register, value).await?,
+                Step::Modify(register, mask, bits) => self.modify(register, mask, bits).await?,
+                Step::WaitUs(us) => delay.delay_us(us).await,
+            }
+        }
         Ok(())
     }
 
