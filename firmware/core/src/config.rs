@@ -238,14 +238,22 @@ fn layout(negative: bool, mantissa: u64, digits: usize, exp: i32, out: &mut [u8]
             (0..point).for_each(|i| w.push(significant.get(i).copied().unwrap_or(b'0')));
             if used > point {
                 w.push(b'.');
-                significant.get(point..).unwrap_or_default().iter().for_each(|&d| w.push(d));
+                significant
+                    .get(point..)
+                    .unwrap_or_default()
+                    .iter()
+                    .for_each(|&d| w.push(d));
             }
         }
     } else {
         w.push(significant[0]);
         if used > 1 {
             w.push(b'.');
-            significant.get(1..).unwrap_or_default().iter().for_each(|&d| w.push(d));
+            significant
+                .get(1..)
+                .unwrap_or_default()
+                .iter()
+                .for_each(|&d| w.push(d));
         }
         w.push(b'e');
         if exp < 0 {
@@ -378,10 +386,11 @@ struct Key {
     show: fn(&Config, &mut dyn fmt::Write) -> fmt::Result,
 }
 
+/// A key named for its field's path in [`Config`].
 macro_rules! key {
-    ($section:ident, $name:literal, $($field:ident).+) => {
+    ($section:ident: $($field:ident).+) => {
         Key {
-            name: $name,
+            name: stringify!($($field).+),
             section: Section::$section,
             apply: |config, text| match Field::parse(text) {
                 Some(value) => {
@@ -399,94 +408,50 @@ macro_rules! key {
 /// detector's sample rate (the firmware's frame rate), the ADC's range and
 /// the IMU's sensitivities (facts of the board, not choices of the rider).
 const KEYS: &[Key] = &[
-    key!(Wheel, "wheel.circumference_m", wheel.circumference_m),
-    key!(Wheel, "wheel.holes", wheel.holes),
-    key!(Wheel, "wheel.timeout_us", wheel.timeout_us),
-    key!(
-        Wheel,
-        "wheel.min_edge_interval_us",
-        wheel.min_edge_interval_us
-    ),
-    key!(Wheel, "wheel.glitch_fraction", wheel.glitch_fraction),
-    key!(Wheel, "wheel.window_edges", wheel.window_edges),
-    key!(Wheel, "wheel.max_window_us", wheel.max_window_us),
-    key!(Steering, "steering.center_counts", steering.center_counts),
-    key!(Steering, "steering.deg_per_count", steering.deg_per_count),
-    key!(Steering, "steering.three_point", steering.three_point),
-    key!(
-        Steering,
-        "steering.saturation_margin",
-        steering.saturation_margin
-    ),
-    key!(Imu, "imu.axis_map", imu.axis_map),
-    key!(Imu, "imu.stuck_samples", imu.stuck_samples),
-    key!(Detector, "detector.window_s", detector.window_s),
-    key!(Detector, "detector.hop_s", detector.hop_s),
-    key!(Detector, "detector.bin_lo_hz", detector.bin_lo_hz),
-    key!(Detector, "detector.bin_hi_hz", detector.bin_hi_hz),
-    key!(Detector, "detector.bin_spacing_hz", detector.bin_spacing_hz),
-    key!(Detector, "detector.band_lo_hz", detector.band_lo_hz),
-    key!(Detector, "detector.band_hi_hz", detector.band_hi_hz),
-    key!(Detector, "detector.highpass_hz", detector.highpass_hz),
-    key!(Detector, "detector.amp_on_deg", detector.amp_on_deg),
-    key!(Detector, "detector.amp_off_deg", detector.amp_off_deg),
-    key!(Detector, "detector.off_hold_s", detector.off_hold_s),
-    key!(Detector, "detector.lookback_s", detector.lookback_s),
-    key!(
-        Detector,
-        "detector.min_growth_ratio",
-        detector.min_growth_ratio
-    ),
-    key!(Detector, "detector.confirm_hops", detector.confirm_hops),
-    key!(Detector, "detector.impulse_fast_s", detector.impulse_fast_s),
-    key!(Detector, "detector.impulse_ref_s", detector.impulse_ref_s),
-    key!(Detector, "detector.impulse_ratio", detector.impulse_ratio),
-    key!(
-        Detector,
-        "detector.impulse_min_deg",
-        detector.impulse_min_deg
-    ),
-    key!(
-        Detector,
-        "detector.impulse_holdoff_s",
-        detector.impulse_holdoff_s
-    ),
-    key!(
-        Detector,
-        "detector.impulse_catchup",
-        detector.impulse_catchup
-    ),
-    key!(
-        Detector,
-        "detector.impulse_capture_s",
-        detector.impulse_capture_s
-    ),
-    key!(
-        Detector,
-        "detector.max_growth_ratio",
-        detector.max_growth_ratio
-    ),
-    key!(Detector, "detector.freq_window_s", detector.freq_window_s),
-    key!(Detector, "detector.min_speed_mps", detector.min_speed_mps),
-    key!(
-        Detector,
-        "detector.wheel_circumference_m",
-        detector.wheel_circumference_m
-    ),
-    key!(
-        Detector,
-        "detector.harmonic_tol_hz",
-        detector.harmonic_tol_hz
-    ),
-    key!(
-        Detector,
-        "detector.harmonic_growth_ratio",
-        detector.harmonic_growth_ratio
-    ),
-    key!(Alert, "alert.enabled", alert.enabled),
-    key!(Alert, "alert.beep_on_us", alert.pattern.beep_on_us),
-    key!(Alert, "alert.beep_off_us", alert.pattern.beep_off_us),
-    key!(Alert, "alert.min_active_us", alert.pattern.min_active_us),
+    key!(Wheel: wheel.circumference_m),
+    key!(Wheel: wheel.holes),
+    key!(Wheel: wheel.timeout_us),
+    key!(Wheel: wheel.min_edge_interval_us),
+    key!(Wheel: wheel.glitch_fraction),
+    key!(Wheel: wheel.window_edges),
+    key!(Wheel: wheel.max_window_us),
+    key!(Steering: steering.center_counts),
+    key!(Steering: steering.deg_per_count),
+    key!(Steering: steering.three_point),
+    key!(Steering: steering.saturation_margin),
+    key!(Imu: imu.axis_map),
+    key!(Imu: imu.stuck_samples),
+    key!(Detector: detector.window_s),
+    key!(Detector: detector.hop_s),
+    key!(Detector: detector.bin_lo_hz),
+    key!(Detector: detector.bin_hi_hz),
+    key!(Detector: detector.bin_spacing_hz),
+    key!(Detector: detector.band_lo_hz),
+    key!(Detector: detector.band_hi_hz),
+    key!(Detector: detector.highpass_hz),
+    key!(Detector: detector.amp_on_deg),
+    key!(Detector: detector.amp_off_deg),
+    key!(Detector: detector.off_hold_s),
+    key!(Detector: detector.lookback_s),
+    key!(Detector: detector.min_growth_ratio),
+    key!(Detector: detector.confirm_hops),
+    key!(Detector: detector.impulse_fast_s),
+    key!(Detector: detector.impulse_ref_s),
+    key!(Detector: detector.impulse_ratio),
+    key!(Detector: detector.impulse_min_deg),
+    key!(Detector: detector.impulse_holdoff_s),
+    key!(Detector: detector.impulse_catchup),
+    key!(Detector: detector.impulse_capture_s),
+    key!(Detector: detector.max_growth_ratio),
+    key!(Detector: detector.freq_window_s),
+    key!(Detector: detector.min_speed_mps),
+    key!(Detector: detector.wheel_circumference_m),
+    key!(Detector: detector.harmonic_tol_hz),
+    key!(Detector: detector.harmonic_growth_ratio),
+    key!(Alert: alert.enabled),
+    key!(Alert: alert.pattern.beep_on_us),
+    key!(Alert: alert.pattern.beep_off_us),
+    key!(Alert: alert.pattern.min_active_us),
 ];
 
 /// Number of `key=value` lines [`Config::write_lines`] produces.

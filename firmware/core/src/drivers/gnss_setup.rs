@@ -67,7 +67,9 @@ pub fn nmea(body: &str) -> Command {
 #[must_use]
 pub fn ubx(class: u8, id: u8, payload: &[u8]) -> Command {
     let mut out = Command::new();
-    let len = u16::try_from(payload.len()).unwrap_or(u16::MAX).to_le_bytes();
+    let len = u16::try_from(payload.len())
+        .unwrap_or(u16::MAX)
+        .to_le_bytes();
     let _ = out.extend_from_slice(&[0xB5, 0x62, class, id, len[0], len[1]]);
     let _ = out.extend_from_slice(payload);
     let (mut ck_a, mut ck_b) = (0u8, 0u8);

@@ -83,7 +83,8 @@ impl<S: SpiDevice, D: DelayNs> Card<S, D> {
             return Ok(());
         }
         self.card.mark_card_uninit();
-        self.card.spi(|s| (self.set_clock)(s, IDENTIFICATION_CLOCK_HZ));
+        self.card
+            .spi(|s| (self.set_clock)(s, IDENTIFICATION_CLOCK_HZ));
         // Reading the size identifies the card and proves it answers.
         let size = self.card.num_blocks();
         self.settle(size)?;

@@ -67,3 +67,76 @@ pub fn tail(answer: [u8; 4]) -> Spi {
         Transaction::transaction_end(),
     ]
 }
+
+/// CRC16 of a data block (SD spec 4.5: CCITT polynomial x^16 + x^12 + x^5 + 1).
+pub fn crc16(bytes: &[u8]) -> u16 {
+    let mut crc = 0u16;
+    for &byte in bytes {
+        crc ^= u16::from(byte) << 8;
+        for _ in 0..8 {
+            crc = if crc & 0x8000 != 0 {
+                (crc << 1) ^ 0x1021
+            } else {
+                crc << 1
+            };
+        }
+    }
+    crc
+}
+
+/// A data block answered after its start token, with its CRC16.
+pub fn data_block(data: &[u8]) -> Spi {
+    let mut out = byte(0xFF, 0xFE);
+    out.extend([
+        Transaction::transaction_start(),
+        Transaction::transfer_in_place(vec![0xFF; data.len()], data.to_vec()),
+        Transaction::transaction_end(),
+        Transaction::transaction_start(),
+        Transaction::transfer_in_place(vec![0xFF; 2], crc16(data).to_be_bytes().to_vec()),
+        Transaction::transaction_end(),
+    ]);
+    out
+}
+
+/// An SDHC card's identification: CMD0, CMD59, CMD8, ACMD41, CMD58.
+pub fn sdhc_identification() -> Spi {
+    [
+        send(0, 0),
+        byte(0xFF, R1_IDLE),
+        command(59, 1, R1_IDLE),
+        command(8, 0x1AA, R1_IDLE),
+        tail([0x00, 0x00, 0x01, 0xAA]),
+        command(55, 0, R1_IDLE),
+        command(41, 0x4000_0000, R1_READY),
+        command(58, 0, R1_READY),
+        tail([0xC0, 0xFF, 0x80, 0x00]),
+        byte(0xFF, NOTHING),
+    ]
+    .concat()
+}
+
+/// Response polls of one command before embedded-sdmmc times out: its
+/// 10 000 retries (about 100 ms at 10 µs each) plus the first poll.
+pub const POLLS_PER_COMMAND: usize = 10_001;
+/// Bytes of 0xFF embedded-sdmmc clocks out after a CMD0 timeout.
+pub const FLUSH_BYTES: usize = 255;
+
+/// `n` polls that read nothing.
+pub fn silence(n: usize) -> Spi {
+    std::iter::repeat_with(|| byte(0xFF, NOTHING))
+        .take(n)
+        .flatten()
+        .collect()
+}
+
+/// Acquisition of a card that never answers: `attempts` CMD0s, each polled
+/// to the timeout and flushed, then the final byte.
+pub fn silent_acquisition(attempts: usize) -> Spi {
+    let attempt = || [send(0, 0), silence(POLLS_PER_COMMAND + FLUSH_BYTES)].concat();
+    let mut out: Spi = std::iter::repeat_with(attempt)
+        .take(attempts)
+        .flatten()
+        .collect();
+    out.extend(silence(1));
+    out
+}
