@@ -22,6 +22,8 @@ enum Command {
     Decode(cmd::decode::Args),
     /// Build a log from a CSV through the firmware's encoder (tests and demos).
     Encode(cmd::encode::Args),
+    /// Replay a steering CSV through the on-board wobble detector; print each alert change.
+    Detect(cmd::detect::Args),
     /// Replay a raw NMEA capture through the firmware's GPS path; one JSON fix per line.
     Nmea(cmd::nmea::Args),
     /// Plot a run like the seed paper's Figure 6: steering, roll, yaw rate, speed.
@@ -40,6 +42,7 @@ fn main() -> ExitCode {
         Command::Info(args) => cmd::info::run(&args),
         Command::Decode(args) => cmd::decode::run(&args),
         Command::Encode(args) => cmd::encode::run(&args),
+        Command::Detect(args) => cmd::detect::run(&args),
         Command::Nmea(args) => cmd::nmea::run(&args),
         Command::Plot(args) => cmd::plot::run(&args),
         Command::Wobble(args) => cmd::wobble::run(&args),

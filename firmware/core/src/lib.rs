@@ -11,6 +11,7 @@ pub mod app;
 pub mod channels;
 pub mod config;
 pub mod decimate;
+pub mod detector;
 pub mod drivers;
 pub mod faults;
 pub mod format;

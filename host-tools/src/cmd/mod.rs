@@ -1,6 +1,7 @@
 //! One module per `wobblog` subcommand: its clap arguments and its `run`.
 
 pub mod decode;
+pub mod detect;
 pub mod encode;
 pub mod gpx;
 pub mod info;

@@ -1,0 +1,97 @@
+//! `detector-metrics`: runs the on-board detector over the corpus and writes
+//! the metrics table.
+//!
+//! ```text
+//! cargo run -p wobble-hil --release --bin detector-metrics            # writes METRICS.md
+//! cargo run -p wobble-hil --release --bin detector-metrics -- --stdout
+//! cargo run -p wobble-hil --release --bin detector-metrics -- --trace NAME  # per-hop estimates as CSV
+//! cargo run -p wobble-hil --release --bin detector-metrics -- --false  # each false alert and its cause
+//! ```
+//! The corpus is generated in memory from the same code as the committed
+//! fixtures (a test asserts they are identical).
+
+use std::process::ExitCode;
+
+use wobble_core::detector::DetectorConfig;
+use wobble_hil::{corpus, metrics};
+
+fn main() -> ExitCode {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let fixtures = corpus::generate();
+    if let Some(i) = args.iter().position(|a| a == "--trace") {
+        let Some(name) = args.get(i + 1) else {
+            eprintln!("detector-metrics: --trace needs a fixture name");
+            return ExitCode::from(2);
+        };
+        let Some(fx) = fixtures.iter().find(|f| &f.truth.name == name) else {
+            eprintln!("detector-metrics: no fixture {name}");
+            return ExitCode::from(2);
+        };
+        let rows = match fx.rows() {
+            Ok(r) => r,
+            Err(e) => {
+                eprintln!("detector-metrics: {name}: {e}");
+                return ExitCode::FAILURE;
+            }
+        };
+        println!("t_s,amp_deg,freq_hz,in_band,growth_ratio,holdoff,harmonic,alert");
+        let mut print = |t: f64, e: wobble_core::detector::Estimate, on: bool| {
+            println!(
+                "{t:.2},{:.3},{:.2},{},{:.3},{},{},{}",
+                e.amp_deg,
+                e.freq_hz,
+                u8::from(e.in_band),
+                e.growth_ratio,
+                u8::from(e.impulse_holdoff),
+                u8::from(e.at_wheel_harmonic),
+                u8::from(on)
+            );
+        };
+        return match metrics::replay(&rows, DetectorConfig::default(), true, Some(&mut print)) {
+            Ok(_) => ExitCode::SUCCESS,
+            Err(e) => {
+                eprintln!("detector-metrics: {e}");
+                ExitCode::FAILURE
+            }
+        };
+    }
+    let (report, no_speed) = match (
+        metrics::evaluate(&fixtures, DetectorConfig::default(), true),
+        metrics::evaluate(&fixtures, DetectorConfig::default(), false),
+    ) {
+        (Ok(a), Ok(b)) => (a, b),
+        (Err(e), _) | (_, Err(e)) => {
+            eprintln!("detector-metrics: {e}");
+            return ExitCode::FAILURE;
+        }
+    };
+    if args.iter().any(|a| a == "--false") {
+        // Every false alert with the nearest ground-truth event before it.
+        for (f, fx) in report.fixtures.iter().zip(&fixtures) {
+            for &t in &f.false_alerts {
+                let near = fx.truth.events.iter().rfind(|e| e.t_s <= t);
+                match near {
+                    Some(e) => println!(
+                        "{} {t:.2}: {} at {:.2} ({:.2} deg, {:.2} Hz, decay {:.1}/s, {:.1} m/s)",
+                        f.name, e.kind, e.t_s, e.amp_deg, e.freq_hz, e.decay_per_s, e.speed_mps
+                    ),
+                    None => println!("{} {t:.2}: no event before", f.name),
+                }
+            }
+        }
+        return ExitCode::SUCCESS;
+    }
+    let md = metrics::markdown(&report, &no_speed);
+    if args.iter().any(|a| a == "--stdout") {
+        print!("{md}");
+        return ExitCode::SUCCESS;
+    }
+    let path = corpus::corpus_dir().join("METRICS.md");
+    if let Err(e) = std::fs::write(&path, &md) {
+        eprintln!("detector-metrics: {}: {e}", path.display());
+        return ExitCode::FAILURE;
+    }
+    print!("{md}");
+    println!("wrote {}", path.display());
+    ExitCode::SUCCESS
+}

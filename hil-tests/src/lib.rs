@@ -1,0 +1,10 @@
+//! Host-side test support of the wobble logger: the recorded-signal corpus
+//! (signal models, the deterministic generator and its ground truth) and the
+//! detector metrics that score the on-board detector against it.
+//!
+//! The QEMU harness will live here too, as its own module.
+#![warn(missing_docs)]
+
+pub mod corpus;
+pub mod metrics;
+pub mod qemu;

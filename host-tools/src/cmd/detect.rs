@@ -1,0 +1,392 @@
+//! `wobblog detect`: replay a steering-angle CSV through the on-board wobble
+//! detector (the firmware's code and defaults) and print every alert change.
+
+use std::io::{self, Read, Write};
+use std::path::{Path, PathBuf};
+
+use wobble_core::detector::{AlertEvent, Detector, DetectorConfig};
+
+use crate::CliError;
+
+const AFTER_HELP: &str = "\
+Input: a CSV with a header naming at least `t_s` (seconds) and `steer_deg`
+(degrees), optionally `speed_mps` (m/s; empty cells mean unknown), sampled at
+100 Hz. Other columns are ignored, so `wobblog decode` output works as is.
+With the speed, the detector cancels the wheel-rotation harmonics as the
+firmware does; without it, it runs on the steering alone.
+
+A gap in t_s longer than 1.5 sample periods restarts the detector (an alert
+that was on is reported off at the last sample before the gap, and a note goes
+to stderr); samples closer than 7.5 ms are an error (not 100 Hz).
+
+Output with --json: one JSON object per line for each alert change,
+  {\"t_s\": 17.12, \"event\": \"alert_on\", \"freq_hz\": 6.4, \"amp_deg\": 0.8}
+  {\"t_s\": 18.9, \"event\": \"alert_off\"}
+and nothing else. Without --json: a table with one line per change (time in
+seconds, event, dominant frequency in Hz and zero-to-peak steering amplitude in
+degrees when the alert switches on), then one summary line.
+
+Exit codes: 0 ok (alerts or not), 1 unreadable or malformed input (the message
+names the file, the line and what is wrong), 2 usage error.";
+
+/// Arguments of `wobblog detect`.
+#[derive(clap::Args)]
+#[command(after_help = AFTER_HELP)]
+pub struct Args {
+    /// The CSV to replay (`t_s,steer_deg[,speed_mps]` at 100 Hz).
+    #[arg(long, value_name = "IN")]
+    pub csv: PathBuf,
+    /// One JSON object per line for each alert change, nothing else.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// One alert change of a replay.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Change {
+    /// Time of the sample that caused it, seconds (the CSV's `t_s`).
+    pub t_s: f64,
+    /// What changed.
+    pub event: AlertEvent,
+}
+
+/// What a replay saw besides the changes.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Replay {
+    /// Alert changes in time order.
+    pub changes: Vec<Change>,
+    /// Rows replayed.
+    pub samples: u64,
+    /// First and last `t_s`.
+    pub span_s: Option<(f64, f64)>,
+    /// Whether the CSV has a `speed_mps` column.
+    pub has_speed: bool,
+    /// Lines at which a time gap restarted the detector.
+    pub restarts: Vec<u64>,
+}
+
+/// Shortest sample spacing accepted, seconds (100 Hz with 25 % jitter).
+const MIN_DT_S: f64 = 0.0075;
+/// Longest sample spacing before the detector restarts, seconds.
+const MAX_DT_S: f64 = 0.015;
+
+/// Replays CSV text from `input` through a fresh detector with `cfg`.
+/// `path` only names the input in errors.
+///
+/// # Errors
+/// [`CliError::File`] naming `path`, the line and the problem.
+pub fn replay(path: &Path, input: impl Read, cfg: DetectorConfig) -> Result<Replay, CliError> {
+    let mut det = Detector::new(cfg).map_err(|e| CliError::Usage(format!("detector: {e}")))?;
+    let mut reader = csv::ReaderBuilder::new()
+        .has_headers(true)
+        .flexible(true)
+        .trim(csv::Trim::All)
+        .from_reader(input);
+    let at_line = |line: u64, msg: String| CliError::file(path, format!("line {line}: {msg}"));
+    let headers = reader.headers().map_err(|e| csv_error(path, &e))?.clone();
+    let column = |name: &str| headers.iter().position(|h| h == name);
+    let (Some(t_col), Some(steer_col)) = (column("t_s"), column("steer_deg")) else {
+        let missing: Vec<&str> = ["t_s", "steer_deg"]
+            .into_iter()
+            .filter(|c| column(c).is_none())
+            .collect();
+        return Err(at_line(
+            1,
+            format!("no `{}` column in the header", missing.join("` or `")),
+        ));
+    };
+    let speed_col = column("speed_mps");
+    let mut out = Replay {
+        has_speed: speed_col.is_some(),
+        ..Replay::default()
+    };
+    let mut record = csv::StringRecord::new();
+    let mut last: Option<(f64, u64)> = None;
+    loop {
+        match reader.read_record(&mut record) {
+            Ok(true) => {}
+            Ok(false) => break,
+            Err(e) => return Err(csv_error(path, &e)),
+        }
+        let line = record.position().map_or(0, csv::Position::line);
+        if record.iter().all(str::is_empty) {
+            continue;
+        }
+        let number = |col: usize, name: &str| -> Result<Option<f64>, CliError> {
+            match record.get(col) {
+                None | Some("") => Ok(None),
+                Some(text) => match text.parse::<f64>() {
+                    Ok(v) if v.is_finite() => Ok(Some(v)),
+                    _ => Err(at_line(line, format!("`{name}` is not a number: {text:?}"))),
+                },
+            }
+        };
+        let t_s = number(t_col, "t_s")?.ok_or_else(|| at_line(line, "`t_s` is empty".into()))?;
+        let steer = number(steer_col, "steer_deg")?
+            .ok_or_else(|| at_line(line, "`steer_deg` is empty".into()))?;
+        let speed = match speed_col {
+            Some(c) => number(c, "speed_mps")?,
+            None => None,
+        };
+        if let Some((t_prev, line_prev)) = last {
+            let dt = t_s - t_prev;
+            if dt <= 0.0 {
+                return Err(at_line(
+                    line,
+                    format!("t_s {t_s} does not come after {t_prev} (line {line_prev})"),
+                ));
+            }
+            if dt < MIN_DT_S {
+                return Err(at_line(
+                    line,
+                    format!("samples {dt:.4} s apart: the detector needs 100 Hz (0.01 s)"),
+                ));
+            }
+            if dt > MAX_DT_S {
+                if det.alert_active() {
+                    out.changes.push(Change {
+                        t_s: t_prev,
+                        event: AlertEvent::Off,
+                    });
+                }
+                det.reset();
+                out.restarts.push(line);
+            }
+        }
+        last = Some((t_s, line));
+        out.samples += 1;
+        out.span_s = Some((out.span_s.map_or(t_s, |s| s.0), t_s));
+        #[allow(clippy::cast_possible_truncation)] // degrees and m/s fit f32
+        if let Some(event) = det.push(steer as f32, speed.map(|v| v as f32)) {
+            out.changes.push(Change { t_s, event });
+        }
+    }
+    Ok(out)
+}
+
+fn csv_error(path: &Path, e: &csv::Error) -> CliError {
+    let line = e.position().map(csv::Position::line);
+    let what = match e.kind() {
+        csv::ErrorKind::Utf8 { .. } => "not UTF-8 text".to_owned(),
+        csv::ErrorKind::Io(io) => io.to_string(),
+        _ => e.to_string(),
+    };
+    match line {
+        Some(l) => CliError::file(path, format!("line {l}: {what}")),
+        None => CliError::file(path, what),
+    }
+}
+
+/// Rounds for printing (`decimals` places).
+fn round(x: f64, decimals: i32) -> f64 {
+    let k = 10f64.powi(decimals);
+    (x * k).round() / k
+}
+
+/// The JSON line of one change.
+#[must_use]
+pub fn json_line(c: &Change) -> String {
+    // serde_json prints finite f64s as valid JSON numbers; inputs are finite.
+    let num = |x: f64| serde_json::to_string(&x).unwrap_or_else(|_| "null".into());
+    match c.event {
+        AlertEvent::On { freq_hz, amp_deg } => format!(
+            "{{\"t_s\": {}, \"event\": \"alert_on\", \"freq_hz\": {}, \"amp_deg\": {}}}",
+            num(round(c.t_s, 3)),
+            num(round(f64::from(freq_hz), 2)),
+            num(round(f64::from(amp_deg), 2)),
+        ),
+        AlertEvent::Off => format!(
+            "{{\"t_s\": {}, \"event\": \"alert_off\"}}",
+            num(round(c.t_s, 3))
+        ),
+    }
+}
+
+/// The human-readable report.
+#[must_use]
+pub fn table(r: &Replay) -> String {
+    use std::fmt::Write as _;
+    let mut s = String::new();
+    if !r.changes.is_empty() {
+        let _ = writeln!(
+            s,
+            "{:>10}  {:<9}  {:>7}  {:>7}",
+            "t_s", "event", "freq_hz", "amp_deg"
+        );
+        for c in &r.changes {
+            match c.event {
+                AlertEvent::On { freq_hz, amp_deg } => {
+                    let _ = writeln!(
+                        s,
+                        "{:>10.2}  {:<9}  {:>7.2}  {:>7.2}",
+                        c.t_s, "alert_on", freq_hz, amp_deg
+                    );
+                }
+                AlertEvent::Off => {
+                    let _ = writeln!(s, "{:>10.2}  {:<9}", c.t_s, "alert_off");
+                }
+            }
+        }
+    }
+    let duration = r.span_s.map_or(0.0, |(a, b)| b - a);
+    let ons = r
+        .changes
+        .iter()
+        .filter(|c| matches!(c.event, AlertEvent::On { .. }))
+        .count();
+    let _ = write!(
+        s,
+        "{} over {duration:.2} s ({} samples, {})",
+        match ons {
+            0 => "no alerts".to_owned(),
+            1 => "1 alert".to_owned(),
+            n => format!("{n} alerts"),
+        },
+        r.samples,
+        if r.has_speed {
+            "with speed"
+        } else {
+            "steering only"
+        }
+    );
+    if !r.restarts.is_empty() {
+        let _ = write!(s, ", {} restarts at time gaps", r.restarts.len());
+    }
+    s.push('\n');
+    s
+}
+
+/// Runs `wobblog detect`.
+pub fn run(args: &Args) -> Result<(), CliError> {
+    let file = std::fs::File::open(&args.csv).map_err(|e| CliError::file(&args.csv, e))?;
+    let r = replay(
+        &args.csv,
+        io::BufReader::new(file),
+        DetectorConfig::default(),
+    )?;
+    for line in &r.restarts {
+        eprintln!(
+            "wobblog: {}: line {line}: time gap; detector restarted",
+            args.csv.display()
+        );
+    }
+    let text = if args.json {
+        let mut s = String::new();
+        for c in &r.changes {
+            s.push_str(&json_line(c));
+            s.push('\n');
+        }
+        s
+    } else {
+        table(&r)
+    };
+    let mut stdout = io::stdout().lock();
+    match stdout
+        .write_all(text.as_bytes())
+        .and_then(|()| stdout.flush())
+    {
+        Ok(()) => Ok(()),
+        // A closed pipe (`| head`) is not a failure of the replay.
+        Err(e) if e.kind() == io::ErrorKind::BrokenPipe => Ok(()),
+        Err(e) => Err(CliError::file(Path::new("<stdout>"), e)),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn run_text(text: &str) -> Result<Replay, CliError> {
+        replay(
+            Path::new("x.csv"),
+            text.as_bytes(),
+            DetectorConfig::default(),
+        )
+    }
+
+    fn message(e: CliError) -> String {
+        e.to_string()
+    }
+
+    #[test]
+    fn json_lines_match_the_documented_shape() {
+        let on = Change {
+            t_s: 17.12,
+            event: AlertEvent::On {
+                freq_hz: 6.4012,
+                amp_deg: 0.8049,
+            },
+        };
+        assert_eq!(
+            json_line(&on),
+            r#"{"t_s": 17.12, "event": "alert_on", "freq_hz": 6.4, "amp_deg": 0.8}"#
+        );
+        let off = Change {
+            t_s: 18.9,
+            event: AlertEvent::Off,
+        };
+        assert_eq!(json_line(&off), r#"{"t_s": 18.9, "event": "alert_off"}"#);
+    }
+
+    #[test]
+    fn header_problems_name_line_one() {
+        let m = message(run_text("time,steer\n0,1\n").unwrap_err());
+        assert!(
+            m.contains("x.csv") && m.contains("line 1") && m.contains("t_s"),
+            "{m}"
+        );
+    }
+
+    #[test]
+    fn bad_values_name_their_line() {
+        let m = message(run_text("t_s,steer_deg\n0.00,1\n0.01,abc\n").unwrap_err());
+        assert!(
+            m.contains("line 3") && m.contains("steer_deg") && m.contains("abc"),
+            "{m}"
+        );
+        let m = message(run_text("t_s,steer_deg\n0.00,1\n0.01,NaN\n").unwrap_err());
+        assert!(m.contains("line 3"), "{m}");
+        let m = message(run_text("t_s,steer_deg\n0.01,1\n0.01,1\n").unwrap_err());
+        assert!(m.contains("line 3") && m.contains("after"), "{m}");
+        let m = message(run_text("t_s,steer_deg\n0.000,1\n0.001,1\n").unwrap_err());
+        assert!(m.contains("100 Hz"), "{m}");
+        let m = message(run_text("t_s,steer_deg,speed_mps\n0.00,1,x\n").unwrap_err());
+        assert!(m.contains("line 2") && m.contains("speed_mps"), "{m}");
+    }
+
+    #[test]
+    fn empty_speed_cells_are_unknown_and_extra_columns_ignored() {
+        let r = run_text("ax_g,t_s,steer_deg,speed_mps,gps_fix\n0,0.00,1,,none\n0,0.01,1,4.0,3d\n")
+            .unwrap();
+        assert_eq!(r.samples, 2);
+        assert!(r.has_speed);
+    }
+
+    #[test]
+    fn header_only_is_no_alerts() {
+        let r = run_text("t_s,steer_deg\n").unwrap();
+        assert_eq!(r.samples, 0);
+        assert!(table(&r).starts_with("no alerts over 0.00 s (0 samples"));
+    }
+
+    #[test]
+    fn a_gap_restarts_and_closes_an_open_alert() {
+        let mut text = String::from("t_s,steer_deg\n");
+        for i in 0..600 {
+            let t = f64::from(i) / 100.0;
+            let env = (0.02 * (2.0 * t).exp()).min(3.0);
+            text.push_str(&format!(
+                "{t:.2},{:.3}\n",
+                env * (std::f64::consts::TAU * 6.5 * t).sin()
+            ));
+        }
+        text.push_str("20.00,0\n");
+        let r = run_text(&text).unwrap();
+        assert_eq!(r.restarts, vec![602]);
+        assert!(matches!(r.changes[0].event, AlertEvent::On { .. }));
+        assert_eq!(
+            r.changes.last().map(|c| (c.t_s, c.event)),
+            Some((5.99, AlertEvent::Off))
+        );
+    }
+}
