@@ -13,6 +13,17 @@ step "toolchain components and the $TARGET target"
 rustup component add rustfmt clippy >/dev/null 2>&1 || true
 rustup target list --installed | grep -qx "$TARGET" || rustup target add "$TARGET"
 
+step "QEMU and dosfstools for the emulator tests (apt-get only when missing)"
+missing=()
+command -v qemu-system-arm >/dev/null || missing+=(qemu-system-arm)
+{ command -v mkfs.fat && command -v fsck.fat; } >/dev/null || missing+=(dosfstools)
+if ((${#missing[@]})); then
+    SUDO=""
+    [ "$(id -u)" -eq 0 ] || SUDO=sudo
+    $SUDO apt-get update
+    DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y "${missing[@]}"
+fi
+
 step "cargo fmt --check"
 cargo fmt --all -- --check
 
@@ -29,6 +40,10 @@ cargo build -p wobble-stm32f405 --target "$TARGET" --release
 cargo clippy -p wobble-stm32f405 --target "$TARGET" -- -D warnings
 # Fails when flash > 128 KiB or static RAM > 64 KiB (firmware/docs/board.md).
 cargo run -q -p wobble-size-budget -- "${CARGO_TARGET_DIR:-target}/$TARGET/release/wobble-stm32f405"
+
+step "QEMU image (netduinoplus2): clippy and release build, run by the tests"
+cargo clippy -p wobble-qemu-image --target "$TARGET" -- -D warnings
+cargo build -p wobble-qemu-image --target "$TARGET" --release
 
 step "tests"
 cargo test

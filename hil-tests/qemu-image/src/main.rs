@@ -25,7 +25,10 @@ use wobble_core::app::{gps, sampler, writer};
 use wobble_core::channels::{RecordQueue, SharedStatus};
 use wobble_core::detector::{Detector, DetectorConfig, PatternConfig};
 use wobble_core::gps::{GpsConfig, GpsReceiver};
-use wobble_core::logger::{CardLogger, FixedTime, HeaderSpec, LoggerConfig};
+use wobble_core::logger::{
+    CardLogger, FixedTime, HeaderSpec, LoggerConfig, FAULT_CARD_ABSENT, FAULT_CARD_FULL,
+    FAULT_CARD_WRITE,
+};
 use wobble_core::wheel::{WheelConfig, WheelSpeed};
 
 use crate::card::SemihostingCard;
@@ -93,6 +96,8 @@ async fn sampler_task(ride: &'static RefCell<Ride>, frames: u32) {
         alert: QuietAlert,
         status_led: StatusLine(None),
     };
+    // Frame k (from 1) is due at this time + k x 10 ms.
+    report::line(format_args!("START t_us={}", Instant::now().as_micros()));
     sampler::run(
         &mut s,
         &mut ports,
@@ -127,14 +132,16 @@ async fn writer_task(scenario: &'static Scenario) {
     let st = logger.stats();
     report::line(format_args!(
         "END frames={} t_us={} max_late_us={} queue_high_water={} queue_frames_dropped={} \
-         card_frames_lost={} card_faults={:?} files={} closed={}",
+         card_frames_lost={} card_absent={} card_write_failed={} card_full={} files={} closed={}",
         FRAMES_SAMPLED.load(Ordering::Relaxed),
         Instant::now().as_micros(),
         MAX_LATE_US.load(Ordering::Relaxed),
         QUEUE.high_water(),
         QUEUE.frames_dropped_pending(),
         st.frames_lost,
-        st.faults,
+        st.faults[usize::from(FAULT_CARD_ABSENT - 1)],
+        st.faults[usize::from(FAULT_CARD_WRITE - 1)],
+        st.faults[usize::from(FAULT_CARD_FULL - 1)],
         st.files_opened,
         closed.is_ok(),
     ));

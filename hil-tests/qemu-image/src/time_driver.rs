@@ -38,7 +38,8 @@ embassy_time_driver::time_driver_impl!(static DRIVER: SysTickDriver = SysTickDri
     next_alarm_us: Mutex::new(Cell::new(u64::MAX)),
 });
 
-/// Starts SysTick at 1 kHz with the given NVIC priority.
+/// Starts SysTick at 1 kHz with the given NVIC priority; takes `SYST` so
+/// nothing else can reprogram it.
 pub fn init(mut syst: SYST, scb: &mut SCB, priority: u8) {
     syst.set_clock_source(SystClkSource::Core);
     syst.set_reload(CYCLES_PER_MS - 1);
@@ -48,8 +49,6 @@ pub fn init(mut syst: SYST, scb: &mut SCB, priority: u8) {
     unsafe { scb.set_priority(cortex_m::peripheral::scb::SystemHandler::SysTick, priority) };
     syst.enable_interrupt();
     syst.enable_counter();
-    // SYST is owned by this driver from now on.
-    core::mem::forget(syst);
 }
 
 impl Driver for SysTickDriver {

@@ -60,23 +60,30 @@ impl Bundle {
     }
 }
 
-/// Lines `fsck.fat -n` prints about a file that was being written when the
-/// power went: its directory entry holds the size of the last flush while
-/// its cluster chain already reaches further, and the free-cluster count in
-/// the FS info sector is behind. Anything else is corruption.
-pub const UNCLOSED_FILE_FSCK: [&str; 4] = [
+/// What `fsck.fat -n` may report after a power cut while the log file was
+/// open, all of it space accounting, none of it data written before the
+/// last flush:
+/// - the file's directory entry holds the size of the last flush while its
+///   cluster chain already reaches further (fsck would truncate the chain);
+/// - the free-cluster count in the FS info sector is behind;
+/// - a cluster allocation was cut between its writes: the second FAT copy
+///   lags the first, or a new cluster is marked used but not yet linked
+///   from the directory entry (fsck would reclaim it).
+pub const UNCLOSED_FILE_FSCK: [&str; 8] = [
     "/RUN",
     "File size is ",
     "Truncating file to ",
     "Free cluster summary wrong",
+    "Auto-correcting.",
+    "FATs differ but appear to be intact.",
+    "Using first FAT.",
+    "Reclaimed ",
 ];
 
 /// Whether an `fsck.fat` complaint is one of [`UNCLOSED_FILE_FSCK`].
 #[must_use]
 pub fn is_unclosed_file_state(problem: &str) -> bool {
-    UNCLOSED_FILE_FSCK
-        .iter()
-        .any(|p| problem.starts_with(p) || problem.contains(", cluster chain length is "))
+    UNCLOSED_FILE_FSCK.iter().any(|p| problem.starts_with(p))
 }
 
 /// A fresh working directory for run `name` under `base`.

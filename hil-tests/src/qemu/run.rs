@@ -142,6 +142,15 @@ impl Outcome {
         self.fields(kind)?.get(key)?.parse().ok()
     }
 
+    /// Index (from 0) of the frame stamped `t_us`: frame k is due at the
+    /// sampler's `START` time + (k + 1) x 10 ms.
+    #[must_use]
+    pub fn frame_index(&self, t_us: u64) -> u64 {
+        let start_us = self.number("START", "t_us").unwrap_or(0);
+        ((t_us.saturating_sub(start_us) + fixture::FRAME_US / 2) / fixture::FRAME_US)
+            .saturating_sub(1)
+    }
+
     /// Alert switchings the image reported as they happened: (on, t_us).
     #[must_use]
     pub fn alerts(&self) -> Vec<(bool, u64)> {

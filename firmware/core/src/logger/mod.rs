@@ -181,6 +181,9 @@ pub struct CardLogger<'a, D: BlockDevice, T: TimeSource> {
     next_flush_us: u64,
     /// Blocks the directory entry's file size covers (as of the last flush).
     size_blocks: u32,
+    /// Frames in the blocks written so far, whether or not the file size
+    /// covers them yet.
+    frames_written: u32,
     /// Fault counts not yet on a card, by code.
     faults_unreported: [u16; FAULT_CARD_CODES],
     stats: LoggerStats,
@@ -214,6 +217,7 @@ impl<'a, D: BlockDevice, T: TimeSource> CardLogger<'a, D, T> {
             next_try_us: 0,
             next_flush_us: 0,
             size_blocks: 0,
+            frames_written: 0,
             faults_unreported: [0; FAULT_CARD_CODES],
             stats: LoggerStats::default(),
         }
@@ -315,6 +319,7 @@ impl<'a, D: BlockDevice, T: TimeSource> CardLogger<'a, D, T> {
                 if seq < self.size_blocks {
                     self.stats.frames_on_card = frames_before;
                 }
+                self.frames_written = frames_before;
             }
             Some(Err(e)) => self.fail(fault_code(&e), now_us),
             None => {}
@@ -338,6 +343,7 @@ impl<'a, D: BlockDevice, T: TimeSource> CardLogger<'a, D, T> {
                 self.stats.flushes = self.stats.flushes.saturating_add(1);
                 self.size_blocks = size_blocks;
                 self.stats.frames_on_card = self.encoder.frames_total();
+                self.frames_written = self.encoder.frames_total();
                 // Whatever was pending is now in this file, on the card.
                 self.faults_unreported = [0; FAULT_CARD_CODES];
                 self.stats.frames_lost_unreported = 0;
@@ -349,16 +355,18 @@ impl<'a, D: BlockDevice, T: TimeSource> CardLogger<'a, D, T> {
     /// The card failed: count what did not reach it, let go of the file.
     fn fail(&mut self, code: u8, now_us: u64) {
         self.count_fault(code);
-        let lost = self
-            .encoder
-            .frames_total()
-            .wrapping_sub(self.stats.frames_on_card);
-        self.count_lost(lost);
+        let mut visible = self.stats.frames_on_card;
         if let Some(f) = self.open.take() {
+            // A card that still answers (a full one) takes the final size
+            // of the file, which then shows every block written so far.
             // The handles are released even when the card does not answer.
-            let _ = self.fs.close_file(f.file);
+            if self.fs.close_file(f.file).is_ok() {
+                visible = self.frames_written;
+            }
             self.release(f.dir, f.volume);
         }
+        self.count_lost(self.encoder.frames_total().wrapping_sub(visible));
+        self.frames_written = 0;
         self.encoder = BlockEncoder::new();
         self.stats.frames_on_card = 0;
         self.size_blocks = 0;
