@@ -67,13 +67,14 @@ static EXECUTOR_THREAD: StaticCell<Executor> = StaticCell::new();
 /// The configuration in force as text, and its lines for the log header.
 static CONFIG_TEXT: StaticCell<heapless::String<MAX_TEXT_LEN>> = StaticCell::new();
 static CONFIG_LINES: StaticCell<heapless::Vec<&'static str, KEY_COUNT>> = StaticCell::new();
-/// Room for `CONFIG.TXT` while it is read at boot.
-static CONFIG_FILE: StaticCell<[u8; 4096]> = StaticCell::new();
 static ADC_RING: StaticCell<[u16; DMA_SAMPLES]> = StaticCell::new();
 static GPS_RING: StaticCell<[u8; adapters::gps::RING_BYTES]> = StaticCell::new();
 
 const FIRMWARE: &str = concat!(env!("CARGO_PKG_NAME"), " ", env!("CARGO_PKG_VERSION"));
-const FRAME_RATE_HZ: u16 = 100;
+/// 100 Hz, from the sampler's period.
+const FRAME_RATE_HZ: u16 = (1_000_000 / sampler::FRAME_PERIOD_US) as u16;
+/// Room for `CONFIG.TXT` (on the stack, at boot only): about 100 lines.
+const CONFIG_FILE_BYTES: usize = 4096;
 
 type Ports =
     SamplerPorts<ImuAdapter, SteeringAdapter, WheelAdapter, MarkerButton, AlertPins, StatusLight>;
@@ -139,7 +140,8 @@ fn card_and_config(pins: pins::CardPins) -> (SdCard, Loaded) {
     );
     let cs = Output::new(pins.cs, Level::High, Speed::VeryHigh);
     let volumes = VolumeManager::new(adapters::card::card(bus, cs), FixedTime::EPOCH);
-    let (loaded, source) = config::load(&volumes, CONFIG_FILE.init([0; 4096]));
+    let mut file = [0u8; CONFIG_FILE_BYTES];
+    let (loaded, source) = config::load(&volumes, &mut file);
     defmt::info!("config: {}, {} faults", source, loaded.faults.first().len());
     for fault in loaded.faults.first() {
         defmt::warn!("CONFIG.TXT line {}: fault {}", fault.line, fault.code);
