@@ -109,7 +109,7 @@ impl History {
 
 /// The wobble detector. Feed it every steering sample with [`Detector::push`].
 ///
-/// Memory: about 1.3 KiB, all inline (no allocation). Cost per sample: see
+/// Memory: about 1.9 KiB, all inline (no allocation). Cost per sample: see
 /// [`DetectorConfig::cost`]; the state machine never loops over anything
 /// longer than [`MAX_WINDOW`] x [`MAX_BINS`].
 #[derive(Clone, Debug)]
