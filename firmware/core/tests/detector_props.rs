@@ -41,7 +41,7 @@ proptest! {
     /// 0.05 Hz in frequency, whatever its phase and steering offset.
     #[test]
     fn estimates_a_steady_sinusoid(
-        f in 6.0f32..9.0, amp in 0.2f32..10.0, phase in 0.0f32..6.28, offset in -20.0f32..20.0,
+        f in 6.0f32..9.0, amp in 0.2f32..10.0, phase in 0.0f32..TAU, offset in -20.0f32..20.0,
     ) {
         let mut d = detector();
         for i in 0..300 {
@@ -58,7 +58,7 @@ proptest! {
     /// reaching 0.5 degrees, with the frequency within 0.25 Hz, exactly once.
     #[test]
     fn alerts_on_growing_oscillation(
-        f in 6.0f32..9.0, growth in 0.5f32..4.0, phase in 0.0f32..6.28, speed in 3.0f32..9.0,
+        f in 6.0f32..9.0, growth in 0.5f32..4.0, phase in 0.0f32..TAU, speed in 3.0f32..9.0,
     ) {
         let onset = 5.0;
         let env = move |t: f32| (0.02 * (growth * (t - onset)).exp()).min(3.0);

@@ -39,8 +39,10 @@ pub fn cos(x: f64) -> f64 {
     if !x.is_finite() {
         return f64::NAN;
     }
-    // Reduce to [0, pi]: cos is even and 2*pi periodic.
-    let mut r = x % TAU;
+    // Reduce to [0, pi]: cos is even and 2*pi periodic. Truncating the
+    // quotient instead of `%` keeps `fmod` (3 KiB of soft-float code) out of
+    // the firmware; the arguments here are a few turns at most.
+    let mut r = x - TAU * ((x / TAU) as i64) as f64;
     if r < 0.0 {
         r = -r;
     }
