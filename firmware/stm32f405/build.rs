@@ -10,4 +10,5 @@ fn main() {
     println!("cargo:rerun-if-changed={}", root.join("memory.x").display());
     println!("cargo:rustc-link-arg-bins=-Tlink.x");
     println!("cargo:rustc-link-arg-bins=-Tdefmt.x");
+    println!("cargo:rustc-link-arg-bins=--icf=all");
 }

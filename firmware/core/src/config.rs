@@ -135,14 +135,14 @@ const SECTIONS: [SectionRules; 5] = [
 /// A value type a key can hold: how it is read from and written to text.
 trait Field: Copy {
     fn parse(text: &str) -> Option<Self>;
-    fn write(self, out: &mut dyn fmt::Write) -> fmt::Result;
+    fn write(self, out: &mut dyn TextOut) -> fmt::Result;
 }
 
 impl Field for f32 {
     fn parse(text: &str) -> Option<Self> {
         text.parse::<f32>().ok().filter(|v| v.is_finite())
     }
-    fn write(self, out: &mut dyn fmt::Write) -> fmt::Result {
+    fn write(self, out: &mut dyn TextOut) -> fmt::Result {
         let mut text = [0u8; FLOAT_TEXT_LEN];
         let len = shortest_text(self, &mut text);
         out.write_str(core::str::from_utf8(text.get(..len).unwrap_or_default()).unwrap_or("0"))
@@ -268,6 +268,31 @@ fn layout(negative: bool, mantissa: u64, digits: usize, exp: i32, out: &mut [u8]
     w.len
 }
 
+/// Where config text goes: `fmt::Write` without `write_fmt`. A `dyn
+/// fmt::Write` vtable links all of `core::fmt` into the firmware; this one
+/// holds only the two methods the writers use.
+pub trait TextOut {
+    /// Appends a string.
+    ///
+    /// # Errors
+    /// When the output is full.
+    fn write_str(&mut self, s: &str) -> fmt::Result;
+    /// Appends a character.
+    ///
+    /// # Errors
+    /// When the output is full.
+    fn write_char(&mut self, c: char) -> fmt::Result;
+}
+
+impl<W: fmt::Write> TextOut for W {
+    fn write_str(&mut self, s: &str) -> fmt::Result {
+        fmt::Write::write_str(self, s)
+    }
+    fn write_char(&mut self, c: char) -> fmt::Result {
+        fmt::Write::write_char(self, c)
+    }
+}
+
 /// Appends bytes to a slice, dropping what does not fit.
 struct Writer<'a> {
     out: &'a mut [u8],
@@ -289,13 +314,29 @@ macro_rules! unsigned_field {
             fn parse(text: &str) -> Option<Self> {
                 text.parse().ok()
             }
-            fn write(self, out: &mut dyn fmt::Write) -> fmt::Result {
-                write!(out, "{self}")
+            fn write(self, out: &mut dyn TextOut) -> fmt::Result {
+                write_unsigned(out, u32::from(self))
             }
         }
     )+};
 }
 unsigned_field!(u8, u16, u32);
+
+/// Decimal digits of `value`. Written out rather than with `write!`, which
+/// would link `core::fmt`'s integer formatting into the firmware.
+fn write_unsigned(out: &mut dyn TextOut, mut value: u32) -> fmt::Result {
+    let mut ascii = [0u8; 10];
+    let mut start = ascii.len();
+    loop {
+        start -= 1;
+        ascii[start] = b'0' + (value % 10) as u8;
+        value /= 10;
+        if value == 0 {
+            break;
+        }
+    }
+    ascii[start..].iter().try_for_each(|&d| out.write_char(char::from(d)))
+}
 
 /// Mounting axes as text: `+x`, `-y`, ...
 const AXIS_NAMES: [(&str, SignedAxis); 6] = [
@@ -321,7 +362,7 @@ impl Field for AxisMap {
         let map = [parts.next()??, parts.next()??, parts.next()??];
         parts.next().is_none().then_some(Self(map))
     }
-    fn write(self, out: &mut dyn fmt::Write) -> fmt::Result {
+    fn write(self, out: &mut dyn TextOut) -> fmt::Result {
         for (i, axis) in self.0.iter().enumerate() {
             let name = AXIS_NAMES
                 .iter()
@@ -350,7 +391,7 @@ impl Field for Option<[CalPoint; 3]> {
         let three = [points.next()??, points.next()??, points.next()??];
         points.next().is_none().then_some(Some(three))
     }
-    fn write(self, out: &mut dyn fmt::Write) -> fmt::Result {
+    fn write(self, out: &mut dyn TextOut) -> fmt::Result {
         let Some(points) = self else {
             return out.write_str("none");
         };
@@ -372,7 +413,7 @@ impl Field for bool {
             _ => None,
         }
     }
-    fn write(self, out: &mut dyn fmt::Write) -> fmt::Result {
+    fn write(self, out: &mut dyn TextOut) -> fmt::Result {
         out.write_str(if self { "true" } else { "false" })
     }
 }
@@ -383,7 +424,7 @@ struct Key {
     section: Section,
     /// Parses `text` into the field; `false` when it does not parse.
     apply: fn(&mut Config, &str) -> bool,
-    show: fn(&Config, &mut dyn fmt::Write) -> fmt::Result,
+    show: fn(&Config, &mut dyn TextOut) -> fmt::Result,
 }
 
 /// A key named for its field's path in [`Config`].
@@ -530,7 +571,8 @@ impl Config {
     /// When `out` fails (is full).
     pub fn write_lines(&self, out: &mut impl fmt::Write) -> fmt::Result {
         for key in KEYS {
-            write!(out, "{}=", key.name)?;
+            out.write_str(key.name)?;
+            out.write_char('=')?;
             (key.show)(self, out)?;
             out.write_char('\n')?;
         }
