@@ -4,7 +4,8 @@
 use std::collections::VecDeque;
 
 use wobble_core::format::{
-    FixMode, Frame, FrameStatus, GpsFix, Record, ACCEL_COUNTS_PER_G, GYRO_COUNTS_PER_DPS, STEER_COUNTS_PER_DEG,
+    FixMode, Frame, FrameStatus, GpsFix, Record, ACCEL_COUNTS_PER_G, GYRO_COUNTS_PER_DPS,
+    STEER_COUNTS_PER_DEG,
 };
 
 /// A GPS fix older than this no longer fills a row's GPS columns.

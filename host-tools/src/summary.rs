@@ -156,7 +156,9 @@ impl SummaryBuilder {
             .finish(&mut |row: &Row| *with_gps += u64::from(row.gps.is_some()));
         let mut s = self.summary;
         let period_us = 1_000_000 / u64::from(s.sample_rate_hz.unwrap_or(100).max(1));
-        s.duration_s = self.span_us.map_or(0.0, |(first, last)| (last.saturating_sub(first) + period_us) as f64 / 1e6);
+        s.duration_s = self.span_us.map_or(0.0, |(first, last)| {
+            (last.saturating_sub(first) + period_us) as f64 / 1e6
+        });
         s.gps_coverage_pct = if s.samples == 0 {
             0.0
         } else {

@@ -9,7 +9,8 @@ fn wobblog() -> Command {
 
 /// A 30 s log of a steady ride with GPS, from CSV through `wobblog encode`.
 fn sample_log(dir: &Path) -> PathBuf {
-    let mut csv = String::from("t_s,steer_deg,speed_mps,gps_lat_deg,gps_lon_deg,gps_speed_mps,gps_fix\n");
+    let mut csv =
+        String::from("t_s,steer_deg,speed_mps,gps_lat_deg,gps_lon_deg,gps_speed_mps,gps_fix\n");
     for i in 0..3000 {
         let t = f64::from(i) / 100.0;
         let steer = (t * 6.4 * std::f64::consts::TAU).sin();
@@ -18,13 +19,28 @@ fn sample_log(dir: &Path) -> PathBuf {
     let csv_path = dir.join("in.csv");
     std::fs::write(&csv_path, csv).unwrap();
     let log = dir.join("run.wbl");
-    wobblog().args(["encode", "--csv"]).arg(&csv_path).arg("-o").arg(&log).assert().success();
+    wobblog()
+        .args(["encode", "--csv"])
+        .arg(&csv_path)
+        .arg("-o")
+        .arg(&log)
+        .assert()
+        .success();
     log
 }
 
 fn info_json(log: &Path) -> serde_json::Value {
-    let out = wobblog().arg("info").arg(log).arg("--json").output().unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let out = wobblog()
+        .arg("info")
+        .arg(log)
+        .arg("--json")
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     serde_json::from_slice(&out.stdout).unwrap()
 }
 
@@ -58,7 +74,10 @@ fn damaged_block_is_reported_with_its_frames_and_time() {
     assert!(out.status.success());
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(stderr.contains("blocks 10-10 lost"), "{stderr}");
-    assert_eq!(out.stdout.iter().filter(|&&b| b == b'\n').count() as u64, 3000 - frames + 1);
+    assert_eq!(
+        out.stdout.iter().filter(|&&b| b == b'\n').count() as u64,
+        3000 - frames + 1
+    );
 }
 
 #[test]
@@ -78,17 +97,29 @@ fn unreadable_inputs_exit_1_naming_the_file() {
 
     let bad_csv = dir.path().join("bad.csv");
     std::fs::write(&bad_csv, "t_s,steer_deg\n0.01,abc\n").unwrap();
-    let out = wobblog().args(["encode", "--csv"]).arg(&bad_csv).arg("-o").arg(dir.path().join("x.wbl")).output().unwrap();
+    let out = wobblog()
+        .args(["encode", "--csv"])
+        .arg(&bad_csv)
+        .arg("-o")
+        .arg(dir.path().join("x.wbl"))
+        .output()
+        .unwrap();
     assert_eq!(out.status.code(), Some(1));
     let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(stderr.contains("bad.csv: line 2: steer_deg: not a number"), "{stderr}");
+    assert!(
+        stderr.contains("bad.csv: line 2: steer_deg: not a number"),
+        "{stderr}"
+    );
 }
 
 #[test]
 fn usage_errors_exit_2() {
     wobblog().assert().code(2);
     wobblog().args(["decode"]).assert().code(2);
-    wobblog().args(["decode", "x.wbl", "--format", "xml"]).assert().code(2);
+    wobblog()
+        .args(["decode", "x.wbl", "--format", "xml"])
+        .assert()
+        .code(2);
 }
 
 #[test]
@@ -120,6 +151,34 @@ fn closing_the_output_pipe_early_is_not_an_error() {
     child.stdout.take().unwrap().read_exact(&mut first).unwrap();
     let out = child.wait_with_output().unwrap();
     assert!(first.starts_with(b"t_s,ax_g"));
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     assert!(out.stderr.is_empty());
+}
+
+#[test]
+fn info_to_a_closed_pipe_does_not_panic() {
+    use std::process::Stdio;
+    let dir = tempfile::tempdir().unwrap();
+    let log = sample_log(dir.path());
+    let child = std::process::Command::new(assert_cmd::cargo::cargo_bin("wobblog"))
+        .arg("info")
+        .arg(&log)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    // Close the read end before the command writes anything.
+    let mut child = child;
+    drop(child.stdout.take());
+    let out = child.wait_with_output().unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(!String::from_utf8_lossy(&out.stderr).contains("panicked"));
 }

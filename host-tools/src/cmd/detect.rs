@@ -1,7 +1,7 @@
 //! `wobblog detect`: replay a steering-angle CSV through the on-board wobble
 //! detector (the firmware's code and defaults) and print every alert change.
 
-use std::io::{self, Read, Write};
+use std::io::{self, Read};
 use std::path::{Path, PathBuf};
 
 use wobble_core::detector::{AlertEvent, Detector, DetectorConfig};
@@ -280,16 +280,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
     } else {
         table(&r)
     };
-    let mut stdout = io::stdout().lock();
-    match stdout
-        .write_all(text.as_bytes())
-        .and_then(|()| stdout.flush())
-    {
-        Ok(()) => Ok(()),
-        // A closed pipe (`| head`) is not a failure of the replay.
-        Err(e) if e.kind() == io::ErrorKind::BrokenPipe => Ok(()),
-        Err(e) => Err(CliError::file(Path::new("<stdout>"), e)),
-    }
+    crate::cmd::logs::print_stdout(&text)
 }
 
 #[cfg(test)]

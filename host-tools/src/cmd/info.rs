@@ -2,6 +2,7 @@
 
 use std::path::PathBuf;
 
+use crate::cmd::logs::print_stdout;
 use crate::reader::read_log;
 use crate::summary::{Summary, SummaryBuilder};
 use crate::CliError;
@@ -19,14 +20,14 @@ pub struct Args {
 /// Runs `wobblog info`.
 pub fn run(args: &Args) -> Result<(), CliError> {
     let summary = summarise(&args.log)?;
-    if args.json {
-        let text =
+    let text = if args.json {
+        let json =
             serde_json::to_string_pretty(&summary).map_err(|e| CliError::file(&args.log, e))?;
-        println!("{text}");
+        json + "\n"
     } else {
-        print!("{}", render(&args.log, &summary));
-    }
-    Ok(())
+        render(&args.log, &summary)
+    };
+    print_stdout(&text)
 }
 
 /// Decodes the log at `path` into a summary.

@@ -56,11 +56,14 @@ pub fn warn_losses(run: &Run) {
     }
 }
 
-/// Writes `text` to standard output; a closed pipe (`| head`) is an error
-/// to report, not a panic as with `print!`.
+/// Writes `text` to standard output. A closed pipe (`| head`) ends the
+/// output quietly, where `print!` would panic; other errors are reported.
 pub fn print_stdout(text: &str) -> Result<(), CliError> {
     let mut out = std::io::stdout().lock();
-    out.write_all(text.as_bytes())
-        .and_then(|()| out.flush())
-        .map_err(|e| CliError::file(Path::new("<stdout>"), e))
+    match out.write_all(text.as_bytes()).and_then(|()| out.flush()) {
+        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => {
+            Err(CliError::file(Path::new("<stdout>"), e))
+        }
+        _ => Ok(()),
+    }
 }
