@@ -161,12 +161,13 @@ impl SharedStatus {
         self.last_fix_ms.store(ms, Ordering::Relaxed);
     }
 
-    /// Whether the last fix is older than `max_age_us` at `now_us` (or
-    /// there was none).
-    pub fn gps_stale(&self, now_us: u64, max_age_us: u64) -> bool {
+    /// Local time of the last fix with a position, µs since boot (to the
+    /// millisecond); `None` before the first. Frame assembly decides from it
+    /// whether the GPS is stale.
+    pub fn last_fix_us(&self) -> Option<u64> {
         match self.last_fix_ms.load(Ordering::Relaxed) {
-            0 => true,
-            ms => now_us.saturating_sub(u64::from(ms) * 1000) > max_age_us,
+            0 => None,
+            ms => Some(u64::from(ms) * 1000),
         }
     }
 

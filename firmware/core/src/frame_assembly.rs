@@ -1,15 +1,35 @@
 //! 100 Hz frame assembly: the latest value of every channel, with status flags.
 //!
-//! At each tick the sampler collects what every channel produced since the
-//! previous tick (each `take()` returns at once, `None` if nothing came) and
-//! hands it to [`FrameAssembler::tick`]. The assembler never waits: a channel
-//! with nothing new keeps its previous value and is flagged stale, a channel
-//! that never delivered reads zero and is flagged stale, and an IMU that has
-//! been silent for `imu_missing_ticks` or is stuck is flagged as a fault.
+//! At each tick the sampler ([`crate::app::sampler`]) reads every sensor port
+//! once (each read returns at once: a channel value, or why there is none)
+//! and hands the results to [`FrameAssembler::tick`]. This is the one place
+//! that turns channel values into a [`Frame`]: held values, status bits and
+//! quantisation to the card's units. The assembler never waits: a channel
+//! with nothing new keeps its previous value and is flagged stale, and a
+//! channel that never delivered reads zero and is flagged stale.
+//!
+//! `IMU_FAULT` means the IMU is missing or stuck, which is any of:
+//! - it did not answer this tick ([`SensorError::NoResponse`]: bus timeout,
+//!   NACK, wrong identity): nothing is coming, so the frame says so at once;
+//! - it answered but has delivered no new sample for `imu_missing_ticks`
+//!   ticks in a row, or never delivered one: a sensor that stays on the bus
+//!   but stopped sampling (a few late samples are only stale);
+//! - its sample is stuck (identical raw values, see [`crate::imu`]).
+//!
+//! `GPS_STALE` is computed from the local time of the last fix with a
+//! position, which the GPS task publishes (see
+//! [`crate::channels::SharedStatus`]), so the rule does not depend on which
+//! task sees the fix.
+//!
+//! `ALERT` is not set here: the detector runs on the assembled frame's
+//! steering (exactly what the card stores, so replaying a log through the
+//! host's detector gives the same alerts), and the sampler sets the bit
+//! once it has.
 
+use crate::app::ports::SensorError;
 use crate::format::{
-    quantise_i16, quantise_u16, FixMode, Frame, FrameStatus, GpsFix, ACCEL_COUNTS_PER_G,
-    EDGE_AGE_NONE, GYRO_COUNTS_PER_DPS, STEER_COUNTS_PER_DEG,
+    quantise_i16, quantise_u16, Frame, FrameStatus, ACCEL_COUNTS_PER_G, EDGE_AGE_NONE,
+    GYRO_COUNTS_PER_DPS, STEER_COUNTS_PER_DEG,
 };
 use crate::imu::ImuSample;
 use crate::steering::SteeringSample;
@@ -19,11 +39,11 @@ use crate::wheel::WheelSample;
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct FrameConfig {
-    /// Consecutive ticks without an IMU sample after which the IMU counts as
-    /// missing (`IMU_FAULT`). Default 10 (100 ms).
+    /// Consecutive ticks without a new IMU sample after which the IMU counts
+    /// as missing (`IMU_FAULT`) even though it answers. Default 10 (100 ms).
     pub imu_missing_ticks: u16,
-    /// A GPS fix with a 2D/3D mode older than this is stale (`GPS_STALE`).
-    /// Default 1 s.
+    /// The GPS is stale (`GPS_STALE`) when its last fix with a position is
+    /// older than this. Default 1 s.
     pub gps_stale_us: u64,
 }
 
@@ -42,20 +62,33 @@ impl Default for FrameConfig {
 }
 
 /// What each channel produced since the previous tick.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TickInputs {
-    /// The IMU's value for this frame, if it delivered samples.
-    pub imu: Option<ImuSample>,
-    /// The steering value for this frame, if the ADC delivered samples.
-    pub steering: Option<SteeringSample>,
+    /// The IMU's value for this frame, or why there is none.
+    pub imu: Result<ImuSample, SensorError>,
+    /// The steering value for this frame, or why there is none.
+    pub steering: Result<SteeringSample, SensorError>,
     /// The wheel's state at the tick (always available: it is computed).
     pub wheel: WheelSample,
-    /// A GPS fix emitted since the previous tick.
-    pub gps_fix: Option<GpsFix>,
-    /// The wobble alert is on.
-    pub alert: bool,
+    /// Local time of the last GPS fix with a position, µs since boot; `None`
+    /// before the first.
+    pub last_gps_fix_us: Option<u64>,
     /// The marker button is held.
     pub marker: bool,
+}
+
+impl Default for TickInputs {
+    /// Nothing delivered: both sensors stale, a default wheel state, no GPS
+    /// fix, no marker.
+    fn default() -> Self {
+        Self {
+            imu: Err(SensorError::Stale),
+            steering: Err(SensorError::Stale),
+            wheel: WheelSample::default(),
+            last_gps_fix_us: None,
+            marker: false,
+        }
+    }
 }
 
 /// Builds one [`Frame`] per tick from the latest channel values.
@@ -65,7 +98,6 @@ pub struct FrameAssembler {
     imu: Option<ImuSample>,
     ticks_without_imu: u16,
     steering: Option<SteeringSample>,
-    last_gps_fix_us: Option<u64>,
 }
 
 impl FrameAssembler {
@@ -77,21 +109,24 @@ impl FrameAssembler {
             imu: None,
             ticks_without_imu: 0,
             steering: None,
-            last_gps_fix_us: None,
         }
     }
 
-    /// The frame for the tick at `t_us`.
+    /// The frame for the tick at `t_us` (without `ALERT`, see the module
+    /// docs).
     pub fn tick(&mut self, t_us: u64, inputs: &TickInputs) -> Frame {
         let mut status = 0u8;
 
         match inputs.imu {
-            Some(s) => {
+            Ok(s) => {
                 self.imu = Some(s);
                 self.ticks_without_imu = 0;
             }
-            None => {
+            Err(e) => {
                 status |= FrameStatus::IMU_STALE;
+                if e == SensorError::NoResponse {
+                    status |= FrameStatus::IMU_FAULT;
+                }
                 self.ticks_without_imu = self.ticks_without_imu.saturating_add(1);
             }
         }
@@ -101,8 +136,8 @@ impl FrameAssembler {
             status |= FrameStatus::IMU_FAULT;
         }
 
-        if inputs.steering.is_some() {
-            self.steering = inputs.steering;
+        if let Ok(s) = inputs.steering {
+            self.steering = Some(s);
         } else {
             status |= FrameStatus::STEER_STALE;
         }
@@ -111,7 +146,7 @@ impl FrameAssembler {
             status |= FrameStatus::STEER_SATURATED;
         }
 
-        let wheel = inputs.wheel;
+        let wheel = &inputs.wheel;
         if wheel.stopped {
             status |= FrameStatus::WHEEL_STOPPED;
         }
@@ -122,17 +157,11 @@ impl FrameAssembler {
             .filter(|&age| age != EDGE_AGE_NONE)
             .unwrap_or(EDGE_AGE_NONE);
 
-        if let Some(fix) = inputs.gps_fix.filter(|f| f.fix != FixMode::None) {
-            self.last_gps_fix_us = Some(fix.t_us);
-        }
-        let gps_fresh = self
+        let gps_fresh = inputs
             .last_gps_fix_us
             .is_some_and(|t| t_us.saturating_sub(t) <= self.config.gps_stale_us);
         if !gps_fresh {
             status |= FrameStatus::GPS_STALE;
-        }
-        if inputs.alert {
-            status |= FrameStatus::ALERT;
         }
         if inputs.marker {
             status |= FrameStatus::MARKER;
@@ -170,8 +199,8 @@ mod tests {
         let f = a.tick(
             1_000_000,
             &TickInputs {
-                imu: Some(imu(0.5)),
-                steering: Some(SteeringSample {
+                imu: Ok(imu(0.5)),
+                steering: Ok(SteeringSample {
                     deg: -3.25,
                     saturated: false,
                 }),
@@ -181,13 +210,8 @@ mod tests {
                     speed_mps: 4.2,
                     stopped: false,
                 },
-                gps_fix: Some(GpsFix {
-                    t_us: 950_000,
-                    fix: FixMode::Fix3d,
-                    ..GpsFix::default()
-                }),
-                alert: true,
-                marker: false,
+                last_gps_fix_us: Some(950_000),
+                marker: true,
             },
         );
         assert_eq!(f.accel, [1024, 0, 2048]);
@@ -196,7 +220,7 @@ mod tests {
         assert_eq!(f.wheel_count, (70_000 % 65_536) as u16);
         assert_eq!(f.wheel_edge_age_us, 10_000);
         assert_eq!(f.speed_mm_s, 4200);
-        assert_eq!(f.status, FrameStatus(FrameStatus::ALERT));
+        assert_eq!(f.status, FrameStatus(FrameStatus::MARKER));
     }
 
     #[test]
@@ -205,8 +229,8 @@ mod tests {
         let first = a.tick(
             0,
             &TickInputs {
-                imu: Some(imu(0.25)),
-                steering: Some(SteeringSample {
+                imu: Ok(imu(0.25)),
+                steering: Ok(SteeringSample {
                     deg: 45.0,
                     saturated: true,
                 }),
@@ -236,7 +260,7 @@ mod tests {
         let f = a.tick(
             110_000,
             &TickInputs {
-                imu: Some(imu(0.0)),
+                imu: Ok(imu(0.0)),
                 ..TickInputs::default()
             },
         );
@@ -270,7 +294,7 @@ mod tests {
         let f = a.tick(
             0,
             &TickInputs {
-                imu: Some(stuck),
+                imu: Ok(stuck),
                 ..TickInputs::default()
             },
         );
@@ -279,25 +303,50 @@ mod tests {
     }
 
     #[test]
-    fn gps_goes_stale_a_second_after_the_last_real_fix() {
+    fn an_imu_that_does_not_answer_is_a_fault_at_once() {
         let mut a = FrameAssembler::new(FrameConfig::DEFAULT);
-        let fix = |t_us, fix| TickInputs {
-            gps_fix: Some(GpsFix {
-                t_us,
-                fix,
-                ..GpsFix::default()
-            }),
+        let answered = TickInputs {
+            imu: Ok(imu(0.5)),
+            ..TickInputs::default()
+        };
+        assert!(!a.tick(0, &answered).status.has(FrameStatus::IMU_FAULT));
+        let f = a.tick(
+            10_000,
+            &TickInputs {
+                imu: Err(SensorError::NoResponse),
+                ..TickInputs::default()
+            },
+        );
+        assert!(f
+            .status
+            .has(FrameStatus::IMU_STALE | FrameStatus::IMU_FAULT));
+        // The last value is held, as for a late sample.
+        assert_eq!(f.accel[0], 1024);
+        // An answer without a new sample is only stale.
+        let f = a.tick(20_000, &TickInputs::default());
+        assert!(f.status.has(FrameStatus::IMU_STALE));
+        assert!(!f.status.has(FrameStatus::IMU_FAULT));
+    }
+
+    #[test]
+    fn gps_goes_stale_a_second_after_the_last_fix() {
+        let mut a = FrameAssembler::new(FrameConfig::DEFAULT);
+        let fix_at = |t_us| TickInputs {
+            last_gps_fix_us: Some(t_us),
             ..TickInputs::default()
         };
         assert!(!a
-            .tick(10_000, &fix(0, FixMode::Fix2d))
+            .tick(10_000, &fix_at(0))
             .status
             .has(FrameStatus::GPS_STALE));
-        // A fix without a mode does not refresh it.
-        let f = a.tick(1_000_000, &fix(990_000, FixMode::None));
+        let f = a.tick(1_000_000, &fix_at(0));
         assert!(!f.status.has(FrameStatus::GPS_STALE));
-        let f = a.tick(1_000_001, &TickInputs::default());
+        let f = a.tick(1_000_001, &fix_at(0));
         assert!(f.status.has(FrameStatus::GPS_STALE));
+        // A fix stamped after the tick (a task preempted between the two
+        // clock reads) is fresh, not a wrapped age.
+        let f = a.tick(2_000_000, &fix_at(2_000_500));
+        assert!(!f.status.has(FrameStatus::GPS_STALE));
     }
 
     #[test]

@@ -3,6 +3,7 @@
 
 use std::f64::consts::TAU;
 
+use wobble_core::app::ports::SensorError;
 use wobble_core::format::{FixMode, Frame, FrameStatus};
 use wobble_core::frame_assembly::{FrameAssembler, FrameConfig, TickInputs};
 use wobble_core::gps::{GpsConfig, GpsEvent, GpsReceiver};
@@ -78,7 +79,8 @@ fn a_silent_imu_never_blocks_the_frames() {
         frames.push(assembler.tick(
             t_us,
             &TickInputs {
-                imu: imu.take(),
+                // An IMU that answers but has nothing new is stale.
+                imu: imu.take().ok_or(SensorError::Stale),
                 ..TickInputs::default()
             },
         ));
@@ -127,6 +129,7 @@ fn wheel_and_gps_in_the_frames() {
     let mut next_edge = 5_000u64;
     let mut frames: Vec<Frame> = Vec::new();
     let mut fixes = Vec::new();
+    let mut last_fix_us = None;
     for tick in 1..=1500u64 {
         let t_us = tick * TICK_US;
         while next_edge <= t_us {
@@ -138,27 +141,26 @@ fn wheel_and_gps_in_the_frames() {
         while next_byte < uart.len() && uart[next_byte].0 <= t_us {
             next_byte += 1;
         }
-        let mut gps_fix = None;
-        if next_byte > start {
-            let chunk: Vec<u8> = uart[start..next_byte].iter().map(|&(_, b)| b).collect();
-            gps.feed(&chunk, uart[next_byte - 1].0, &mut |e| {
-                if let GpsEvent::Fix(f) = e {
-                    gps_fix = Some(f);
-                    fixes.push(f);
-                }
-            });
-        }
-        gps.poll(t_us, &mut |e| {
+        // As the GPS task publishes it: the time of the last fix with a
+        // position.
+        let mut on_event = |e| {
             if let GpsEvent::Fix(f) = e {
-                gps_fix = Some(f);
+                if f.lat_e7.is_some() {
+                    last_fix_us = Some(f.t_us);
+                }
                 fixes.push(f);
             }
-        });
+        };
+        if next_byte > start {
+            let chunk: Vec<u8> = uart[start..next_byte].iter().map(|&(_, b)| b).collect();
+            gps.feed(&chunk, uart[next_byte - 1].0, &mut on_event);
+        }
+        gps.poll(t_us, &mut on_event);
         frames.push(assembler.tick(
             t_us,
             &TickInputs {
                 wheel: wheel.sample(t_us),
-                gps_fix,
+                last_gps_fix_us: last_fix_us,
                 ..TickInputs::default()
             },
         ));

@@ -40,6 +40,7 @@ use wobble_core::config::{self, Config, Loaded, KEY_COUNT, MAX_TEXT_LEN};
 use wobble_core::detector::Detector;
 use wobble_core::drivers::icm42688::{self, Icm42688};
 use wobble_core::format::Record;
+use wobble_core::frame_assembly::FrameConfig;
 use wobble_core::gps::{GpsConfig, GpsReceiver};
 use wobble_core::imu::Imu;
 use wobble_core::logger::{CardLogger, FixedTime, HeaderSpec, LoggerConfig};
@@ -219,6 +220,7 @@ fn sampler_parts(
     };
     let sampler = Sampler::new(
         defmt::unwrap!(WheelSpeed::try_new(config.wheel).ok()),
+        FrameConfig::DEFAULT,
         defmt::unwrap!(Detector::new(config.detector).ok()),
         config.alert.pattern,
     );

@@ -24,6 +24,7 @@ use wobble_core::app::sampler::{Sampler, SamplerPorts};
 use wobble_core::app::{gps, sampler, writer};
 use wobble_core::channels::{RecordQueue, SharedStatus};
 use wobble_core::detector::{Detector, DetectorConfig, PatternConfig};
+use wobble_core::frame_assembly::FrameConfig;
 use wobble_core::gps::{GpsConfig, GpsReceiver};
 use wobble_core::logger::{
     CardLogger, FixedTime, HeaderSpec, LoggerConfig, FAULT_CARD_ABSENT, FAULT_CARD_FULL,
@@ -87,7 +88,12 @@ async fn sampler_task(ride: &'static RefCell<Ride>, frames: u32) {
         report::line(format_args!("FATAL default configuration rejected"));
         semihosting::process::exit(2)
     };
-    let mut s = Sampler::new(wheel, detector, PatternConfig::DEFAULT);
+    let mut s = Sampler::new(
+        wheel,
+        FrameConfig::DEFAULT,
+        detector,
+        PatternConfig::DEFAULT,
+    );
     let mut ports = SamplerPorts {
         imu: Port(ride),
         steering: Port(ride),

@@ -16,8 +16,9 @@ use embassy_time::{Instant, Timer};
 use semihosting::fs::File;
 use semihosting::io::Read;
 use wobble_core::app::ports::{
-    GpsPort, ImuPort, ImuReading, MarkerInput, SensorError, SteeringPort, WheelPort,
+    GpsPort, ImuPort, ImuSample, MarkerInput, SensorError, SteeringPort, SteeringSample, WheelPort,
 };
+use wobble_core::format::{ACCEL_COUNTS_PER_G, GYRO_COUNTS_PER_DPS, STEER_COUNTS_PER_DEG};
 
 use crate::scenario::{within, Scenario};
 
@@ -68,17 +69,26 @@ impl Buffered {
 /// Most wheel edges in one 10 ms row (240 pulses/s at 10 m/s is 2.4).
 const MAX_EDGES: usize = 16;
 
+/// One row as the sensor channels would deliver it. The fixture's counts
+/// are the card's units, which are powers of two (IMU) or 100 (steering):
+/// frame assembly quantises these values back to exactly the same counts.
 struct Row {
-    steer_cdeg: i16,
-    imu: ImuReading,
+    steering: SteeringSample,
+    imu: ImuSample,
     edges_age_us: heapless::Vec<u16, MAX_EDGES>,
 }
 
 fn read_row(f: &mut Buffered) -> Option<Row> {
-    let steer_cdeg = f.i16()?;
-    let mut imu = ImuReading::default();
-    for v in imu.accel.iter_mut().chain(imu.gyro.iter_mut()) {
-        *v = f.i16()?;
+    let steering = SteeringSample {
+        deg: f32::from(f.i16()?) / STEER_COUNTS_PER_DEG,
+        saturated: false,
+    };
+    let mut imu = ImuSample::default();
+    for g in &mut imu.accel_g {
+        *g = f32::from(f.i16()?) / ACCEL_COUNTS_PER_G;
+    }
+    for dps in &mut imu.gyro_dps {
+        *dps = f32::from(f.i16()?) / GYRO_COUNTS_PER_DPS;
     }
     let n = f.byte()?;
     let mut edges_age_us = heapless::Vec::new();
@@ -88,7 +98,7 @@ fn read_row(f: &mut Buffered) -> Option<Row> {
         let _ = edges_age_us.push(age);
     }
     Some(Row {
-        steer_cdeg,
+        steering,
         imu,
         edges_age_us,
     })
@@ -132,7 +142,7 @@ impl WheelPort for Port {
 }
 
 impl ImuPort for Port {
-    async fn read(&mut self) -> Result<ImuReading, SensorError> {
+    async fn read(&mut self) -> Result<ImuSample, SensorError> {
         let ride = self.0.borrow();
         if ride
             .scenario
@@ -146,11 +156,11 @@ impl ImuPort for Port {
 }
 
 impl SteeringPort for Port {
-    async fn read_deg(&mut self) -> Result<f32, SensorError> {
+    async fn read(&mut self) -> Result<SteeringSample, SensorError> {
         let ride = self.0.borrow();
         ride.row
             .as_ref()
-            .map(|r| f32::from(r.steer_cdeg) / 100.0)
+            .map(|r| r.steering)
             .ok_or(SensorError::Stale)
     }
 }

@@ -2,21 +2,15 @@
 //! crate implements them with real peripherals, the QEMU image with fixture
 //! replay; the tasks never see which.
 //!
-//! Units are the card format's: accelerations in 1/2048 g, rates in 1/32
-//! deg/s, steering in degrees, times in µs since boot (the `embassy-time`
-//! clock).
+//! The sensor ports deliver the core's channel values ([`ImuSample`] in g
+//! and deg/s in the bicycle frame, [`SteeringSample`] in degrees), which the
+//! sampler hands to [`crate::frame_assembly`]; quantisation to the card's
+//! units happens there, never in an adapter. Times are µs since boot (the
+//! `embassy-time` clock).
 
 pub use crate::detector::AlertOutput;
-
-/// One IMU reading, already scaled to the frame's units.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub struct ImuReading {
-    /// Acceleration x, y, z, 1/2048 g.
-    pub accel: [i16; 3],
-    /// Angular rate x, y, z, 1/32 deg/s.
-    pub gyro: [i16; 3],
-}
+pub use crate::imu::ImuSample;
+pub use crate::steering::SteeringSample;
 
 /// Why a sensor read failed.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -34,16 +28,22 @@ pub enum SensorError {
 /// The 6-DOF IMU, read once per frame.
 #[allow(async_fn_in_trait)]
 pub trait ImuPort {
-    /// The latest filtered sample. Must return within a few ms: the
-    /// sampler's period is 10 ms.
-    async fn read(&mut self) -> Result<ImuReading, SensorError>;
+    /// The frame's value from the samples since the previous read (the
+    /// [`crate::imu::Imu`] channel's `take`), `stuck` set when the sensor
+    /// repeats itself; [`SensorError::NoResponse`] when it did not answer,
+    /// [`SensorError::Stale`] when it answered without a new sample. Must
+    /// return within a few ms: the sampler's period is 10 ms.
+    async fn read(&mut self) -> Result<ImuSample, SensorError>;
 }
 
 /// The steering potentiometer, calibrated.
 #[allow(async_fn_in_trait)]
 pub trait SteeringPort {
-    /// Steering angle now, degrees, left positive.
-    async fn read_deg(&mut self) -> Result<f32, SensorError>;
+    /// The frame's angle from the ADC samples since the previous read (the
+    /// [`crate::steering::Steering`] channel's `take`), degrees, left
+    /// positive, `saturated` when a sample hit either end of the ADC range;
+    /// [`SensorError::Stale`] when no sample came.
+    async fn read(&mut self) -> Result<SteeringSample, SensorError>;
 }
 
 /// The wheel's hall sensor, whose edges the hardware timestamps.

@@ -1,5 +1,11 @@
-//! The 100 Hz sampling task: reads the sensor ports, builds the frame, runs
-//! the wobble detector, drives the alert output and queues the records.
+//! The 100 Hz sampling task: reads the sensor ports, has the frame built by
+//! [`FrameAssembler`], runs the wobble detector on it, drives the alert
+//! output and queues the records.
+//!
+//! The frame itself (held values, status bits, quantisation) is the
+//! assembler's; what is the sampler's own: fault records for failed reads,
+//! the detector with its alert records and pattern, marker records, and the
+//! timing statistics.
 //!
 //! The work of one tick is [`Sampler::step`], a plain function of the inputs
 //! and the time, so it is tested without an executor; [`run`] is the loop
@@ -8,43 +14,48 @@
 use embassy_time::{Duration, Instant, Ticker};
 
 use super::ports::{
-    AlertOutput, ImuPort, ImuReading, LoggerHealth, MarkerInput, SensorError, StatusLed,
-    SteeringPort, WheelPort,
+    AlertOutput, ImuPort, ImuSample, LoggerHealth, MarkerInput, SensorError, StatusLed,
+    SteeringPort, SteeringSample, WheelPort,
 };
 use crate::channels::{RecordQueue, SharedStatus};
 use crate::detector::{AlertEvent, AlertPattern, Detector, PatternConfig};
 use crate::faults::FaultCounter;
-use crate::format::{
-    quantise_i16, quantise_u16, FaultSource, Frame, FrameStatus, Marker, Record, EDGE_AGE_NONE,
-    STEER_COUNTS_PER_DEG,
-};
+use crate::format::{FaultSource, FrameStatus, Marker, Record};
+use crate::frame_assembly::{FrameAssembler, FrameConfig, TickInputs};
 use crate::wheel::WheelSpeed;
 
 /// Frame period: 100 Hz.
 pub const FRAME_PERIOD_US: u64 = 10_000;
-/// The GPS counts as stale (status bit) without a fix for this long.
-pub const GPS_STALE_US: u64 = 1_000_000;
 /// Each sensor fault code is recorded at most once per second, with a count.
 pub const FAULT_INTERVAL_US: u64 = 1_000_000;
 
 /// IMU fault 1: the IMU did not answer.
 pub const FAULT_IMU_NO_RESPONSE: u8 = 1;
-/// IMU fault 2: the IMU answered with a stale or impossible sample.
+/// IMU fault 2: the IMU answered with a stale, impossible or stuck sample.
 pub const FAULT_IMU_BAD_SAMPLE: u8 = 2;
 /// Steering fault 1: the steering sensor could not be read.
 pub const FAULT_STEER_READ: u8 = 1;
 
-/// What one tick read from the sensors.
+/// Status bits that make the status LED show [`LoggerHealth::Degraded`]: a
+/// sensor not delivering live values, or no recent GPS fix.
+const DEGRADED: u8 = FrameStatus::IMU_STALE
+    | FrameStatus::IMU_FAULT
+    | FrameStatus::STEER_STALE
+    | FrameStatus::STEER_SATURATED
+    | FrameStatus::GPS_STALE;
+
+/// What one tick read from the ports.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Inputs {
     /// The IMU's answer.
-    pub imu: Result<ImuReading, SensorError>,
-    /// The steering angle, degrees.
-    pub steer_deg: Result<f32, SensorError>,
+    pub imu: Result<ImuSample, SensorError>,
+    /// The steering sensor's answer.
+    pub steering: Result<SteeringSample, SensorError>,
     /// Whether the marker button is held.
     pub marker: bool,
-    /// Whether the GPS has had no fix for [`GPS_STALE_US`].
-    pub gps_stale: bool,
+    /// Local time of the last GPS fix with a position, µs since boot
+    /// ([`SharedStatus::last_fix_us`]).
+    pub last_gps_fix_us: Option<u64>,
 }
 
 /// Counters of the sampling task.
@@ -60,31 +71,37 @@ pub struct SamplerStats {
 /// State of the sampling task (see the module docs).
 pub struct Sampler {
     wheel: WheelSpeed,
+    assembler: FrameAssembler,
     detector: Detector,
     pattern: AlertPattern,
     imu_faults: FaultCounter<2>,
     steer_faults: FaultCounter<1>,
-    last_imu: ImuReading,
-    last_steer_deg: f32,
     marker_held: bool,
     markers: u16,
+    status: FrameStatus,
     stats: SamplerStats,
 }
 
 impl Sampler {
-    /// A sampler with the configured wheel estimator and detector.
+    /// A sampler with the configured wheel estimator, frame assembly and
+    /// detector.
     #[must_use]
-    pub fn new(wheel: WheelSpeed, detector: Detector, pattern: PatternConfig) -> Self {
+    pub fn new(
+        wheel: WheelSpeed,
+        frame: FrameConfig,
+        detector: Detector,
+        pattern: PatternConfig,
+    ) -> Self {
         Self {
             wheel,
+            assembler: FrameAssembler::new(frame),
             detector,
             pattern: AlertPattern::new(pattern),
             imu_faults: FaultCounter::new(FaultSource::Imu, FAULT_INTERVAL_US),
             steer_faults: FaultCounter::new(FaultSource::Steering, FAULT_INTERVAL_US),
-            last_imu: ImuReading::default(),
-            last_steer_deg: 0.0,
             marker_held: false,
             markers: 0,
+            status: FrameStatus(0),
             stats: SamplerStats::default(),
         }
     }
@@ -95,14 +112,21 @@ impl Sampler {
         self.stats
     }
 
+    /// Status bits of the last frame built (the status LED shows them).
+    #[must_use]
+    pub fn last_status(&self) -> FrameStatus {
+        self.status
+    }
+
     /// Counts a wheel edge captured at `t_us`.
     pub fn wheel_edge(&mut self, t_us: u64) {
         self.wheel.on_edge(t_us);
     }
 
-    /// One tick at `now_us`: hands the records it makes to `out` (frame
-    /// last, so a reader sees an event before the frame that shows it) and
-    /// returns the alert switching, if any.
+    /// One tick at `now_us`: hands the records it makes to `out` (faults,
+    /// alert and marker first, the frame last, so a reader sees an event
+    /// before the frame that shows it) and returns the alert switching, if
+    /// any.
     pub fn step(
         &mut self,
         now_us: u64,
@@ -110,47 +134,38 @@ impl Sampler {
         alert_out: &mut impl AlertOutput,
         out: &mut impl FnMut(Record<'static>),
     ) -> Option<AlertEvent> {
-        let mut status = 0u8;
         let mut emit_fault = |f| out(Record::Fault(f));
-        match inputs.imu {
-            Ok(reading) => self.last_imu = reading,
-            Err(e) => {
-                status |= FrameStatus::IMU_STALE;
-                let code = match e {
-                    SensorError::NoResponse => {
-                        status |= FrameStatus::IMU_FAULT;
-                        FAULT_IMU_NO_RESPONSE
-                    }
-                    _ => FAULT_IMU_BAD_SAMPLE,
-                };
-                self.imu_faults.count(code, now_us, &mut emit_fault);
-            }
+        let imu_fault = match inputs.imu {
+            Ok(sample) if sample.stuck => Some(FAULT_IMU_BAD_SAMPLE),
+            Ok(_) => None,
+            Err(SensorError::NoResponse) => Some(FAULT_IMU_NO_RESPONSE),
+            Err(_) => Some(FAULT_IMU_BAD_SAMPLE),
+        };
+        if let Some(code) = imu_fault {
+            self.imu_faults.count(code, now_us, &mut emit_fault);
         }
-        match inputs.steer_deg {
-            Ok(deg) => self.last_steer_deg = deg,
-            Err(_) => {
-                status |= FrameStatus::STEER_STALE;
-                self.steer_faults
-                    .count(FAULT_STEER_READ, now_us, &mut emit_fault);
-            }
+        if inputs.steering.is_err() {
+            self.steer_faults
+                .count(FAULT_STEER_READ, now_us, &mut emit_fault);
         }
         self.imu_faults.poll(now_us, &mut emit_fault);
         self.steer_faults.poll(now_us, &mut emit_fault);
 
-        let steer_counts = f64::from(self.last_steer_deg) * f64::from(STEER_COUNTS_PER_DEG);
-        if steer_counts.abs() >= f64::from(i16::MAX) {
-            status |= FrameStatus::STEER_SATURATED;
-        }
-        let wheel = self.wheel.sample(now_us);
-        if wheel.stopped {
-            status |= FrameStatus::WHEEL_STOPPED;
-        }
-        if inputs.gps_stale {
-            status |= FrameStatus::GPS_STALE;
-        }
+        let mut frame = self.assembler.tick(
+            now_us,
+            &TickInputs {
+                imu: inputs.imu,
+                steering: inputs.steering,
+                wheel: self.wheel.sample(now_us),
+                last_gps_fix_us: inputs.last_gps_fix_us,
+                marker: inputs.marker,
+            },
+        );
+        // The detector sees the frame's values as the card stores them, so
+        // the host's `wobblog detect` over a decoded log sees the same input.
         let event = self
             .detector
-            .push(self.last_steer_deg, Some(wheel.speed_mps));
+            .push(frame.steer_deg(), Some(frame.speed_mps()));
         if let Some(ev) = event {
             out(Record::Alert(ev.to_record(now_us)));
             self.pattern
@@ -158,37 +173,20 @@ impl Sampler {
         }
         self.pattern.update(now_us, alert_out);
         if self.detector.alert_active() {
-            status |= FrameStatus::ALERT;
+            frame.status.0 |= FrameStatus::ALERT;
         }
-        if inputs.marker {
-            status |= FrameStatus::MARKER;
-            if !self.marker_held {
-                self.markers = self.markers.wrapping_add(1);
-                out(Record::Marker(Marker {
-                    t_us: now_us,
-                    id: self.markers,
-                }));
-            }
+        if inputs.marker && !self.marker_held {
+            self.markers = self.markers.wrapping_add(1);
+            out(Record::Marker(Marker {
+                t_us: now_us,
+                id: self.markers,
+            }));
         }
         self.marker_held = inputs.marker;
 
-        let edge_age_us = wheel
-            .last_edge_us
-            .map(|t| now_us.saturating_sub(t))
-            .filter(|&age| age < u64::from(EDGE_AGE_NONE))
-            .map_or(EDGE_AGE_NONE, |age| age as u16);
+        self.status = frame.status;
         self.stats.frames = self.stats.frames.wrapping_add(1);
-        out(Record::Frame(Frame {
-            t_us: now_us,
-            accel: self.last_imu.accel,
-            gyro: self.last_imu.gyro,
-            steer_cdeg: quantise_i16(self.last_steer_deg, STEER_COUNTS_PER_DEG),
-            // The card stores the cumulative count modulo 2^16.
-            wheel_count: wheel.pulses as u16,
-            wheel_edge_age_us: edge_age_us,
-            speed_mm_s: quantise_u16(wheel.speed_mps, 1000.0),
-            status: FrameStatus(status),
-        }));
+        out(Record::Frame(frame));
         event
     }
 }
@@ -239,9 +237,9 @@ pub async fn run<I, S, W, M, A, L>(
         ports.wheel.drain_edges(&mut |t| sampler.wheel_edge(t));
         let inputs = Inputs {
             imu: ports.imu.read().await,
-            steer_deg: ports.steering.read_deg().await,
+            steering: ports.steering.read().await,
             marker: ports.marker.is_pressed(),
-            gps_stale: shared.gps_stale(now_us, GPS_STALE_US),
+            last_gps_fix_us: shared.last_fix_us(),
         };
         let event = sampler.step(now_us, &inputs, &mut ports.alert, &mut |rec| {
             queue.push(rec);
@@ -249,7 +247,7 @@ pub async fn run<I, S, W, M, A, L>(
         if let Some(ev) = event {
             on_alert(now_us, ev);
         }
-        let degraded = inputs.imu.is_err() || inputs.steer_deg.is_err() || inputs.gps_stale;
+        let degraded = sampler.status.0 & DEGRADED != 0;
         ports.status_led.show(match (shared.card_ok(), degraded) {
             (false, _) => LoggerHealth::NoCard,
             (true, true) => LoggerHealth::Degraded,

@@ -5,9 +5,8 @@ use embassy_stm32::mode::Async;
 use embassy_stm32::spi::{mode::Master, Spi};
 use embassy_time::{Delay, Duration, Instant};
 use embedded_hal_bus::spi::ExclusiveDevice;
-use wobble_core::app::ports::{ImuPort, ImuReading, SensorError};
+use wobble_core::app::ports::{ImuPort, ImuSample, SensorError};
 use wobble_core::drivers::icm42688::{Error, Icm42688};
-use wobble_core::format::{quantise_i16, ACCEL_COUNTS_PER_G, GYRO_COUNTS_PER_DPS};
 use wobble_core::imu::Imu;
 
 /// The sensor's SPI device: SPI1 with its chip select.
@@ -63,7 +62,7 @@ impl ImuAdapter {
 }
 
 impl ImuPort for ImuAdapter {
-    async fn read(&mut self) -> Result<ImuReading, SensorError> {
+    async fn read(&mut self) -> Result<ImuSample, SensorError> {
         self.ensure_ready().await?;
         let raw = match self.driver.read().await {
             Ok(raw) => raw,
@@ -72,15 +71,10 @@ impl ImuPort for ImuAdapter {
         self.channel.push(raw);
         let sample = self.channel.take().ok_or(SensorError::Stale)?;
         if sample.stuck {
-            // Frozen output: reset the sensor on the next attempt.
+            // Frozen output: the frame flags it; reset the sensor on the
+            // next attempt.
             self.ready = false;
-            return Err(SensorError::Stale);
         }
-        Ok(ImuReading {
-            accel: sample.accel_g.map(|g| quantise_i16(g, ACCEL_COUNTS_PER_G)),
-            gyro: sample
-                .gyro_dps
-                .map(|r| quantise_i16(r, GYRO_COUNTS_PER_DPS)),
-        })
+        Ok(sample)
     }
 }

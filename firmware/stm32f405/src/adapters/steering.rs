@@ -4,7 +4,7 @@
 
 use embassy_stm32::adc::RingBufferedAdc;
 use embassy_stm32::peripherals::ADC1;
-use wobble_core::app::ports::{SensorError, SteeringPort};
+use wobble_core::app::ports::{SensorError, SteeringPort, SteeringSample};
 use wobble_core::steering::Steering;
 
 /// Conversions per frame, at most: 21 MHz ADC clock / (480 + 12 cycles)
@@ -33,15 +33,11 @@ impl SteeringAdapter {
 }
 
 impl SteeringPort for SteeringAdapter {
-    async fn read_deg(&mut self) -> Result<f32, SensorError> {
+    async fn read(&mut self) -> Result<SteeringSample, SensorError> {
         let n = self.adc.read_latest(&mut self.frame);
         self.channel
             .push_all(self.frame.get(..n).unwrap_or_default());
-        let sample = self.channel.take().ok_or(SensorError::Stale)?;
-        if sample.saturated {
-            // At an end stop, wiper lifted or unplugged: not an angle.
-            return Err(SensorError::OutOfRange);
-        }
-        Ok(sample.deg)
+        // No conversion since the last frame: the DMA ring stopped.
+        self.channel.take().ok_or(SensorError::Stale)
     }
 }
