@@ -214,12 +214,13 @@ fn encode_gps(w: &mut Writer<'_>, g: &GpsFix, sdelta: i64) -> Option<()> {
     };
     let position = g.lat_e7.zip(g.lon_e7);
     let quality = g.sats.is_some() || g.hdop_d.is_some();
-    let flags = u8::from(g.utc.is_some()) * GPS_UTC
-        | u8::from(position.is_some()) * GPS_POS
-        | u8::from(g.speed_cm_s.is_some()) * GPS_SPEED
-        | u8::from(g.course_cdeg.is_some()) * GPS_COURSE
-        | u8::from(g.alt_cm.is_some()) * GPS_ALT
-        | u8::from(quality) * GPS_QUALITY
+    let bit = |present: bool, mask: u8| if present { mask } else { 0 };
+    let flags = bit(g.utc.is_some(), GPS_UTC)
+        | bit(position.is_some(), GPS_POS)
+        | bit(g.speed_cm_s.is_some(), GPS_SPEED)
+        | bit(g.course_cdeg.is_some(), GPS_COURSE)
+        | bit(g.alt_cm.is_some(), GPS_ALT)
+        | bit(quality, GPS_QUALITY)
         | (fix_bits << GPS_FIX_SHIFT);
     w.u8(TAG_GPS)?;
     w.uvar(varint::zigzag(sdelta))?;

@@ -14,33 +14,75 @@ pub const STEER_COUNTS_PER_DEG: f32 = 100.0;
 /// `Frame::wheel_edge_age_us` value meaning "no edge in the last 65.534 ms".
 pub const EDGE_AGE_NONE: u16 = u16::MAX;
 
-/// Round and saturate a physical value into an `i16` field. Computed in
-/// `f64` so that the quantisation error is half a count, whatever the input.
+/// A physical value that can be quantised: `f32` in the firmware (hardware
+/// floating point, no soft-float `f64` on the sampling path) and `f64` on the
+/// host (CSV input, where the error must stay within half a count).
+pub trait Physical: Copy {
+    /// `self × counts_per_unit`, rounded half away from zero, saturated to
+    /// the `i32` range (NaN gives 0).
+    fn counts(self, counts_per_unit: f32) -> i32;
+}
+
+impl Physical for f32 {
+    fn counts(self, counts_per_unit: f32) -> i32 {
+        // Adding the half and letting `as` truncate toward zero rounds half
+        // away from zero without `f32::round`, which needs std.
+        let x = self * counts_per_unit;
+        (if x >= 0.0 { x + 0.5 } else { x - 0.5 }) as i32
+    }
+}
+
+impl Physical for f64 {
+    fn counts(self, counts_per_unit: f32) -> i32 {
+        let x = self * f64::from(counts_per_unit);
+        (if x >= 0.0 { x + 0.5 } else { x - 0.5 }) as i32
+    }
+}
+
+/// Round and saturate a physical value into an `i16` field.
 #[must_use]
-pub fn quantise_i16(value: impl Into<f64>, counts_per_unit: f32) -> i16 {
-    // `as` saturates and maps NaN to 0, which is what a log wants.
-    round_half_away(value.into() * f64::from(counts_per_unit)) as i16
+pub fn quantise_i16(value: impl Physical, counts_per_unit: f32) -> i16 {
+    value.counts(counts_per_unit).clamp(i16::MIN.into(), i16::MAX.into()) as i16
 }
 
 /// Round and saturate a physical value into a `u16` field.
 #[must_use]
-pub fn quantise_u16(value: impl Into<f64>, counts_per_unit: f32) -> u16 {
-    round_half_away(value.into() * f64::from(counts_per_unit)) as u16
+pub fn quantise_u16(value: impl Physical, counts_per_unit: f32) -> u16 {
+    value.counts(counts_per_unit).clamp(0, u16::MAX.into()) as u16
 }
 
-/// Round and saturate a physical value into an `i32` field.
+/// Round and saturate a physical value into an `i32` field (positions, on
+/// the host and in the GPS path: computed in `f64`).
 #[must_use]
 pub fn quantise_i32(value: f64, counts_per_unit: f64) -> i32 {
-    round_half_away(value * counts_per_unit) as i32
+    let x = value * counts_per_unit;
+    (if x >= 0.0 { x + 0.5 } else { x - 0.5 }) as i32
 }
 
-/// `f64::round` needs std; adding the half and letting `as` truncate toward
-/// zero rounds half away from zero.
-fn round_half_away(x: f64) -> f64 {
-    if x >= 0.0 {
-        x + 0.5
-    } else {
-        x - 0.5
+#[cfg(test)]
+mod quantise_tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    proptest! {
+        #[test]
+        fn within_half_a_count_and_saturating(v in -100.0f64..100.0, k in prop::sample::select(vec![2048.0f32, 32.0, 100.0, 1000.0])) {
+            let exact = v * f64::from(k);
+            let q = f64::from(quantise_i16(v, k));
+            let clamped = exact.clamp(f64::from(i16::MIN), f64::from(i16::MAX));
+            prop_assert!((q - clamped).abs() <= 0.5 + 1e-9, "{} {}", q, exact);
+            // The f32 path agrees with the f64 one up to f32's own rounding.
+            let q32 = f64::from(quantise_i16(v as f32, k));
+            prop_assert!((q32 - q).abs() <= 1.0);
+            let u = f64::from(quantise_u16(v, k));
+            prop_assert!((u - exact.clamp(0.0, 65535.0)).abs() <= 0.5 + 1e-9);
+        }
+    }
+
+    #[test]
+    fn nan_is_zero() {
+        assert_eq!(quantise_i16(f32::NAN, 100.0), 0);
+        assert_eq!(quantise_u16(f64::NAN, 100.0), 0);
     }
 }
 
