@@ -134,7 +134,9 @@ fn card_absent_at_boot_then_inserted() {
     let (out, logs) = run("absent", scenario, |_| Ok(()));
     let log = &logs[0];
     let lost = assert_accounted(&out, log, DropoutReason::CardUnavailable);
-    assert!((250..=300).contains(&lost), "lost {lost}");
+    // The card is back at 2.5 s and found by the next retry (every 1 s), at
+    // 3 s; the frames sampled while the file is opened are lost too.
+    assert!((250..=310).contains(&lost), "lost {lost}");
     let absent: Vec<_> = log
         .faults
         .iter()

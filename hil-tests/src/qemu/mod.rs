@@ -1,5 +1,5 @@
 //! The QEMU harness: builds the firmware image for `netduinoplus2`, runs it
-//! under `qemu-system-arm -icount shift=auto,sleep=off` on fixtures with a
+//! under `qemu-system-arm -icount shift=3,sleep=off` on fixtures with a
 //! fresh FAT32 card image, and reads back what it wrote.
 //!
 //! ```text

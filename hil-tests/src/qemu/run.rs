@@ -211,7 +211,14 @@ pub fn run(
             "null",
         ])
         .args(["-semihosting-config", "enable=on,target=native"])
-        .args(["-icount", "shift=auto,sleep=off", "-kernel"])
+        // A fixed 8 ns per instruction (125 MIPS, close to the F405's
+        // 168 MHz) instead of `shift=auto`: auto scales virtual time to the
+        // host's speed, so on a loaded machine the emulated CPU slowed to a
+        // crawl, the detector's 50 ms hop made ticks 4 ms late and the
+        // timing assertions failed at random. A fixed shift makes a run's
+        // virtual time a function of the instructions alone; `sleep=off`
+        // still skips idle time.
+        .args(["-icount", "shift=3,sleep=off", "-kernel"])
         .arg(&image)
         .stdin(Stdio::null())
         .stdout(Stdio::piped())
