@@ -335,7 +335,9 @@ fn write_unsigned(out: &mut dyn TextOut, mut value: u32) -> fmt::Result {
             break;
         }
     }
-    ascii[start..].iter().try_for_each(|&d| out.write_char(char::from(d)))
+    ascii[start..]
+        .iter()
+        .try_for_each(|&d| out.write_char(char::from(d)))
 }
 
 /// Mounting axes as text: `+x`, `-y`, ...
@@ -418,13 +420,79 @@ impl Field for bool {
     }
 }
 
-/// One key of the file: its name, section, and how to set and show it.
+/// A reference to one field of a [`Config`], by type. Each key only says
+/// where its field is; parsing and writing are written once per type here
+/// rather than once per key, which keeps the firmware small.
+enum Slot<'a> {
+    F32(&'a mut f32),
+    U8(&'a mut u8),
+    U16(&'a mut u16),
+    U32(&'a mut u32),
+    Bool(&'a mut bool),
+    Axes(&'a mut AxisMap),
+    CalPoints(&'a mut Option<[CalPoint; 3]>),
+}
+
+macro_rules! slot_from {
+    ($($t:ty => $variant:ident),+) => {$(
+        impl<'a> From<&'a mut $t> for Slot<'a> {
+            fn from(field: &'a mut $t) -> Self {
+                Self::$variant(field)
+            }
+        }
+    )+};
+}
+slot_from!(f32 => F32, u8 => U8, u16 => U16, u32 => U32, bool => Bool, AxisMap => Axes,
+    Option<[CalPoint; 3]> => CalPoints);
+
+/// Sets `field` from `text`; `false` when it does not parse.
+fn set<T: Field>(field: &mut T, text: &str) -> bool {
+    T::parse(text).map(|v| *field = v).is_some()
+}
+
+impl Slot<'_> {
+    fn apply(self, text: &str) -> bool {
+        match self {
+            Self::F32(f) => set(f, text),
+            Self::U8(f) => set(f, text),
+            Self::U16(f) => set(f, text),
+            Self::U32(f) => set(f, text),
+            Self::Bool(f) => set(f, text),
+            Self::Axes(f) => set(f, text),
+            Self::CalPoints(f) => set(f, text),
+        }
+    }
+
+    fn write(self, out: &mut dyn TextOut) -> fmt::Result {
+        match self {
+            Self::F32(f) => f.write(out),
+            Self::U8(f) => f.write(out),
+            Self::U16(f) => f.write(out),
+            Self::U32(f) => f.write(out),
+            Self::Bool(f) => f.write(out),
+            Self::Axes(f) => f.write(out),
+            Self::CalPoints(f) => f.write(out),
+        }
+    }
+}
+
+/// One key of the file: its name, section, and where its field is.
 struct Key {
     name: &'static str,
     section: Section,
+    slot: fn(&mut Config) -> Slot<'_>,
+}
+
+impl Key {
     /// Parses `text` into the field; `false` when it does not parse.
-    apply: fn(&mut Config, &str) -> bool,
-    show: fn(&Config, &mut dyn TextOut) -> fmt::Result,
+    fn apply(&self, config: &mut Config, text: &str) -> bool {
+        (self.slot)(config).apply(text)
+    }
+
+    fn show(&self, config: &Config, out: &mut dyn TextOut) -> fmt::Result {
+        let mut copy = *config;
+        (self.slot)(&mut copy).write(out)
+    }
 }
 
 /// A key named for its field's path in [`Config`].
@@ -433,14 +501,7 @@ macro_rules! key {
         Key {
             name: stringify!($($field).+),
             section: Section::$section,
-            apply: |config, text| match Field::parse(text) {
-                Some(value) => {
-                    config.$($field).+ = value;
-                    true
-                }
-                None => false,
-            },
-            show: |config, out| Field::write(config.$($field).+, out),
+            slot: |config| Slot::from(&mut config.$($field).+),
         }
     };
 }
@@ -542,7 +603,7 @@ impl Config {
                 faults.push(line_no, FAULT_UNKNOWN_KEY);
                 continue;
             };
-            if !(key.apply)(&mut config, value) {
+            if !key.apply(&mut config, value) {
                 faults.push(line_no, FAULT_BAD_VALUE);
                 continue;
             }
@@ -573,7 +634,7 @@ impl Config {
         for key in KEYS {
             out.write_str(key.name)?;
             out.write_char('=')?;
-            (key.show)(self, out)?;
+            key.show(self, out)?;
             out.write_char('\n')?;
         }
         Ok(())
@@ -924,7 +985,7 @@ steering.three_point=1:2,3
                 &three_point,
             ]
             .iter()
-            .any(|v| (key.apply)(&mut c, v));
+            .any(|v| key.apply(&mut c, v));
             assert!(applied, "{}", key.name);
         }
         let text = text_of(&c);

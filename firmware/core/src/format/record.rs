@@ -42,7 +42,9 @@ impl Physical for f64 {
 /// Round and saturate a physical value into an `i16` field.
 #[must_use]
 pub fn quantise_i16(value: impl Physical, counts_per_unit: f32) -> i16 {
-    value.counts(counts_per_unit).clamp(i16::MIN.into(), i16::MAX.into()) as i16
+    value
+        .counts(counts_per_unit)
+        .clamp(i16::MIN.into(), i16::MAX.into()) as i16
 }
 
 /// Round and saturate a physical value into a `u16` field.
