@@ -14,12 +14,19 @@ const FRAMES_PER_HOUR: usize = 100 * 3600;
 /// A one-hour ride as CSV: a 6.4 Hz steering wobble, speed and a GPS track.
 fn one_hour_csv() -> Vec<u8> {
     let mut csv = Vec::with_capacity(FRAMES_PER_HOUR * 80);
-    csv.extend_from_slice(b"t_s,ax_g,az_g,gz_dps,steer_deg,speed_mps,gps_lat_deg,gps_lon_deg,gps_speed_mps,gps_fix\n");
+    csv.extend_from_slice(
+        b"t_s,ax_g,az_g,gz_dps,steer_deg,speed_mps,gps_lat_deg,gps_lon_deg,gps_speed_mps,gps_fix\n",
+    );
     for i in 0..FRAMES_PER_HOUR {
         let t = i as f64 / 100.0;
         let steer = 2.0 * (t * 6.4 * std::f64::consts::TAU).sin();
         let lat = 52.2 + t * 1e-5;
-        writeln!(csv, "{t},0.05,1.0,{:.3},{steer:.2},4.2,{lat:.7},6.88,4.2,3d", steer * 3.0).unwrap();
+        writeln!(
+            csv,
+            "{t},0.05,1.0,{:.3},{steer:.2},4.2,{lat:.7},6.88,4.2,3d",
+            steer * 3.0
+        )
+        .unwrap();
     }
     csv
 }
@@ -34,7 +41,10 @@ fn benches(c: &mut Criterion) {
     let mut group = c.benchmark_group("export");
     group.sample_size(10);
     group.throughput(Throughput::Elements(FRAMES_PER_HOUR as u64));
-    for (name, format) in [("csv_one_hour", Format::Csv), ("jsonl_one_hour", Format::Jsonl)] {
+    for (name, format) in [
+        ("csv_one_hour", Format::Csv),
+        ("jsonl_one_hour", Format::Jsonl),
+    ] {
         group.bench_function(name, |b| {
             b.iter(|| decode::decode_to(&log, format, std::io::sink(), Path::new("sink")).unwrap())
         });

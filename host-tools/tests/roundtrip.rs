@@ -26,14 +26,23 @@ fn rows() -> impl Strategy<Value = Vec<CsvRow>> {
         -300.0..300.0f64,
         0.0..60.0f64,
     );
-    let gps = proptest::option::of((-90.0..90.0f64, -180.0..180.0f64, 0.0..600.0f64, prop_oneof![Just("2d"), Just("3d")]));
+    let gps = proptest::option::of((
+        -90.0..90.0f64,
+        -180.0..180.0f64,
+        0.0..600.0f64,
+        prop_oneof![Just("2d"), Just("3d")],
+    ));
     (vec((value_ranges, gps, 0..40u64), 1..600), 0..10_000u64).prop_map(|(items, start_cs)| {
         let mut t_cs = start_cs;
         items
             .into_iter()
             .map(|((a, b, c, d, e, f, g, h), gps, jitter_us)| {
                 t_cs += 1;
-                CsvRow { t_s: t_cs as f64 / 100.0 + jitter_us as f64 * 1e-6, values: [a, b, c, d, e, f, g, h], gps }
+                CsvRow {
+                    t_s: t_cs as f64 / 100.0 + jitter_us as f64 * 1e-6,
+                    values: [a, b, c, d, e, f, g, h],
+                    gps,
+                }
             })
             .collect()
     })
@@ -66,7 +75,16 @@ fn round_trip(csv: &str, format: Format) -> String {
 }
 
 /// Largest error a stored value may show: half a count of each column.
-const TOLERANCE: [f64; 8] = [0.5 / 2048.0, 0.5 / 2048.0, 0.5 / 2048.0, 0.5 / 32.0, 0.5 / 32.0, 0.5 / 32.0, 0.005, 0.0005];
+const TOLERANCE: [f64; 8] = [
+    0.5 / 2048.0,
+    0.5 / 2048.0,
+    0.5 / 2048.0,
+    0.5 / 32.0,
+    0.5 / 32.0,
+    0.5 / 32.0,
+    0.005,
+    0.0005,
+];
 
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(64))]

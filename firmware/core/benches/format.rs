@@ -16,8 +16,16 @@ fn ride(frames: u64) -> impl Iterator<Item = Record<'static>> {
         let wave = |k: u64, amp: i64| ((i * k) % 200) as i64 * amp / 100 - amp;
         let frame = Frame {
             t_us,
-            accel: [wave(3, 300) as i16, wave(5, 200) as i16, 2048 + wave(7, 100) as i16],
-            gyro: [wave(11, 900) as i16, wave(13, 600) as i16, wave(17, 1200) as i16],
+            accel: [
+                wave(3, 300) as i16,
+                wave(5, 200) as i16,
+                2048 + wave(7, 100) as i16,
+            ],
+            gyro: [
+                wave(11, 900) as i16,
+                wave(13, 600) as i16,
+                wave(17, 1200) as i16,
+            ],
             steer_cdeg: wave(19, 500) as i16,
             wheel_count: (i * 9 / 10) as u16,
             wheel_edge_age_us: (i % 11_000) as u16,
@@ -27,7 +35,10 @@ fn ride(frames: u64) -> impl Iterator<Item = Record<'static>> {
         let gps = (i % 5 == 0).then(|| {
             Record::Gps(GpsFix {
                 t_us: t_us - 3_000,
-                utc: Some(UtcTime { days_since_2000: 7382, ms_of_day: (i * 10) as u32 }),
+                utc: Some(UtcTime {
+                    days_since_2000: 7382,
+                    ms_of_day: (i * 10) as u32,
+                }),
                 lat_e7: Some(522_100_000 + i as i32),
                 lon_e7: Some(68_800_000 - i as i32),
                 speed_cm_s: Some(400),
@@ -77,11 +88,19 @@ fn benches(c: &mut Criterion) {
     let mut group = c.benchmark_group("format");
     group.sample_size(20);
     group.throughput(Throughput::Bytes(log.len() as u64));
-    group.bench_function("decode_one_hour_bytes", |b| b.iter(|| decode(black_box(&log))));
+    group.bench_function("decode_one_hour_bytes", |b| {
+        b.iter(|| decode(black_box(&log)))
+    });
     group.throughput(Throughput::Elements(FRAMES_PER_HOUR));
-    group.bench_function("decode_one_hour_frames", |b| b.iter(|| decode(black_box(&log))));
+    group.bench_function("decode_one_hour_frames", |b| {
+        b.iter(|| decode(black_box(&log)))
+    });
     group.bench_function("encode_one_hour_frames", |b| {
-        b.iter_batched(|| (), |()| encode_log(FRAMES_PER_HOUR), BatchSize::SmallInput)
+        b.iter_batched(
+            || (),
+            |()| encode_log(FRAMES_PER_HOUR),
+            BatchSize::SmallInput,
+        )
     });
     group.finish();
 }
