@@ -32,6 +32,10 @@ fn bundled_ride_logs_every_frame_fix_and_alert() {
     let log = &logs[0];
     assert_eq!(log.name, "RUN00001.WBL");
     assert!(log.starts_with_header);
+    // The header holds the configuration in force, complete and exact.
+    let in_force = wobble_core::config::Config::parse(log.summary.config.join("\n").as_bytes());
+    assert!(in_force.faults.is_empty(), "{:?}", in_force.faults);
+    assert_eq!(in_force.config, wobble_core::config::Config::default());
 
     // Exactly duration x 100 frames, 10 ms apart, no dropout.
     assert_eq!(log.frames.len(), FRAMES as usize);

@@ -23,14 +23,15 @@ use wobble_core::app::ports::{AlertOutput, LoggerHealth, StatusLed};
 use wobble_core::app::sampler::{Sampler, SamplerPorts};
 use wobble_core::app::{gps, sampler, writer};
 use wobble_core::channels::{RecordQueue, SharedStatus};
-use wobble_core::detector::{Detector, DetectorConfig, PatternConfig};
+use wobble_core::config::{Config, KEY_COUNT, MAX_TEXT_LEN};
+use wobble_core::detector::Detector;
 use wobble_core::frame_assembly::FrameConfig;
 use wobble_core::gps::{GpsConfig, GpsReceiver};
 use wobble_core::logger::{
     CardLogger, FixedTime, HeaderSpec, LoggerConfig, FAULT_CARD_ABSENT, FAULT_CARD_FULL,
     FAULT_CARD_WRITE,
 };
-use wobble_core::wheel::{WheelConfig, WheelSpeed};
+use wobble_core::wheel::WheelSpeed;
 
 use crate::card::SemihostingCard;
 use crate::replay::{Gps, Port, Ride};
@@ -47,13 +48,25 @@ static MAX_LATE_US: AtomicU32 = AtomicU32::new(0);
 const SYSTICK_PRIORITY: u8 = 0x40;
 const SAMPLER_PRIORITY: u8 = 0x80;
 
-/// Configuration lines written into every log's header.
-const CONFIG_LINES: [&str; 4] = [
-    "source=qemu-netduinoplus2",
-    "sample_rate_hz=100",
-    "flush_period_ms=500",
-    "detector=defaults",
-];
+/// The configuration in force: the defaults, as on a card without
+/// `CONFIG.TXT` (the image's card holds only the log).
+fn config() -> Config {
+    Config::default()
+}
+
+/// The configuration's `key=value` lines for the log header, as the board
+/// writes them.
+fn config_lines() -> &'static [&'static str] {
+    static TEXT: StaticCell<heapless::String<MAX_TEXT_LEN>> = StaticCell::new();
+    static LINES: StaticCell<heapless::Vec<&'static str, KEY_COUNT>> = StaticCell::new();
+    let text = TEXT.init(heapless::String::new());
+    if config().write_lines(text).is_err() {
+        report::line(format_args!("FATAL configuration text too long"));
+        semihosting::process::exit(2)
+    }
+    let text: &'static heapless::String<MAX_TEXT_LEN> = text;
+    LINES.init(text.lines().take(KEY_COUNT).collect())
+}
 
 /// The buzzer and the alert LED: the harness hears the alert through the
 /// `ALERT` lines instead.
@@ -81,19 +94,15 @@ impl StatusLed for StatusLine {
 
 #[embassy_executor::task]
 async fn sampler_task(ride: &'static RefCell<Ride>, frames: u32) {
+    let config = config();
     let (Ok(wheel), Ok(detector)) = (
-        WheelSpeed::try_new(WheelConfig::DEFAULT),
-        Detector::new(DetectorConfig::DEFAULT),
+        WheelSpeed::try_new(config.wheel),
+        Detector::new(config.detector),
     ) else {
         report::line(format_args!("FATAL default configuration rejected"));
         semihosting::process::exit(2)
     };
-    let mut s = Sampler::new(
-        wheel,
-        FrameConfig::DEFAULT,
-        detector,
-        PatternConfig::DEFAULT,
-    );
+    let mut s = Sampler::new(wheel, FrameConfig::DEFAULT, detector, config.alert.pattern);
     let mut ports = SamplerPorts {
         imu: Port(ride),
         steering: Port(ride),
@@ -130,7 +139,7 @@ async fn writer_task(scenario: &'static Scenario) {
         firmware: concat!("wobble-qemu-image ", env!("CARGO_PKG_VERSION")),
         device_id: *b"QEMU-NETDUI2",
         sample_rate_hz: 100,
-        config: &CONFIG_LINES,
+        config: config_lines(),
     };
     let card = SemihostingCard::open(scenario);
     let mut logger = CardLogger::new(card, FixedTime::EPOCH, header, LoggerConfig::DEFAULT);
