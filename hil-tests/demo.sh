@@ -13,18 +13,8 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 OUT="${1:-out/demo}"
-TARGET=thumbv7em-none-eabihf
 
-rustup target list --installed | grep -qx "$TARGET" || rustup target add "$TARGET"
-missing=()
-command -v qemu-system-arm >/dev/null || missing+=(qemu-system-arm)
-{ command -v mkfs.fat && command -v fsck.fat; } >/dev/null || missing+=(dosfstools)
-if ((${#missing[@]})); then
-    SUDO=""
-    [ "$(id -u)" -eq 0 ] || SUDO=sudo
-    $SUDO apt-get update
-    DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y "${missing[@]}"
-fi
+source hil-tests/install-tools.sh
 
 rm -rf "$OUT"
 mkdir -p "$OUT"

@@ -9,20 +9,9 @@ TARGET=thumbv7em-none-eabihf
 
 step() { printf '\n==> %s\n' "$*"; }
 
-step "toolchain components and the $TARGET target"
+step "toolchain components, the $TARGET target, QEMU and dosfstools (installed only when missing)"
 rustup component add rustfmt clippy >/dev/null 2>&1 || true
-rustup target list --installed | grep -qx "$TARGET" || rustup target add "$TARGET"
-
-step "QEMU and dosfstools for the emulator tests (apt-get only when missing)"
-missing=()
-command -v qemu-system-arm >/dev/null || missing+=(qemu-system-arm)
-{ command -v mkfs.fat && command -v fsck.fat; } >/dev/null || missing+=(dosfstools)
-if ((${#missing[@]})); then
-    SUDO=""
-    [ "$(id -u)" -eq 0 ] || SUDO=sudo
-    $SUDO apt-get update
-    DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y "${missing[@]}"
-fi
+source hil-tests/install-tools.sh
 
 step "cargo fmt --check"
 cargo fmt --all -- --check
