@@ -185,6 +185,38 @@ fn load_scenario() -> &'static Scenario {
     }
 }
 
+/// Most steering samples the detector benchmark holds.
+const BENCH_SAMPLES: usize = 3000;
+
+/// Times the wobble detector alone over the ride's steering at 4 m/s:
+/// `BENCH detector samples=N us=T`, virtual time, which the harness turns
+/// into instructions. The samples are read first, so no file access is
+/// timed.
+fn bench_detector(ride: &mut Ride) -> ! {
+    static SAMPLES: StaticCell<heapless::Vec<f32, BENCH_SAMPLES>> = StaticCell::new();
+    let samples = SAMPLES.init(heapless::Vec::new());
+    while let Some(deg) = ride.next_steer_deg() {
+        if samples.push(deg).is_err() {
+            break;
+        }
+    }
+    let Ok(mut detector) = Detector::new(config().detector) else {
+        report::line(format_args!("FATAL default configuration rejected"));
+        semihosting::process::exit(2)
+    };
+    let start = Instant::now();
+    let alerts = samples
+        .iter()
+        .filter(|&&deg| detector.push(deg, Some(4.0)).is_some())
+        .count();
+    let us = Instant::now().as_micros() - start.as_micros();
+    report::line(format_args!(
+        "BENCH detector samples={} us={us} alert_changes={alerts}",
+        samples.len()
+    ));
+    semihosting::process::exit(0)
+}
+
 #[entry]
 fn main() -> ! {
     let Some(mut cp) = cortex_m::Peripherals::take() else {
@@ -194,6 +226,9 @@ fn main() -> ! {
     static RIDE: StaticCell<RefCell<Ride>> = StaticCell::new();
     let ride: &'static RefCell<Ride> = RIDE.init(RefCell::new(Ride::open(scenario)));
     time_driver::init(cp.SYST, &mut cp.SCB, SYSTICK_PRIORITY);
+    if scenario.bench_detector {
+        bench_detector(&mut ride.borrow_mut())
+    }
     let high = executor::start_high(&mut cp.SCB, SAMPLER_PRIORITY);
     high.spawn(sampler_task(ride, scenario.frames).expect("one sampler task"));
     executor::run_thread(|spawner| {

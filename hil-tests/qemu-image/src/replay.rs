@@ -121,6 +121,13 @@ impl Ride {
     }
 }
 
+impl Ride {
+    /// The next frame's steering angle, degrees; `None` at the end.
+    pub fn next_steer_deg(&mut self) -> Option<f32> {
+        read_row(&mut self.file).map(|row| row.steering.deg)
+    }
+}
+
 /// One sensor's view of the shared ride.
 #[derive(Clone, Copy)]
 pub struct Port(pub &'static RefCell<Ride>);

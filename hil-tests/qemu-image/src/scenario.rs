@@ -10,6 +10,7 @@
 //! | `card_absent_ms=A:B` | the card does not answer from A to B ms |
 //! | `imu_dead_ms=A` | the IMU stops answering at A ms |
 //! | `gps_garbage_ms=A:B` | the GPS sends noise instead of NMEA from A to B ms |
+//! | `bench=detector` | no ride: time the wobble detector over the ride's steering |
 
 use heapless::Vec;
 
@@ -25,6 +26,7 @@ pub struct Scenario {
     pub card_absent_ms: Option<(u32, u32)>,
     pub imu_dead_from_ms: Option<u32>,
     pub gps_garbage_ms: Option<(u32, u32)>,
+    pub bench_detector: bool,
 }
 
 fn pair(v: &str) -> Option<(u32, u32)> {
@@ -46,6 +48,9 @@ impl Scenario {
                 "card_absent_ms" => pair(value).map(|p| s.card_absent_ms = Some(p)).is_some(),
                 "imu_dead_ms" => value.parse().map(|t| s.imu_dead_from_ms = Some(t)).is_ok(),
                 "gps_garbage_ms" => pair(value).map(|p| s.gps_garbage_ms = Some(p)).is_some(),
+                "bench" => (value == "detector")
+                    .then(|| s.bench_detector = true)
+                    .is_some(),
                 _ => false,
             };
             if !ok {

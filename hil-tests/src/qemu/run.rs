@@ -15,6 +15,10 @@ use crate::corpus::Row;
 pub const TARGET: &str = "thumbv7em-none-eabihf";
 /// A run taking longer than this on the wall clock has hung.
 pub const WALL_LIMIT: Duration = Duration::from_secs(180);
+/// QEMU's instruction clock: each instruction takes 2^shift ns of virtual
+/// time, so 8 ns (125 MIPS, about the F405's 168 MHz at a little over one
+/// cycle per instruction). Virtual µs × 1000 / 8 counts instructions.
+pub const ICOUNT_SHIFT: u32 = 3;
 
 /// Builds the image (once per process; a no-op when it is up to date) and
 /// returns its path.
@@ -68,6 +72,9 @@ pub struct Scenario {
     pub imu_dead_from_ms: Option<u32>,
     /// GPS noise from/to, ms.
     pub gps_garbage_ms: Option<(u32, u32)>,
+    /// Instead of riding, time the wobble detector over the ride's steering
+    /// and report it in a `BENCH` line.
+    pub bench_detector: bool,
 }
 
 impl Scenario {
@@ -93,6 +100,9 @@ impl Scenario {
         }
         if let Some(t) = self.imu_dead_from_ms {
             s += &format!("imu_dead_ms={t}\n");
+        }
+        if self.bench_detector {
+            s += "bench=detector\n";
         }
         if let Some((a, b)) = self.gps_garbage_ms {
             s += &format!("gps_garbage_ms={a}:{b}\n");
@@ -211,14 +221,17 @@ pub fn run(
             "null",
         ])
         .args(["-semihosting-config", "enable=on,target=native"])
-        // A fixed 8 ns per instruction (125 MIPS, close to the F405's
-        // 168 MHz) instead of `shift=auto`: auto scales virtual time to the
+        // A fixed instruction clock instead of `shift=auto`: auto scales virtual time to the
         // host's speed, so on a loaded machine the emulated CPU slowed to a
         // crawl, the detector's 50 ms hop made ticks 4 ms late and the
         // timing assertions failed at random. A fixed shift makes a run's
         // virtual time a function of the instructions alone; `sleep=off`
         // still skips idle time.
-        .args(["-icount", "shift=3,sleep=off", "-kernel"])
+        .args([
+            "-icount",
+            &format!("shift={ICOUNT_SHIFT},sleep=off"),
+            "-kernel",
+        ])
         .arg(&image)
         .stdin(Stdio::null())
         .stdout(Stdio::piped())
