@@ -212,6 +212,18 @@ mod tests {
         })
     }
 
+    /// The writer's side: takes everything queued, noting each frame with
+    /// the frames reported lost before it.
+    fn drain(q: &RecordQueue, delivered: &mut Vec<(u64, u64)>, lost: &mut u64) {
+        while let Some(r) = q.try_pop() {
+            match r {
+                Record::Frame(f) => delivered.push((f.t_us, *lost)),
+                Record::Dropout(d) => *lost += u64::from(d.frames_lost),
+                _ => {}
+            }
+        }
+    }
+
     proptest! {
         /// A writer that stalls for any stretch: every frame is either
         /// delivered in order or counted in a dropout record that comes
@@ -226,13 +238,7 @@ mod tests {
                 for _ in 0..run_ms / 10 {
                     q.push(frame(t));
                     t += 10_000;
-                    while let Some(r) = q.try_pop() {
-                        match r {
-                            Record::Frame(f) => delivered.push((f.t_us, lost)),
-                            Record::Dropout(d) => lost += u64::from(d.frames_lost),
-                            _ => {}
-                        }
-                    }
+                    drain(&q, &mut delivered, &mut lost);
                 }
                 for _ in 0..stall_ms / 10 {
                     q.push(frame(t));
@@ -241,13 +247,7 @@ mod tests {
             }
             q.push(frame(t));
             t += 10_000;
-            while let Some(r) = q.try_pop() {
-                match r {
-                    Record::Frame(f) => delivered.push((f.t_us, lost)),
-                    Record::Dropout(d) => lost += u64::from(d.frames_lost),
-                    _ => {}
-                }
-            }
+            drain(&q, &mut delivered, &mut lost);
             let total = t / 10_000;
             prop_assert_eq!(delivered.len() as u64 + lost + u64::from(q.frames_dropped_pending()), total);
             // Each delivered frame's index = frames before it delivered + lost before it.

@@ -78,6 +78,16 @@ fn checksummed(body: &str) -> String {
     format!("${body}*{cs:02X}")
 }
 
+/// The valid lines of `stream` that start at or after `offset_us`, with
+/// their times made relative to it.
+fn lines_after(stream: &[u8], offset_us: u64) -> Vec<(u64, String)> {
+    valid_lines(stream)
+        .into_iter()
+        .filter(|(t, _)| *t >= offset_us)
+        .map(|(t, text)| (t - offset_us, text))
+        .collect()
+}
+
 proptest! {
     #[test]
     fn garbage_then_a_capture_parses_the_capture_exactly(
@@ -90,11 +100,7 @@ proptest! {
 
         // Line level: after the garbage, exactly the capture's valid lines.
         let reference = valid_lines(&capture.bytes);
-        let after: Vec<_> = valid_lines(&stream)
-            .into_iter()
-            .filter(|(t, _)| *t >= offset)
-            .map(|(t, text)| (t - offset, text))
-            .collect();
+        let after = lines_after(&stream, offset);
         prop_assert_eq!(after, reference);
 
         // Fix level: the same fixes, shifted by the garbage's duration.
@@ -115,11 +121,7 @@ proptest! {
         let offset = garbage.len() as u64 * BYTE_US;
         let stream = [garbage.as_slice(), &capture.bytes].concat();
         let reference = valid_lines(&capture.bytes);
-        let after: Vec<_> = valid_lines(&stream)
-            .into_iter()
-            .filter(|(t, _)| *t >= offset)
-            .map(|(t, text)| (t - offset, text))
-            .collect();
+        let after = lines_after(&stream, offset);
         prop_assert_eq!(after, reference);
         // And the whole path survives it.
         let _ = receive(&stream);
