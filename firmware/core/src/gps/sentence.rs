@@ -9,7 +9,7 @@
 use nmea::sentences::{FixType, GgaData, GllData, GsaData, RmcData, VtgData, ZdaData};
 use nmea::ParseResult;
 
-use crate::format::{FixMode, UtcTime};
+use crate::format::{quantise_i32, FixMode, UtcTime};
 
 /// Metres per second in one knot.
 const MPS_PER_KNOT: f64 = 1852.0 / 3600.0;
@@ -175,7 +175,7 @@ fn from_gga(d: &GgaData) -> Option<Update> {
         tod_ms: d.fix_time.map(tod_ms),
         lat_e7: d.latitude.map(deg_e7),
         lon_e7: d.longitude.map(deg_e7),
-        alt_cm: d.altitude.map(|m| round_i32(f64::from(m) * 100.0)),
+        alt_cm: d.altitude.map(|m| quantise_i32(f64::from(m), 100.0)),
         sats: d.fix_satellites.map(|n| n.min(u32::from(u8::MAX)) as u8),
         hdop_d: d.hdop.map(hdop_d),
         validity,
@@ -246,26 +246,22 @@ fn date_days(d: chrono::NaiveDate) -> Option<u16> {
 }
 
 fn deg_e7(deg: f64) -> i32 {
-    round_i32(deg * 1e7)
+    quantise_i32(deg, 1e7)
 }
 
 fn knots_to_cm_s(knots: f32) -> Option<u16> {
     let cm_s = f64::from(knots) * MPS_PER_KNOT * 100.0;
-    (cm_s.is_finite() && cm_s >= 0.0).then(|| round_i32(cm_s).clamp(0, i32::from(u16::MAX)) as u16)
+    (cm_s.is_finite() && cm_s >= 0.0)
+        .then(|| quantise_i32(cm_s, 1.0).clamp(0, i32::from(u16::MAX)) as u16)
 }
 
 fn course_cdeg(deg: f32) -> Option<u16> {
     let cdeg = f64::from(deg) * 100.0;
-    (cdeg.is_finite() && (0.0..=36_000.0).contains(&cdeg)).then(|| round_i32(cdeg) as u16)
+    (cdeg.is_finite() && (0.0..=36_000.0).contains(&cdeg)).then(|| quantise_i32(cdeg, 1.0) as u16)
 }
 
 fn hdop_d(hdop: f32) -> u8 {
-    round_i32(f64::from(hdop) * 10.0).clamp(0, i32::from(u8::MAX)) as u8
-}
-
-/// Round half away from zero and saturate (NaN -> 0), without `std`.
-fn round_i32(x: f64) -> i32 {
-    (if x >= 0.0 { x + 0.5 } else { x - 0.5 }) as i32
+    quantise_i32(f64::from(hdop), 10.0).clamp(0, i32::from(u8::MAX)) as u8
 }
 
 #[cfg(test)]
