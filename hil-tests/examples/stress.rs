@@ -57,18 +57,10 @@ fn main() -> Result<(), String> {
             .and_then(|v| v.parse().ok())
             .unwrap_or(1e9);
         println!("{:?}", fx.truth.episodes);
+        println!("{}", metrics::TRACE_HEADER);
         let mut print = |t: f64, e: Estimate, on: bool| {
             if (t0..=t1).contains(&t) {
-                println!(
-                    "{t:.2} amp {:.3} f {:.2} band {} ratio {:.3} hold {} harm {} on {}",
-                    e.amp_deg,
-                    e.freq_hz,
-                    u8::from(e.in_band),
-                    e.growth_ratio,
-                    u8::from(e.impulse_holdoff),
-                    u8::from(e.at_wheel_harmonic),
-                    u8::from(on)
-                );
+                println!("{}", metrics::trace_line(t, &e, on));
             }
         };
         metrics::replay(&fx.rows()?, c, use_speed, Some(&mut print)).map_err(|e| e.to_string())?;

@@ -43,6 +43,25 @@ pub struct AlertChange {
     pub event: AlertEvent,
 }
 
+/// Header of the per-hop trace that `trace_line` writes.
+pub const TRACE_HEADER: &str = "t_s,amp_deg,freq_hz,in_band,growth_ratio,holdoff,harmonic,alert";
+
+/// One CSV line of the detector's state at `t_s` (see [`TRACE_HEADER`]),
+/// for looking into a single ride with `detector-metrics --trace`.
+#[must_use]
+pub fn trace_line(t_s: f64, e: &Estimate, alert: bool) -> String {
+    format!(
+        "{t_s:.2},{:.3},{:.2},{},{:.3},{},{},{}",
+        e.amp_deg,
+        e.freq_hz,
+        u8::from(e.in_band),
+        e.growth_ratio,
+        u8::from(e.impulse_holdoff),
+        u8::from(e.at_wheel_harmonic),
+        u8::from(alert)
+    )
+}
+
 /// Replays `rows` through a fresh detector with `cfg`, giving it the speed
 /// column if `use_speed`; `trace`, if given, receives every analysis (time,
 /// estimate, alert state).

@@ -6,7 +6,7 @@ use std::sync::OnceLock;
 
 use wobble_core::detector::DetectorConfig;
 use wobble_hil::corpus::{self, Fixture};
-use wobble_hil::metrics::{self, goals, Report};
+use wobble_hil::metrics::{self, goals, FixtureScore, Report};
 
 fn fixtures() -> &'static [Fixture] {
     static F: OnceLock<Vec<Fixture>> = OnceLock::new();
@@ -137,6 +137,17 @@ fn frequency_goal() {
     assert!(err <= goals::FREQ_ERROR_HZ, "frequency error {err:.3} Hz");
 }
 
+fn assert_no_false_alerts<'a>(fixtures: impl Iterator<Item = &'a FixtureScore>) {
+    for f in fixtures {
+        assert!(
+            f.false_alerts.is_empty(),
+            "{}: false alerts at {:?}",
+            f.name,
+            f.false_alerts
+        );
+    }
+}
+
 #[test]
 fn no_false_alerts() {
     let r = report(true);
@@ -145,14 +156,7 @@ fn no_false_alerts() {
         "{} s of non-wobble",
         r.non_wobble_s()
     );
-    for f in &r.fixtures {
-        assert!(
-            f.false_alerts.is_empty(),
-            "{}: false alerts at {:?}",
-            f.name,
-            f.false_alerts
-        );
-    }
+    assert_no_false_alerts(r.fixtures.iter());
 }
 
 /// Steering only (a CSV without speed): no harmonic canceller, no wheel-
@@ -177,14 +181,7 @@ fn without_speed_the_goals_hold_except_under_strong_ripple() {
             e.fixture
         );
     }
-    for f in r.fixtures.iter().filter(|f| !strong(&f.name)) {
-        assert!(
-            f.false_alerts.is_empty(),
-            "{}: false alerts at {:?}",
-            f.name,
-            f.false_alerts
-        );
-    }
+    assert_no_false_alerts(r.fixtures.iter().filter(|f| !strong(&f.name)));
 }
 
 #[test]

@@ -78,6 +78,12 @@ fn checksummed(body: &str) -> String {
     format!("${body}*{cs:02X}")
 }
 
+/// `capture` preceded by `garbage`, and the time the garbage takes on the
+/// wire, µs.
+fn after_garbage(garbage: &[u8], capture: &[u8]) -> (Vec<u8>, u64) {
+    ([garbage, capture].concat(), garbage.len() as u64 * BYTE_US)
+}
+
 /// The valid lines of `stream` that start at or after `offset_us`, with
 /// their times made relative to it.
 fn lines_after(stream: &[u8], offset_us: u64) -> Vec<(u64, String)> {
@@ -95,13 +101,9 @@ proptest! {
         which in 0..SMALL.len(),
     ) {
         let capture = capture(which);
-        let offset = garbage.len() as u64 * BYTE_US;
-        let stream = [garbage.as_slice(), &capture.bytes].concat();
-
+        let (stream, offset) = after_garbage(&garbage, &capture.bytes);
         // Line level: after the garbage, exactly the capture's valid lines.
-        let reference = valid_lines(&capture.bytes);
-        let after = lines_after(&stream, offset);
-        prop_assert_eq!(after, reference);
+        prop_assert_eq!(lines_after(&stream, offset), valid_lines(&capture.bytes));
 
         // Fix level: the same fixes, shifted by the garbage's duration.
         let reference = fixes(&receive(&capture.bytes));
@@ -118,11 +120,8 @@ proptest! {
         which in 0..SMALL.len(),
     ) {
         let capture = capture(which);
-        let offset = garbage.len() as u64 * BYTE_US;
-        let stream = [garbage.as_slice(), &capture.bytes].concat();
-        let reference = valid_lines(&capture.bytes);
-        let after = lines_after(&stream, offset);
-        prop_assert_eq!(after, reference);
+        let (stream, offset) = after_garbage(&garbage, &capture.bytes);
+        prop_assert_eq!(lines_after(&stream, offset), valid_lines(&capture.bytes));
         // And the whole path survives it.
         let _ = receive(&stream);
     }

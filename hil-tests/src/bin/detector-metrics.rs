@@ -34,18 +34,9 @@ fn main() -> ExitCode {
                 return ExitCode::FAILURE;
             }
         };
-        println!("t_s,amp_deg,freq_hz,in_band,growth_ratio,holdoff,harmonic,alert");
+        println!("{}", metrics::TRACE_HEADER);
         let mut print = |t: f64, e: wobble_core::detector::Estimate, on: bool| {
-            println!(
-                "{t:.2},{:.3},{:.2},{},{:.3},{},{},{}",
-                e.amp_deg,
-                e.freq_hz,
-                u8::from(e.in_band),
-                e.growth_ratio,
-                u8::from(e.impulse_holdoff),
-                u8::from(e.at_wheel_harmonic),
-                u8::from(on)
-            );
+            println!("{}", metrics::trace_line(t, &e, on));
         };
         return match metrics::replay(&rows, DetectorConfig::default(), true, Some(&mut print)) {
             Ok(_) => ExitCode::SUCCESS,
