@@ -3,8 +3,11 @@
 #![warn(missing_docs)]
 
 pub mod analysis;
+pub mod cli;
 pub mod cmd;
+pub mod codes;
 pub mod error;
+pub mod events;
 pub mod export;
 pub mod losses;
 pub mod plot;
@@ -12,5 +15,6 @@ pub mod reader;
 pub mod rows;
 pub mod summary;
 pub mod time;
+pub mod words;
 
 pub use error::CliError;
