@@ -16,6 +16,10 @@ pub enum CliError {
         /// What is wrong with it.
         message: String,
     },
+    /// Standard output was closed by its reader (`| head`): the command
+    /// ends quietly and successfully, as a filter should.
+    #[error("standard output closed")]
+    PipeClosed,
 }
 
 impl CliError {
@@ -33,6 +37,7 @@ impl CliError {
         match self {
             Self::Usage(_) => 2,
             Self::File { .. } => 1,
+            Self::PipeClosed => 0,
         }
     }
 }

@@ -7,6 +7,7 @@ use serde::Serialize;
 
 use crate::analysis::{find_episodes, wobble_speed_mps, Episode, Run};
 use crate::cmd::logs::{for_each_log, print_stdout, warn_losses};
+use crate::output::Output;
 use crate::plot::modes::ModePlot;
 use crate::plot::{render, ImageKind};
 use crate::CliError;
@@ -43,6 +44,12 @@ pub fn run(args: &Args) -> Result<(), CliError> {
     if let Some(plot) = &args.plot {
         ImageKind::of(plot)?;
     }
+    let inputs: Vec<&Path> = args.logs.iter().map(PathBuf::as_path).collect();
+    let plot_out = args
+        .plot
+        .as_deref()
+        .map(|p| Output::create(p, &inputs))
+        .transpose()?;
     let mut reports = Vec::new();
     let mut names = Vec::new();
     let result = for_each_log(&args.logs, "analysing", |log| {
@@ -69,13 +76,13 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         }
     }
     print_stdout(&text)?;
-    if let Some(plot) = &args.plot {
+    if let Some(out) = plot_out {
         let runs = names
             .into_iter()
             .zip(reports)
             .map(|(name, r)| (name, r.episodes))
             .collect();
-        render(&ModePlot::new(runs), plot)?;
+        render(&ModePlot::new(runs), out)?;
     }
     result
 }
