@@ -38,6 +38,9 @@ pub struct Output {
     sink: Sink,
     /// The target as given, for messages.
     name: PathBuf,
+    /// A write found standard output closed. Writers such as Parquet's
+    /// wrap the I/O error in their own, hiding its kind from the caller.
+    pipe_closed: bool,
 }
 
 enum Sink {
@@ -64,6 +67,7 @@ impl Output {
                 target: resolved,
             },
             name: target.to_path_buf(),
+            pipe_closed: false,
         })
     }
 
@@ -74,6 +78,7 @@ impl Output {
         Self {
             sink: Sink::Stdout(BufWriter::with_capacity(BUFFER_LEN, io::stdout())),
             name: PathBuf::from("<stdout>"),
+            pipe_closed: false,
         }
     }
 
@@ -98,12 +103,29 @@ impl Output {
     /// the output's name and the system's reason, or, for a closed pipe on
     /// standard output, [`CliError::PipeClosed`] (a quiet, successful end).
     #[must_use]
-    pub fn error(&self, err: io::Error) -> CliError {
-        if self.is_stdout() && err.kind() == io::ErrorKind::BrokenPipe {
+    pub fn error(&self, err: impl Into<Box<dyn std::error::Error>>) -> CliError {
+        let err: Box<dyn std::error::Error> = err.into();
+        let broken = err
+            .downcast_ref::<io::Error>()
+            .is_some_and(|e| e.kind() == io::ErrorKind::BrokenPipe);
+        if self.pipe_closed || (self.is_stdout() && broken) {
             CliError::PipeClosed
         } else {
             CliError::file(&self.name, err)
         }
+    }
+
+    /// Whether a write found standard output closed by its reader.
+    #[must_use]
+    pub fn pipe_closed(&self) -> bool {
+        self.pipe_closed
+    }
+
+    fn note(&mut self, result: io::Result<()>) -> io::Result<()> {
+        if let Err(e) = &result {
+            self.pipe_closed |= self.is_stdout() && e.kind() == io::ErrorKind::BrokenPipe;
+        }
+        result
     }
 
     /// Makes the output final: flushes it, and for a file syncs it to disk
@@ -111,7 +133,13 @@ impl Output {
     pub fn commit(self) -> Result<(), CliError> {
         let name = self.name;
         match self.sink {
-            Sink::Stdout(mut out) => out.flush().map_err(|e| Self::stdout().error(e)),
+            Sink::Stdout(mut out) => out.flush().map_err(|e| {
+                if e.kind() == io::ErrorKind::BrokenPipe {
+                    CliError::PipeClosed
+                } else {
+                    CliError::file(&name, e)
+                }
+            }),
             Sink::File { temp, target } => {
                 let temp = temp
                     .into_inner()
@@ -129,24 +157,21 @@ impl Output {
 
 impl Write for Output {
     fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
-        match &mut self.sink {
+        let mut written = 0;
+        let result = match &mut self.sink {
             Sink::File { temp, .. } => temp.write(buf),
             Sink::Stdout(out) => out.write(buf),
         }
-    }
-
-    fn write_all(&mut self, buf: &[u8]) -> io::Result<()> {
-        match &mut self.sink {
-            Sink::File { temp, .. } => temp.write_all(buf),
-            Sink::Stdout(out) => out.write_all(buf),
-        }
+        .map(|n| written = n);
+        self.note(result).map(|()| written)
     }
 
     fn flush(&mut self) -> io::Result<()> {
-        match &mut self.sink {
+        let result = match &mut self.sink {
             Sink::File { temp, .. } => temp.flush(),
             Sink::Stdout(out) => out.flush(),
-        }
+        };
+        self.note(result)
     }
 }
 

@@ -33,7 +33,10 @@ pub fn run(args: &Args) -> Result<(), CliError> {
     }
     let mut out = Output::create_or_stdout(args.output.as_deref(), &[&args.log])?;
     let name = out.name().to_path_buf();
-    let losses = decode_to(&args.log, args.format, &mut out, &name)?;
+    let losses = match decode_to(&args.log, args.format, &mut out, &name) {
+        Err(_) if out.pipe_closed() => return Err(CliError::PipeClosed),
+        result => result?,
+    };
     out.commit()?;
     for line in losses.describe() {
         eprintln!("wobblog: {}: warning: {line}", args.log.display());

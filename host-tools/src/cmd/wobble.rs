@@ -75,7 +75,8 @@ pub fn run(args: &Args) -> Result<(), CliError> {
             text.push_str(&render_text(report));
         }
     }
-    print_stdout(&text)?;
+    // The figure is drawn even when the table's reader went away.
+    let printed = print_stdout(&text);
     if let Some(out) = plot_out {
         let runs = names
             .into_iter()
@@ -84,7 +85,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
             .collect();
         render(&ModePlot::new(runs), out)?;
     }
-    result
+    result.and(printed)
 }
 
 fn render_text(r: &RunEpisodes) -> String {
