@@ -10,6 +10,7 @@ pub mod error;
 pub mod events;
 pub mod export;
 pub mod losses;
+pub mod output;
 pub mod plot;
 pub mod reader;
 pub mod rows;
