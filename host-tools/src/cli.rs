@@ -71,7 +71,7 @@ pub fn main() -> ExitCode {
 
 fn report(result: Result<(), CliError>) -> ExitCode {
     match result {
-        Ok(()) => ExitCode::SUCCESS,
+        Ok(()) | Err(CliError::PipeClosed) => ExitCode::SUCCESS,
         Err(err) => {
             eprintln!("wobblog: {err}");
             ExitCode::from(err.exit_code())
