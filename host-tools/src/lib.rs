@@ -7,6 +7,7 @@ pub mod cmd;
 pub mod error;
 pub mod export;
 pub mod losses;
+pub mod output;
 pub mod plot;
 pub mod reader;
 pub mod rows;

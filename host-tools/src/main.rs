@@ -4,7 +4,7 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
-use wobblog::cmd;
+use wobblog::{cmd, CliError};
 
 /// Decode, inspect and analyse wobble-logger card logs.
 #[derive(Parser)]
@@ -50,7 +50,7 @@ fn main() -> ExitCode {
         Command::Summary(args) => cmd::summary::run(&args),
     };
     match result {
-        Ok(()) => ExitCode::SUCCESS,
+        Ok(()) | Err(CliError::PipeClosed) => ExitCode::SUCCESS,
         Err(err) => {
             eprintln!("wobblog: {err}");
             ExitCode::from(err.exit_code())

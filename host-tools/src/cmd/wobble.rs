@@ -7,6 +7,7 @@ use serde::Serialize;
 
 use crate::analysis::{find_episodes, wobble_speed_mps, Episode, Run};
 use crate::cmd::logs::{for_each_log, print_stdout, warn_losses};
+use crate::output::Output;
 use crate::plot::modes::ModePlot;
 use crate::plot::{render, ImageKind};
 use crate::CliError;
@@ -43,6 +44,12 @@ pub fn run(args: &Args) -> Result<(), CliError> {
     if let Some(plot) = &args.plot {
         ImageKind::of(plot)?;
     }
+    let inputs: Vec<&Path> = args.logs.iter().map(PathBuf::as_path).collect();
+    let plot_out = args
+        .plot
+        .as_deref()
+        .map(|p| Output::create(p, &inputs))
+        .transpose()?;
     let mut reports = Vec::new();
     let mut names = Vec::new();
     let result = for_each_log(&args.logs, "analysing", |log| {
@@ -68,16 +75,17 @@ pub fn run(args: &Args) -> Result<(), CliError> {
             text.push_str(&render_text(report));
         }
     }
-    print_stdout(&text)?;
-    if let Some(plot) = &args.plot {
+    // The figure is drawn even when the table's reader went away.
+    let printed = print_stdout(&text);
+    if let Some(out) = plot_out {
         let runs = names
             .into_iter()
             .zip(reports)
             .map(|(name, r)| (name, r.episodes))
             .collect();
-        render(&ModePlot::new(runs), plot)?;
+        render(&ModePlot::new(runs), out)?;
     }
-    result
+    result.and(printed)
 }
 
 fn render_text(r: &RunEpisodes) -> String {
