@@ -69,7 +69,13 @@ fn round_trip(csv: &str, format: Format) -> String {
     let out = std::fs::File::create(&log).unwrap();
     encode::encode(csv.as_bytes(), Path::new("in.csv"), out, &log).unwrap();
     let mut decoded = Vec::new();
-    let losses = decode::decode_to(&log, format, &mut decoded, Path::new("out")).unwrap();
+    let losses = decode::decode_to(
+        &log,
+        &decode::Export::all(format),
+        &mut decoded,
+        Path::new("out"),
+    )
+    .unwrap();
     assert!(losses.describe().is_empty());
     String::from_utf8(decoded).unwrap()
 }
