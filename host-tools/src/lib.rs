@@ -4,6 +4,7 @@
 
 pub mod analysis;
 pub mod cmd;
+pub mod csv_input;
 pub mod error;
 pub mod export;
 pub mod losses;
