@@ -145,6 +145,6 @@ proptest! {
 fn missing_columns_are_zero() {
     let out = round_trip("t_s,steer_deg\n0.01,1.5\n0.02,-2.25\n", Format::Csv);
     let lines: Vec<&str> = out.lines().collect();
-    assert_eq!(lines[1], "0.01,0.0,0.0,0.0,0.0,0.0,0.0,1.5,0.0,,,,");
-    assert_eq!(lines[2], "0.02,0.0,0.0,0.0,0.0,0.0,0.0,-2.25,0.0,,,,");
+    assert_eq!(lines[1], "0.01,0.0,0.0,0.0,0.0,0.0,0.0,1.5,0.0,,,,,");
+    assert_eq!(lines[2], "0.02,0.0,0.0,0.0,0.0,0.0,0.0,-2.25,0.0,,,,,");
 }
