@@ -21,3 +21,4 @@ pub mod imu;
 pub mod logger;
 pub mod steering;
 pub mod wheel;
+pub mod wheel_capture;

@@ -4,7 +4,7 @@
 //!
 //! | executor | priority | tasks |
 //! |---|---|---|
-//! | interrupt (UART4 vector) | high | 100 Hz sampler, wheel capture |
+//! | interrupt (UART4 vector) | high | 100 Hz sampler |
 //! | interrupt (UART5 vector) | medium | GPS |
 //! | thread mode | low | SD writer (blocking), watchdog feeder |
 #![no_std]
@@ -22,11 +22,9 @@ use embassy_stm32::gpio::{Input, Level, Output, Pull, Speed};
 use embassy_stm32::interrupt;
 use embassy_stm32::interrupt::{InterruptExt, Priority};
 use embassy_stm32::mode::Async;
-use embassy_stm32::peripherals::{ADC1, IWDG, TIM5};
+use embassy_stm32::peripherals::{ADC1, IWDG};
 use embassy_stm32::spi::Spi;
 use embassy_stm32::time::Hertz;
-use embassy_stm32::timer::input_capture::{CapturePin, InputCapture};
-use embassy_stm32::timer::low_level::CountingMode;
 use embassy_stm32::usart::{self, RingBufferedUartRx, Uart, UartTx};
 use embassy_stm32::Peri;
 use embassy_time::{Delay, Instant};
@@ -110,14 +108,13 @@ fn main() -> ! {
         LoggerConfig::DEFAULT,
     );
 
-    let (sampler, ports, capture) =
-        sampler_parts(board.imu, board.steering, board.wheel, board.rider, &config);
+    let _wheel_timer = adapters::wheel::start(board.wheel);
+    let (sampler, ports) = sampler_parts(board.imu, board.steering, board.rider, &config);
     let (gps_tx, gps_rx) = gps_uart(board.gps);
 
     interrupt::UART4.set_priority(Priority::P6);
     let high = EXECUTOR_HIGH.start(interrupt::UART4);
     high.spawn(defmt::unwrap!(sampler_task(sampler, ports)));
-    high.spawn(defmt::unwrap!(wheel_task(capture)));
 
     interrupt::UART5.set_priority(Priority::P7);
     let medium = EXECUTOR_MEDIUM.start(interrupt::UART5);
@@ -171,10 +168,9 @@ fn header(config: &Config) -> HeaderSpec<'static> {
 fn sampler_parts(
     imu: pins::ImuPins,
     steering: pins::SteeringPins,
-    wheel: pins::WheelPins,
     rider: pins::RiderPins,
     config: &Config,
-) -> (Sampler, Ports, InputCapture<'static, TIM5>) {
+) -> (Sampler, Ports) {
     let mut spi_config = embassy_stm32::spi::Config::default();
     spi_config.frequency = Hertz(clocks::IMU_SPI_HZ);
     let bus = Spi::new(
@@ -190,17 +186,6 @@ fn sampler_parts(
     let steering = SteeringAdapter::new(
         steering_adc(steering.adc, steering.wiper, steering.dma),
         defmt::unwrap!(Steering::try_new(config.steering).ok()),
-    );
-
-    let capture = InputCapture::new(
-        wheel.timer,
-        Some(CapturePin::new(wheel.hall, Pull::Up)),
-        None,
-        None,
-        None,
-        Irqs,
-        Hertz(1_000_000),
-        CountingMode::EdgeAlignedUp,
     );
 
     let ports = SamplerPorts {
@@ -224,7 +209,7 @@ fn sampler_parts(
         defmt::unwrap!(Detector::new(config.detector).ok()),
         config.alert.pattern,
     );
-    (sampler, ports, capture)
+    (sampler, ports)
 }
 
 /// ADC1 converting the wiper continuously into a DMA ring, the slowest
@@ -278,11 +263,6 @@ async fn sampler_task(mut sampler: Sampler, mut ports: Ports) {
         },
     )
     .await;
-}
-
-#[embassy_executor::task]
-async fn wheel_task(capture: InputCapture<'static, TIM5>) {
-    adapters::wheel::capture_edges(capture).await
 }
 
 #[embassy_executor::task]

@@ -1,11 +1,11 @@
 //! `wobblog decode`: one row per 100 Hz frame, as CSV, JSON lines or Parquet.
 
-use std::fs::File;
-use std::io::{BufWriter, IsTerminal, Write};
+use std::io::{IsTerminal, Write};
 use std::path::{Path, PathBuf};
 
 use crate::export::{Format, RowWriter};
 use crate::losses::Losses;
+use crate::output::Output;
 use crate::reader::read_log;
 use crate::rows::RowAssembler;
 use crate::CliError;
@@ -31,17 +31,13 @@ pub fn run(args: &Args) -> Result<(), CliError> {
             "parquet output is binary: give -o FILE or redirect standard output".into(),
         ));
     }
-    let out: Box<dyn Write + Send> = match &args.output {
-        Some(path) => Box::new(File::create(path).map_err(|e| CliError::file(path, e))?),
-        None => Box::new(std::io::stdout()),
+    let mut out = Output::create_or_stdout(args.output.as_deref(), &[&args.log])?;
+    let name = out.name().to_path_buf();
+    let losses = match decode_to(&args.log, args.format, &mut out, &name) {
+        Err(_) if out.pipe_closed() => return Err(CliError::PipeClosed),
+        result => result?,
     };
-    let out_name = args.output.as_deref().unwrap_or(Path::new("<stdout>"));
-    let losses = decode_to(
-        &args.log,
-        args.format,
-        BufWriter::with_capacity(1 << 16, out),
-        out_name,
-    )?;
+    out.commit()?;
     for line in losses.describe() {
         eprintln!("wobblog: {}: warning: {line}", args.log.display());
     }

@@ -1,7 +1,7 @@
 //! `wobblog encode`: build a card log from a CSV, through the firmware's encoder.
 
 use std::fs::File;
-use std::io::{BufWriter, Write};
+use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use wobble_core::format::header::header_records;
@@ -11,6 +11,7 @@ use wobble_core::format::{
 };
 
 use crate::export::CSV_COLUMNS;
+use crate::output::Output;
 use crate::CliError;
 
 /// Arguments of `wobblog encode`.
@@ -31,9 +32,10 @@ const GPS_REPEAT_US: u64 = 500_000;
 
 /// Runs `wobblog encode`.
 pub fn run(args: &Args) -> Result<(), CliError> {
+    let mut output = Output::create(&args.output, &[&args.csv])?;
     let input = File::open(&args.csv).map_err(|e| CliError::file(&args.csv, e))?;
-    let output = File::create(&args.output).map_err(|e| CliError::file(&args.output, e))?;
-    encode(input, &args.csv, BufWriter::new(output), &args.output)
+    encode(input, &args.csv, &mut output, &args.output)?;
+    output.commit()
 }
 
 /// Index of each known column in the CSV, if present.

@@ -1,8 +1,11 @@
 //! One module per `wobblog` subcommand: its clap arguments and its `run`.
 
+pub mod completions;
+pub mod config;
 pub mod decode;
 pub mod detect;
 pub mod encode;
+pub mod events;
 pub mod gpx;
 pub mod info;
 pub mod logs;

@@ -161,8 +161,9 @@ impl From<&Row> for JsonRow {
 /// Keeps the kind of an I/O error wrapped by `csv` (its own conversion
 /// turns every error into `Other`, hiding a closed pipe).
 fn csv_io_error(err: csv::Error) -> std::io::Error {
+    let message = err.to_string();
     match err.into_kind() {
         csv::ErrorKind::Io(e) => e,
-        other => std::io::Error::other(format!("{other:?}")),
+        _ => std::io::Error::other(message),
     }
 }

@@ -195,6 +195,10 @@ pub struct Extras {
     pub gps_outages_s: Vec<(f64, f64)>,
     /// Whether to write GPS at all.
     pub gps: bool,
+    /// Records written after the frame at their time (faults, dropouts, ...).
+    pub records: Vec<Record<'static>>,
+    /// Configuration lines for the header.
+    pub config: Vec<String>,
 }
 
 /// Latitude of the GPS track's start, degrees.
@@ -254,7 +258,7 @@ pub fn write_log(path: &Path, ride: &Ride, extras: &Extras) {
         sample_rate_hz: 100,
         run: 3,
     };
-    for rec in header_records(info, []) {
+    for rec in header_records(info, extras.config.iter().map(String::as_str)) {
         put(&mut encoder, rec);
     }
     for i in 0..ride.t_s.len() {
@@ -287,6 +291,11 @@ pub fn write_log(path: &Path, ride: &Ride, extras: &Extras) {
                 }
             }
         }
+        for rec in &extras.records {
+            if now(rec.t_us() as f64 / 1e6) {
+                put(&mut encoder, *rec);
+            }
+        }
         for (id, &m) in extras.markers_s.iter().enumerate() {
             if now(m) {
                 put(
@@ -314,6 +323,7 @@ pub fn standard_log(path: &Path) -> (Ride, Extras) {
         markers_s: vec![5.0, 20.0],
         gps_outages_s: vec![(22.0, 29.0)],
         gps: true,
+        ..Extras::default()
     };
     write_log(path, &ride, &extras);
     (ride, extras)
