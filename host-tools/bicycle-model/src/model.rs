@@ -59,6 +59,14 @@ impl Model {
         })
     }
 
+    /// The Whipple matrices, if this is the Whipple model.
+    #[must_use]
+    pub fn whipple_matrices(&self) -> Option<&WhippleMatrices> {
+        match self {
+            Self::Whipple(m) => Some(m),
+        }
+    }
+
     /// The state matrix at `speed_mps`.
     #[must_use]
     pub fn state_matrix(&self, speed_mps: f64) -> DMatrix<f64> {
