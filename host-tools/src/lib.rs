@@ -6,6 +6,7 @@ pub mod analysis;
 pub mod cli;
 pub mod cmd;
 pub mod codes;
+pub mod csv_input;
 pub mod error;
 pub mod events;
 pub mod export;
