@@ -71,7 +71,9 @@ fn assert_close(got: Complex<f64>, want: Complex<f64>, what: &str) {
 #[test]
 fn matrices_match_the_published_values() {
     let model = benchmark();
-    let m = model.whipple_matrices().expect("benchmark.toml is a Whipple model");
+    let m = model
+        .whipple_matrices()
+        .expect("benchmark.toml is a Whipple model");
     // Meijaard et al. 2007, eqs. (5.1)-(5.4).
     let want_m = Matrix2::new(
         80.81722,
@@ -178,7 +180,10 @@ fn bicycle_parameters_txt_reads_like_the_toml() {
         .source
         .contains("0.001"));
     let (from_txt, from_toml) = (Model::from_set(&set).unwrap(), benchmark());
-    let (a, b) = (from_txt.whipple_matrices().unwrap(), from_toml.whipple_matrices().unwrap());
+    let (a, b) = (
+        from_txt.whipple_matrices().unwrap(),
+        from_toml.whipple_matrices().unwrap(),
+    );
     assert!((a.m - b.m).abs().max() < 1e-12);
     assert!((a.c1 - b.c1).abs().max() < 1e-12);
     assert!((a.k0 - b.k0).abs().max() < 1e-12);
