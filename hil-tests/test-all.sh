@@ -27,7 +27,7 @@ cargo build -p wobble-core --target "$TARGET" --release
 step "firmware for the STM32F405 board: release build, clippy, size budget"
 cargo build -p wobble-stm32f405 --target "$TARGET" --release
 cargo clippy -p wobble-stm32f405 --target "$TARGET" -- -D warnings
-# Fails when flash > 128 KiB or static RAM > 64 KiB (firmware/docs/board.md).
+# Fails when flash > 192 KiB or static RAM > 64 KiB (firmware/docs/board.md).
 cargo run -q -p wobble-size-budget -- "${CARGO_TARGET_DIR:-target}/$TARGET/release/wobble-stm32f405"
 
 step "QEMU image (netduinoplus2): clippy and release build, run by the tests"

@@ -1,13 +1,13 @@
 //! `wobblog gpx`: the run's GPS track as GPX 1.1, for maps and GIS tools.
 
-use std::fs::File;
-use std::io::{BufWriter, Write};
+use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use quick_xml::events::{BytesDecl, BytesText, Event};
 use quick_xml::Writer;
 use wobble_core::format::{Event as LogEvent, GpsFix, Record};
 
+use crate::output::Output;
 use crate::reader::read_log;
 use crate::rows::GpsColumns;
 use crate::CliError;
@@ -28,6 +28,7 @@ const SEGMENT_GAP_US: u64 = 5_000_000;
 
 /// Runs `wobblog gpx`.
 pub fn run(args: &Args) -> Result<(), CliError> {
+    let mut out = Output::create_or_stdout(args.output.as_deref(), &[&args.log])?;
     let segments = track(&args.log)?;
     if segments.is_empty() {
         eprintln!(
@@ -39,14 +40,8 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         .log
         .file_stem()
         .map_or_else(String::new, |s| s.to_string_lossy().into_owned());
-    match &args.output {
-        Some(path) => {
-            let file = File::create(path).map_err(|e| CliError::file(path, e))?;
-            write_gpx(BufWriter::new(file), &name, &segments).map_err(|e| CliError::file(path, e))
-        }
-        None => write_gpx(std::io::stdout().lock(), &name, &segments)
-            .map_err(|e| CliError::file(Path::new("<stdout>"), e)),
-    }
+    write_gpx(&mut out, &name, &segments).map_err(|e| out.error(e))?;
+    out.commit()
 }
 
 /// The fixes with a position, split into segments at gaps.

@@ -4,6 +4,7 @@ use std::path::PathBuf;
 
 use crate::analysis::Run;
 use crate::cmd::logs::warn_losses;
+use crate::output::Output;
 use crate::plot::timeplot::TimePlot;
 use crate::plot::{render, ImageKind};
 use crate::CliError;
@@ -34,9 +35,10 @@ pub fn run(args: &Args) -> Result<(), CliError> {
             )));
         }
     }
+    let out = Output::create(&args.output, &[&args.log])?;
     let run = Run::load(&args.log)?;
     warn_losses(&run);
     let figure = TimePlot::new(&run, args.from, args.to)
         .ok_or_else(|| CliError::file(&args.log, "no frames in the requested time window"))?;
-    render(&figure, &args.output)
+    render(&figure, out)
 }

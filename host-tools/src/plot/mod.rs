@@ -7,12 +7,14 @@
 pub mod modes;
 pub mod timeplot;
 
+use std::io::Write;
 use std::path::Path;
 use std::sync::Once;
 
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
+use crate::output::Output;
 use crate::CliError;
 
 /// The font every figure uses.
@@ -53,26 +55,53 @@ impl ImageKind {
     }
 }
 
-/// Draws `figure` into the file at `path` (PNG or SVG by its extension).
-pub fn render(figure: &impl Figure, path: &Path) -> Result<(), CliError> {
-    let kind = ImageKind::of(path)?;
+/// Draws `figure` into `out`, PNG or SVG by the output's extension, and
+/// commits it. The image is drawn in memory (plotters' own file writing
+/// would bypass the atomic output and report errors as debug text).
+pub fn render(figure: &impl Figure, mut out: Output) -> Result<(), CliError> {
+    let kind = ImageKind::of(out.name())?;
     register_font();
+    let bytes = draw(figure, kind)
+        .map_err(|e| CliError::file(out.name(), format!("cannot draw the plot: {e}")))?;
+    out.write_all(&bytes).map_err(|e| out.error(e))?;
+    out.commit()
+}
+
+fn draw(figure: &impl Figure, kind: ImageKind) -> Result<Vec<u8>, String> {
     let size = figure.size_px();
-    let drawn = match kind {
+    match kind {
         ImageKind::Png => {
-            let root = BitMapBackend::new(path, size).into_drawing_area();
-            figure
-                .draw(&root)
-                .and_then(|()| root.present().map_err(|e| e.to_string()))
+            let (w, h) = size;
+            let mut pixels = vec![0u8; w as usize * h as usize * 3];
+            {
+                let root = BitMapBackend::with_buffer(&mut pixels, size).into_drawing_area();
+                figure.draw(&root)?;
+                root.present().map_err(|e| e.to_string())?;
+            }
+            encode_png(&pixels, size).map_err(|e| e.to_string())
         }
         ImageKind::Svg => {
-            let root = SVGBackend::new(path, size).into_drawing_area();
-            figure
-                .draw(&root)
-                .and_then(|()| root.present().map_err(|e| e.to_string()))
+            let mut svg = String::new();
+            {
+                let root = SVGBackend::with_string(&mut svg, size).into_drawing_area();
+                figure.draw(&root)?;
+                root.present().map_err(|e| e.to_string())?;
+            }
+            Ok(svg.into_bytes())
         }
-    };
-    drawn.map_err(|e| CliError::file(path, format!("cannot draw the plot: {e}")))
+    }
+}
+
+/// 8-bit RGB pixels, row by row, as a PNG file.
+fn encode_png(pixels: &[u8], (w, h): (u32, u32)) -> Result<Vec<u8>, png::EncodingError> {
+    let mut bytes = Vec::new();
+    let mut encoder = png::Encoder::new(&mut bytes, w, h);
+    encoder.set_color(png::ColorType::Rgb);
+    encoder.set_depth(png::BitDepth::Eight);
+    let mut writer = encoder.write_header()?;
+    writer.write_image_data(pixels)?;
+    writer.finish()?;
+    Ok(bytes)
 }
 
 fn register_font() {
