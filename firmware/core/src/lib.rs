@@ -22,5 +22,6 @@ pub mod imu;
 pub mod logger;
 pub mod stall;
 pub mod steering;
+pub mod watchdog;
 pub mod wheel;
 pub mod wheel_capture;
