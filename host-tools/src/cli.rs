@@ -40,6 +40,9 @@ enum Command {
     Gpx(cmd::gpx::Args),
     /// One row per run in a directory: duration, distance, episodes, wobble speed, losses.
     Summary(cmd::summary::Args),
+    /// The linear bicycle models: eigenvalues against speed, plots, parameter studies, fits.
+    #[command(subcommand)]
+    Model(cmd::model::Command),
     /// Print a shell completion script (bash, zsh, fish, ...).
     Completions(cmd::completions::Args),
     /// Print the man page (roff) of wobblog.
@@ -63,6 +66,7 @@ pub fn main() -> ExitCode {
         Command::Wobble(args) => cmd::wobble::run(&args),
         Command::Gpx(args) => cmd::gpx::run(&args),
         Command::Summary(args) => cmd::summary::run(&args),
+        Command::Model(command) => cmd::model::run(&command),
         Command::Completions(args) => cmd::completions::run(&args),
         Command::Man => cmd::completions::man(),
     };

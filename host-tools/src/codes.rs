@@ -3,7 +3,14 @@
 //! keyed by the firmware's own `FAULT_*` constants) and one for the dropout
 //! reasons.
 
-use wobble_core::app::sampler::{FAULT_IMU_BAD_SAMPLE, FAULT_IMU_NO_RESPONSE, FAULT_STEER_READ};
+use wobble_core::app::sampler::{
+    FAULT_IMU_BAD_SAMPLE, FAULT_IMU_NO_RESPONSE, FAULT_STEER_OVERRUN, FAULT_STEER_READ,
+};
+use wobble_core::boot::{
+    FAULT_BOR_FAILED, FAULT_BOR_PROGRAMMED, FAULT_HSE_FAILED, FAULT_RESET_BROWN_OUT,
+    FAULT_RESET_LOW_POWER, FAULT_RESET_PIN, FAULT_RESET_POWER_ON, FAULT_RESET_SOFTWARE,
+    FAULT_RESET_UNKNOWN, FAULT_RESET_WATCHDOG, FAULT_RESET_WINDOW_WATCHDOG,
+};
 use wobble_core::config::{
     FAULT_BAD_VALUE, FAULT_REJECTED, FAULT_SYNTAX, FAULT_UNKNOWN_KEY, FAULT_UNREADABLE,
 };
@@ -14,7 +21,7 @@ use wobble_core::gps::{
 use wobble_core::logger::{FAULT_CARD_ABSENT, FAULT_CARD_FULL, FAULT_CARD_WRITE};
 
 /// Every fault code the firmware records: (source, code, meaning).
-pub const FAULT_MEANINGS: [(FaultSource, u8, &str); 16] = [
+pub const FAULT_MEANINGS: [(FaultSource, u8, &str); 28] = [
     (
         FaultSource::Imu,
         FAULT_IMU_NO_RESPONSE,
@@ -29,6 +36,11 @@ pub const FAULT_MEANINGS: [(FaultSource, u8, &str); 16] = [
         FaultSource::Steering,
         FAULT_STEER_READ,
         "the steering ADC could not be read",
+    ),
+    (
+        FaultSource::Steering,
+        FAULT_STEER_OVERRUN,
+        "the steering ADC overran (samples lost) and was restarted",
     ),
     (FaultSource::Gps, FAULT_CHECKSUM, "NMEA checksum mismatch"),
     (
@@ -79,6 +91,61 @@ pub const FAULT_MEANINGS: [(FaultSource, u8, &str); 16] = [
         FAULT_UNREADABLE,
         "unreadable bytes or a file too long",
     ),
+    (
+        FaultSource::System,
+        FAULT_RESET_POWER_ON,
+        "reset cause: power-on",
+    ),
+    (
+        FaultSource::System,
+        FAULT_RESET_BROWN_OUT,
+        "reset cause: brown-out (supply below the BOR threshold)",
+    ),
+    (
+        FaultSource::System,
+        FAULT_RESET_WATCHDOG,
+        "reset cause: independent watchdog (a task hung)",
+    ),
+    (
+        FaultSource::System,
+        FAULT_RESET_WINDOW_WATCHDOG,
+        "reset cause: window watchdog",
+    ),
+    (
+        FaultSource::System,
+        FAULT_RESET_SOFTWARE,
+        "reset cause: software (the firmware reset itself after a panic or fault)",
+    ),
+    (
+        FaultSource::System,
+        FAULT_RESET_PIN,
+        "reset cause: NRST pin (reset button, debug probe)",
+    ),
+    (
+        FaultSource::System,
+        FAULT_RESET_LOW_POWER,
+        "reset cause: low-power management",
+    ),
+    (
+        FaultSource::System,
+        FAULT_RESET_UNKNOWN,
+        "reset cause unknown (no flag set)",
+    ),
+    (
+        FaultSource::System,
+        FAULT_HSE_FAILED,
+        "the crystal did not start: clocks from the internal oscillator",
+    ),
+    (
+        FaultSource::System,
+        FAULT_BOR_PROGRAMMED,
+        "brown-out reset level was below 2.7 V and has been programmed to level 3",
+    ),
+    (
+        FaultSource::System,
+        FAULT_BOR_FAILED,
+        "programming the brown-out level failed",
+    ),
 ];
 
 /// What fault `code` of `source` means; a log from a newer firmware may
@@ -116,6 +183,7 @@ mod tests {
             FaultSource::Card => "card",
             FaultSource::Config => "config",
             FaultSource::Gps => "GPS",
+            FaultSource::System => "system",
             _ => "?",
         };
         let rows: Vec<&str> = doc

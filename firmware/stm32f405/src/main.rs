@@ -13,6 +13,7 @@
 mod adapters;
 mod clocks;
 mod pins;
+mod startup;
 mod watchdog;
 
 use cortex_m_rt::entry;
@@ -33,6 +34,7 @@ use embedded_sdmmc::VolumeManager;
 use static_cell::StaticCell;
 use wobble_core::app::sampler::{Sampler, SamplerPorts};
 use wobble_core::app::{gps, sampler, writer};
+use wobble_core::boot;
 use wobble_core::channels::{RecordQueue, SharedStatus};
 use wobble_core::config::{self, Config, Loaded, KEY_COUNT, MAX_TEXT_LEN};
 use wobble_core::detector::Detector;
@@ -92,8 +94,42 @@ unsafe fn UART5() {
 
 #[entry]
 fn main() -> ! {
-    let board = Board::new(embassy_stm32::init(clocks::config()));
+    // RTT needs no clock: this line appears even if the clocks never come up.
     defmt::info!("{} starting", FIRMWARE);
+    let reset = startup::take_reset_cause();
+    defmt::info!("reset cause: {}", reset);
+    let crystal = startup::start_hse();
+    if !crystal {
+        defmt::error!(
+            "HSE did not start in {} ms: running on HSI",
+            clocks::HSE_STARTUP_TIMEOUT_MS
+        );
+    }
+    let mut board = Board::new(embassy_stm32::init(clocks::config(crystal)));
+    startup::enable_flash_accelerator();
+    let bor = startup::ensure_bor_level3();
+    if let Some(code) = bor {
+        defmt::warn!("brown-out reset level 3: system fault {}", code);
+    }
+    let boot_faults = [
+        Some(reset.fault_code()),
+        (!crystal).then_some(boot::FAULT_HSE_FAILED),
+        bor,
+    ];
+    for code in boot_faults.into_iter().flatten() {
+        QUEUE.push(Record::Fault(boot::system_fault(code, 0)));
+    }
+    if reset.is_abnormal() || !crystal {
+        // Shown on the alert LED before logging starts: the cause, or 9
+        // for the crystal.
+        let code = if crystal {
+            reset.fault_code()
+        } else {
+            boot::FAULT_HSE_FAILED
+        };
+        let mut led = Output::new(board.rider.alert_led.reborrow(), Level::Low, Speed::Low);
+        startup::blink_code(&mut led, code);
+    }
 
     let (card, loaded) = card_and_config(board.card);
     let config = loaded.config;

@@ -9,6 +9,7 @@ pub mod events;
 pub mod gpx;
 pub mod info;
 pub mod logs;
+pub mod model;
 pub mod nmea;
 pub mod plot;
 pub mod summary;
