@@ -29,7 +29,7 @@ step "firmware for the STM32F405 board: release build, clippy, size budget"
 # `.cargo/config.toml` selects the MCU target and the size-optimised profile.
 (cd firmware/stm32f405 && cargo build --release)
 cargo clippy -p wobble-stm32f405 --target "$TARGET" -- -D warnings
-# Fails when flash > 128 KiB or static RAM > 64 KiB (firmware/docs/board.md).
+# Fails when flash > 192 KiB or static RAM > 64 KiB (firmware/docs/board.md).
 cargo run -q -p wobble-size-budget -- "${CARGO_TARGET_DIR:-target}/$TARGET/release/wobble-stm32f405"
 
 step "QEMU image (netduinoplus2): clippy and release build, run by the tests"

@@ -46,7 +46,15 @@ fn benches(c: &mut Criterion) {
         ("jsonl_one_hour", Format::Jsonl),
     ] {
         group.bench_function(name, |b| {
-            b.iter(|| decode::decode_to(&log, format, std::io::sink(), Path::new("sink")).unwrap())
+            b.iter(|| {
+                decode::decode_to(
+                    &log,
+                    &decode::Export::all(format),
+                    std::io::sink(),
+                    Path::new("sink"),
+                )
+                .unwrap()
+            })
         });
     }
     group.finish();

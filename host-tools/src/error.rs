@@ -16,6 +16,14 @@ pub enum CliError {
         /// What is wrong with it.
         message: String,
     },
+    /// A runtime failure that concerns no single file, such as several logs
+    /// of a multi-log command failing (exit code 1).
+    #[error("{0}")]
+    Failed(String),
+    /// Standard output was closed by its reader (`| head`): the command
+    /// ends quietly and successfully, as a filter should.
+    #[error("standard output closed")]
+    PipeClosed,
 }
 
 impl CliError {
@@ -32,7 +40,8 @@ impl CliError {
     pub fn exit_code(&self) -> u8 {
         match self {
             Self::Usage(_) => 2,
-            Self::File { .. } => 1,
+            Self::File { .. } | Self::Failed(_) => 1,
+            Self::PipeClosed => 0,
         }
     }
 }

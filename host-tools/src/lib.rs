@@ -3,14 +3,20 @@
 #![warn(missing_docs)]
 
 pub mod analysis;
+pub mod cli;
 pub mod cmd;
+pub mod codes;
+pub mod csv_input;
 pub mod error;
+pub mod events;
 pub mod export;
 pub mod losses;
+pub mod output;
 pub mod plot;
 pub mod reader;
 pub mod rows;
 pub mod summary;
 pub mod time;
+pub mod words;
 
 pub use error::CliError;

@@ -128,7 +128,8 @@ fn push_capped<T>(list: &mut Vec<T>, item: T) {
     }
 }
 
-fn cause_name(cause: SkipCause) -> &'static str {
+/// The words for why bytes were skipped.
+pub fn cause_name(cause: SkipCause) -> &'static str {
     match cause {
         SkipCause::Damaged => "damaged block",
         SkipCause::UnsupportedVersion(_) => "unsupported format version",

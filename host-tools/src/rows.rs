@@ -4,7 +4,7 @@
 use std::collections::VecDeque;
 
 use wobble_core::format::{
-    FixMode, Frame, FrameStatus, GpsFix, Record, ACCEL_COUNTS_PER_G, GYRO_COUNTS_PER_DPS,
+    FixMode, Frame, FrameStatus, GpsFix, Record, UtcSync, ACCEL_COUNTS_PER_G, GYRO_COUNTS_PER_DPS,
     STEER_COUNTS_PER_DEG,
 };
 
@@ -61,10 +61,13 @@ pub struct Row {
     pub status: FrameStatus,
     /// GPS fix in force, if any.
     pub gps: Option<GpsColumns>,
+    /// UTC, µs since 1970, from the latest GPS sync pair at or before the
+    /// frame (`None` before the first).
+    pub utc_us: Option<i64>,
 }
 
 impl Row {
-    fn new(frame: &Frame, gps: Option<GpsColumns>) -> Self {
+    fn new(frame: &Frame, gps: Option<GpsColumns>, sync: Option<UtcSync>) -> Self {
         // In f64, so that every stored count prints as its exact value (or
         // the shortest decimal that is nearest to it).
         let scaled = |c: i16, counts_per_unit: f32| f64::from(c) / f64::from(counts_per_unit);
@@ -77,8 +80,18 @@ impl Row {
             wheel_count: frame.wheel_count,
             status: frame.status,
             gps,
+            utc_us: sync.and_then(|s| utc_us_at(s, frame.t_us)),
         }
     }
+}
+
+/// UTC at local time `t_us` through the pair `sync`, µs since 1970.
+fn utc_us_at(sync: UtcSync, t_us: u64) -> Option<i64> {
+    let offset_us = i64::try_from(t_us).ok()? - i64::try_from(sync.t_us).ok()?;
+    i64::try_from(sync.unix_ms)
+        .ok()?
+        .checked_mul(1000)?
+        .checked_add(offset_us)
 }
 
 /// Turns a stream of records into rows, in bounded memory.
@@ -90,6 +103,7 @@ impl Row {
 pub struct RowAssembler {
     pending: VecDeque<(u64, Row)>,
     gps: Option<(u64, GpsColumns)>,
+    sync: Option<UtcSync>,
 }
 
 impl RowAssembler {
@@ -104,7 +118,9 @@ impl RowAssembler {
         match record {
             Record::Frame(frame) => {
                 let gps = self.gps_at(frame.t_us);
-                self.pending.push_back((frame.t_us, Row::new(frame, gps)));
+                let sync = self.sync.filter(|s| s.t_us <= frame.t_us);
+                self.pending
+                    .push_back((frame.t_us, Row::new(frame, gps, sync)));
                 while let Some(&(t, _)) = self.pending.front() {
                     if t + GPS_WAIT_US >= frame.t_us {
                         break;
@@ -123,6 +139,15 @@ impl RowAssembler {
                         if *t >= fix.t_us {
                             row.gps = columns.filter(|_| *t - fix.t_us <= GPS_STALE_US);
                         }
+                    }
+                }
+            }
+            // Like a fix, a pair is stamped before frames written ahead of it.
+            Record::UtcSync(sync) if self.sync.is_none_or(|s| sync.t_us >= s.t_us) => {
+                self.sync = Some(*sync);
+                for (t, row) in &mut self.pending {
+                    if *t >= sync.t_us {
+                        row.utc_us = utc_us_at(*sync, *t);
                     }
                 }
             }

@@ -45,7 +45,13 @@ fn known_wobble_is_measured() {
 
     let text = stdout_of(wobblog().arg("wobble").arg(&log));
     assert!(text.contains("wobble speed 5.00 m/s"), "{text}");
-    assert!(text.contains("Unstable"), "{text}");
+    assert!(text.contains(": 1 episode, "), "{text}");
+    // The table's names and values are the JSON's.
+    assert!(
+        text.contains("peak_amp_deg  speed_at_onset_mps  stability"),
+        "{text}"
+    );
+    assert!(text.trim_end().ends_with("unstable"), "{text}");
 }
 
 #[test]

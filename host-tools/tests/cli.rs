@@ -107,7 +107,7 @@ fn unreadable_inputs_exit_1_naming_the_file() {
     assert_eq!(out.status.code(), Some(1));
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(
-        stderr.contains("bad.csv: line 2: steer_deg: not a number"),
+        stderr.contains("bad.csv: line 2, column 2: `steer_deg` is not a number"),
         "{stderr}"
     );
 }

@@ -27,6 +27,9 @@ fn same(cell: &str, field: &Field) -> bool {
         Field::Null => cell.is_empty(),
         Field::Double(v) => cell.parse::<f64>().is_ok_and(|c| c == *v),
         Field::Str(s) => cell == s,
+        Field::TimestampMicros(us) => {
+            wobblog::time::parse_iso8601(cell).is_some_and(|ms| ms == us.div_euclid(1000))
+        }
         _ => false,
     }
 }
@@ -54,7 +57,8 @@ fn parquet_matches_csv_row_for_row() {
         .map(|c| c.name())
         .collect();
     assert_eq!(names, header);
-    assert_eq!(names, CSV_COLUMNS);
+    assert_eq!(names[..CSV_COLUMNS.len()], CSV_COLUMNS);
+    assert_eq!(names[CSV_COLUMNS.len()..], ["utc"]);
 
     let mut rows = 0;
     let mut with_gps = 0;
@@ -107,4 +111,74 @@ fn unreadable_log_leaves_no_parquet_bytes() {
         .assert()
         .code(1);
     assert_eq!(std::fs::metadata(&out).map(|m| m.len()).unwrap_or(0), 0);
+}
+
+#[test]
+fn parquet_carries_the_log_metadata_and_a_dictionary_gps_fix() {
+    let dir = tempfile::tempdir().unwrap();
+    let log = dir.path().join("RUN00003.WBL");
+    let ride = analysis_support::Ride::new(5.0, 5.0, 0.0, 0.0, 0.0);
+    let extras = analysis_support::Extras {
+        gps: true,
+        config: vec![
+            "wheel.circumference_m=2.1".into(),
+            "alert.enabled=on".into(),
+        ],
+        ..Default::default()
+    };
+    analysis_support::write_log(&log, &ride, &extras);
+    let pq_path = dir.path().join("run.parquet");
+    wobblog()
+        .arg("decode")
+        .arg(&log)
+        .arg("-o")
+        .arg(&pq_path)
+        .assert()
+        .success();
+    let reader = SerializedFileReader::new(File::open(&pq_path).unwrap()).unwrap();
+    let meta = reader.metadata();
+    let kv: std::collections::BTreeMap<String, String> = meta
+        .file_metadata()
+        .key_value_metadata()
+        .unwrap()
+        .iter()
+        .map(|kv| (kv.key.clone(), kv.value.clone().unwrap_or_default()))
+        .collect();
+    assert_eq!(kv["firmware"], "test");
+    assert_eq!(kv["run"], "3");
+    assert_eq!(kv["device_id"], "07".repeat(12));
+    assert_eq!(kv["sample_rate_hz"], "100");
+    assert_eq!(kv["config"], "wheel.circumference_m=2.1\nalert.enabled=on");
+    assert_eq!(kv["first_utc"], "2020-03-18T10:00:01.000Z");
+    assert_eq!(kv["unit.steer_deg"], "deg");
+    assert_eq!(kv["unit.gx_dps"], "deg/s");
+    assert_eq!(kv["unit.speed_mps"], "m/s");
+
+    let group = meta.row_group(0);
+    let fix = group
+        .columns()
+        .iter()
+        .find(|c| c.column_path().string() == "gps_fix")
+        .unwrap();
+    assert!(fix.dictionary_page_offset().is_some(), "{fix:?}");
+    assert!(
+        fix.encodings()
+            .any(|e| e == parquet::basic::Encoding::RLE_DICTIONARY),
+        "{fix:?}"
+    );
+    let utc = meta
+        .file_metadata()
+        .schema_descr()
+        .columns()
+        .iter()
+        .find(|c| c.name() == "utc")
+        .unwrap()
+        .logical_type_ref();
+    assert!(
+        matches!(
+            utc,
+            Some(parquet::basic::LogicalType::Timestamp(t)) if t.is_adjusted_to_u_t_c
+        ),
+        "{utc:?}"
+    );
 }

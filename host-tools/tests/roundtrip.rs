@@ -69,7 +69,13 @@ fn round_trip(csv: &str, format: Format) -> String {
     let out = std::fs::File::create(&log).unwrap();
     encode::encode(csv.as_bytes(), Path::new("in.csv"), out, &log).unwrap();
     let mut decoded = Vec::new();
-    let losses = decode::decode_to(&log, format, &mut decoded, Path::new("out")).unwrap();
+    let losses = decode::decode_to(
+        &log,
+        &decode::Export::all(format),
+        &mut decoded,
+        Path::new("out"),
+    )
+    .unwrap();
     assert!(losses.describe().is_empty());
     String::from_utf8(decoded).unwrap()
 }
@@ -139,6 +145,6 @@ proptest! {
 fn missing_columns_are_zero() {
     let out = round_trip("t_s,steer_deg\n0.01,1.5\n0.02,-2.25\n", Format::Csv);
     let lines: Vec<&str> = out.lines().collect();
-    assert_eq!(lines[1], "0.01,0.0,0.0,0.0,0.0,0.0,0.0,1.5,0.0,,,,");
-    assert_eq!(lines[2], "0.02,0.0,0.0,0.0,0.0,0.0,0.0,-2.25,0.0,,,,");
+    assert_eq!(lines[1], "0.01,0.0,0.0,0.0,0.0,0.0,0.0,1.5,0.0,,,,,");
+    assert_eq!(lines[2], "0.02,0.0,0.0,0.0,0.0,0.0,0.0,-2.25,0.0,,,,,");
 }

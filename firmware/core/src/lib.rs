@@ -8,6 +8,7 @@
 #![warn(missing_docs)]
 
 pub mod app;
+pub mod boot;
 pub mod channels;
 pub mod config;
 pub mod decimate;
@@ -19,5 +20,8 @@ pub mod frame_assembly;
 pub mod gps;
 pub mod imu;
 pub mod logger;
+pub mod stall;
 pub mod steering;
+pub mod watchdog;
 pub mod wheel;
+pub mod wheel_capture;

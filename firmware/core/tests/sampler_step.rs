@@ -6,7 +6,7 @@ use proptest::prelude::*;
 use wobble_core::app::ports::{ImuSample, SensorError, SteeringSample};
 use wobble_core::app::sampler::{
     Inputs, Sampler, FAULT_IMU_BAD_SAMPLE, FAULT_IMU_NO_RESPONSE, FAULT_INTERVAL_US,
-    FAULT_STEER_READ, FRAME_PERIOD_US,
+    FAULT_STEER_OVERRUN, FAULT_STEER_READ, FRAME_PERIOD_US,
 };
 use wobble_core::detector::{AlertEvent, AlertOutput, Detector, DetectorConfig, PatternConfig};
 use wobble_core::format::{Fault, FaultSource, Frame, FrameStatus, Record};
@@ -216,6 +216,34 @@ fn a_steering_read_failure_holds_the_angle_and_is_counted() {
     assert_eq!(frame.steer_cdeg, 13_500);
     assert!(frame.status.has(FrameStatus::STEER_SATURATED));
     assert!(faults(&records).is_empty());
+}
+
+#[test]
+fn an_adc_overrun_is_its_own_counted_fault() {
+    let mut s = sampler();
+    let mut out = Outputs::default();
+    step(&mut s, 1, &inputs(1), &mut out);
+    let overrun = Inputs {
+        steering: Err(SensorError::Overrun),
+        ..inputs(2)
+    };
+    let records = step(&mut s, 2, &overrun, &mut out);
+    assert!(frame_of(&records).status.has(FrameStatus::STEER_STALE));
+    let codes: Vec<_> = faults(&records)
+        .iter()
+        .map(|f| (f.source, f.code))
+        .collect();
+    assert_eq!(codes, [(FaultSource::Steering, FAULT_STEER_OVERRUN)]);
+    // A read failure right after is recorded under its own code at once.
+    let stale = Inputs {
+        steering: Err(SensorError::Stale),
+        ..inputs(3)
+    };
+    let codes: Vec<_> = faults(&step(&mut s, 3, &stale, &mut out))
+        .iter()
+        .map(|f| f.code)
+        .collect();
+    assert_eq!(codes, [FAULT_STEER_READ]);
 }
 
 #[test]

@@ -1,16 +1,21 @@
-//! The card block device identifies a card at the slow clock, runs it at
-//! the data clock, and after any error identifies it again before the next
-//! access: a card that was missing, then inserted, then pulled.
+//! The card block device identifies a card (wake-up clocks, slow clock),
+//! runs it at the data clock with chip select held for each operation, and
+//! after any error identifies it again before the next access: a card that
+//! was missing, then inserted, then pulled; and one whose blocks keep
+//! failing their CRC, which then runs at half the clock.
 
 mod sd_support;
 
-use std::cell::RefCell;
+use std::cell::{Cell, RefCell};
 
 use embedded_hal_mock::eh1::delay::NoopDelay;
+use embedded_hal_mock::eh1::digital::Mock as PinMock;
 use embedded_hal_mock::eh1::spi::Mock;
 use embedded_sdmmc::{Block, BlockCount, BlockDevice, BlockIdx, SdCardError};
 use sd_support::*;
-use wobble_core::drivers::sdcard::{Card, ACQUIRE_RETRIES, IDENTIFICATION_CLOCK_HZ};
+use wobble_core::drivers::sdcard::{
+    Card, CardHooks, ACQUIRE_RETRIES, CRC_ERRORS_BEFORE_SLOWING, IDENTIFICATION_CLOCK_HZ,
+};
 
 const DATA_CLOCK_HZ: u32 = 21_000_000;
 
@@ -27,6 +32,7 @@ const BLOCKS: u32 = 15_160 * 1024;
 
 thread_local! {
     static CLOCKS: RefCell<Vec<u32>> = const { RefCell::new(Vec::new()) };
+    static OPERATIONS: Cell<u32> = const { Cell::new(0) };
 }
 
 fn set_clock(_: &mut Mock<u8>, hz: u32) {
@@ -37,8 +43,23 @@ fn take_clocks() -> Vec<u32> {
     CLOCKS.with(|c| std::mem::take(&mut *c.borrow_mut()))
 }
 
+fn count_operation() {
+    OPERATIONS.with(|n| n.set(n.get() + 1));
+}
+
+pub const HOOKS: CardHooks<Mock<u8>> = CardHooks {
+    set_clock,
+    now_us: || 0,
+    after_operation: count_operation,
+};
+
 fn csd_read() -> Spi {
     [command(9, 0, R1_READY), data_block(&csd())].concat()
+}
+
+/// Wake-up clocks, then `exchange` as one operation.
+fn identification(exchange: Spi) -> Spi {
+    [wake_up_clocks(), operation(exchange)].concat()
 }
 
 #[test]
@@ -46,21 +67,33 @@ fn missing_then_inserted_then_pulled() {
     let attempts = ACQUIRE_RETRIES as usize + 1;
     let expectations = [
         // 1. No card.
-        silent_acquisition(attempts),
+        identification(silent_acquisition(attempts)),
         // 2. A card: identified (with its size read), then the size asked.
-        sdhc_identification(),
-        csd_read(),
-        csd_read(),
+        identification([sdhc_identification(), csd_read()].concat()),
+        operation(csd_read()),
         // 3. Pulled during a block read: CMD17 gets no answer.
-        byte(0xFF, NOTHING),
-        send(17, 5),
-        silence(POLLS_PER_COMMAND),
-        // 4. The next access starts over with identification.
-        silent_acquisition(attempts),
+        operation([byte(0xFF, NOTHING), send(17, 5), silence(POLLS_PER_COMMAND)].concat()),
+        // 4. The next access starts over, wake-up clocks first.
+        identification(silent_acquisition(attempts)),
     ]
     .concat();
     let mut spi = Mock::new(&expectations);
-    let card = Card::new(spi.clone(), NoopDelay::new(), set_clock, DATA_CLOCK_HZ);
+    let pins = [
+        &IDENTIFY_CS[..],
+        &IDENTIFY_CS,
+        &OPERATION_CS,
+        &OPERATION_CS,
+        &IDENTIFY_CS,
+    ]
+    .concat();
+    let mut chip_select = PinMock::new(&cs(&pins));
+    let card = Card::new(
+        spi.clone(),
+        chip_select.clone(),
+        NoopDelay::new(),
+        HOOKS,
+        DATA_CLOCK_HZ,
+    );
 
     assert!(matches!(card.num_blocks(), Err(SdCardError::CardNotFound)));
     assert_eq!(take_clocks(), [IDENTIFICATION_CLOCK_HZ]);
@@ -74,5 +107,69 @@ fn missing_then_inserted_then_pulled() {
 
     assert!(matches!(card.num_blocks(), Err(SdCardError::CardNotFound)));
     assert_eq!(take_clocks(), [IDENTIFICATION_CLOCK_HZ]);
+    // Every operation, failed or not, proved the writer alive.
+    assert_eq!(OPERATIONS.with(Cell::get), 5);
     spi.done();
+    chip_select.done();
+}
+
+#[test]
+fn repeated_crc_errors_halve_the_data_clock() {
+    let block = [0x5Au8; 512];
+    let bad_read = || {
+        [
+            command(17, 9, R1_READY),
+            data_block_with_crc(&block, crc16(&block) ^ 1),
+        ]
+        .concat()
+    };
+    let identify = || identification([sdhc_identification(), csd_read()].concat());
+    let mut expectations = Vec::new();
+    let mut pins = Vec::new();
+    for _ in 0..CRC_ERRORS_BEFORE_SLOWING {
+        expectations.extend([identify(), operation(bad_read())].concat());
+        pins.extend([&IDENTIFY_CS[..], &OPERATION_CS].concat());
+    }
+    expectations.extend(
+        [
+            identify(),
+            operation([command(17, 9, R1_READY), data_block(&block)].concat()),
+        ]
+        .concat(),
+    );
+    pins.extend([&IDENTIFY_CS[..], &OPERATION_CS].concat());
+    let mut spi = Mock::new(&expectations);
+    let mut chip_select = PinMock::new(&cs(&pins));
+    let card = Card::new(
+        spi.clone(),
+        chip_select.clone(),
+        NoopDelay::new(),
+        HOOKS,
+        DATA_CLOCK_HZ,
+    );
+    let mut blocks = [Block::new()];
+    for _ in 0..CRC_ERRORS_BEFORE_SLOWING {
+        let read = card.read(&mut blocks, BlockIdx(9));
+        assert!(matches!(read, Err(SdCardError::CrcError(..))), "{read:?}");
+    }
+    assert_eq!(card.data_clock_hz(), DATA_CLOCK_HZ / 2);
+    card.read(&mut blocks, BlockIdx(9))
+        .expect("read at the lower clock");
+    assert_eq!(blocks[0].contents, block);
+    let clocks = take_clocks();
+    let data_clocks: Vec<u32> = clocks
+        .into_iter()
+        .filter(|&hz| hz != IDENTIFICATION_CLOCK_HZ)
+        .collect();
+    assert_eq!(
+        data_clocks,
+        [
+            DATA_CLOCK_HZ,
+            DATA_CLOCK_HZ,
+            DATA_CLOCK_HZ,
+            DATA_CLOCK_HZ / 2
+        ]
+    );
+    spi.done();
+    chip_select.done();
 }

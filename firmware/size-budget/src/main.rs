@@ -1,5 +1,5 @@
 //! `wobble-size-budget ELF`: prints the firmware's flash and static RAM and
-//! exits with 1 when either exceeds the budget (128 KiB, 64 KiB), 2 on a
+//! exits with 1 when either exceeds the budget (192 KiB, 64 KiB), 2 on a
 //! usage error or an unreadable file.
 
 use std::process::ExitCode;

@@ -16,6 +16,10 @@
 //!   card is identified (at most 400 kHz), then 42 MHz / 2 = 21 MHz (at most
 //!   25 MHz in default speed mode).
 //! - A board with a 12 MHz crystal needs only M = 6 (and `HSE_HZ`).
+//! - Without the crystal (it did not start within
+//!   [`HSE_STARTUP_TIMEOUT_MS`]) the same tree runs from the 16 MHz HSI with
+//!   M = 8: every frequency is the same, only less exact (±1 % at 25 °C,
+//!   enough for the UART; recorded as a system fault).
 
 use embassy_stm32::rcc::{
     AHBPrescaler, APBPrescaler, Hse, HseMode, Pll, PllMul, PllPDiv, PllPreDiv, PllQDiv, PllSource,
@@ -26,22 +30,33 @@ use embassy_stm32::Config;
 
 /// The crystal.
 pub const HSE_HZ: u32 = 8_000_000;
+/// Longest wait for the crystal to start (ST's reference value; a good
+/// crystal needs about 2 ms).
+pub const HSE_STARTUP_TIMEOUT_MS: u32 = 100;
 /// SPI clock of the IMU (rounded down by the prescaler to 10.5 MHz).
 pub const IMU_SPI_HZ: u32 = 10_500_000;
 /// SPI clock of the card once identified.
 pub const CARD_SPI_HZ: u32 = 21_000_000;
 
-/// The chip configuration with the clock tree above.
-pub fn config() -> Config {
+/// The chip configuration with the clock tree above, from the crystal if
+/// `crystal` (it has started), else from the HSI.
+pub fn config(crystal: bool) -> Config {
     let mut config = Config::default();
     let rcc = &mut config.rcc;
-    rcc.hse = Some(Hse {
-        freq: Hertz(HSE_HZ),
-        mode: HseMode::Oscillator,
-    });
-    rcc.pll_src = PllSource::HSE;
+    let prediv = if crystal {
+        rcc.hse = Some(Hse {
+            freq: Hertz(HSE_HZ),
+            mode: HseMode::Oscillator,
+        });
+        rcc.pll_src = PllSource::HSE;
+        PllPreDiv::DIV4
+    } else {
+        rcc.hsi = true;
+        rcc.pll_src = PllSource::HSI;
+        PllPreDiv::DIV8
+    };
     rcc.pll = Some(Pll {
-        prediv: PllPreDiv::DIV4,
+        prediv,
         mul: PllMul::MUL168,
         divp: Some(PllPDiv::DIV2),
         divq: Some(PllQDiv::DIV7),

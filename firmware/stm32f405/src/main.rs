@@ -4,7 +4,7 @@
 //!
 //! | executor | priority | tasks |
 //! |---|---|---|
-//! | interrupt (UART4 vector) | high | 100 Hz sampler, wheel capture |
+//! | interrupt (UART4 vector) | high | 100 Hz sampler |
 //! | interrupt (UART5 vector) | medium | GPS |
 //! | thread mode | low | SD writer (blocking), watchdog feeder |
 #![no_std]
@@ -13,6 +13,7 @@
 mod adapters;
 mod clocks;
 mod pins;
+mod startup;
 mod watchdog;
 
 use cortex_m_rt::entry;
@@ -22,11 +23,9 @@ use embassy_stm32::gpio::{Input, Level, Output, Pull, Speed};
 use embassy_stm32::interrupt;
 use embassy_stm32::interrupt::{InterruptExt, Priority};
 use embassy_stm32::mode::Async;
-use embassy_stm32::peripherals::{ADC1, IWDG, TIM5};
+use embassy_stm32::peripherals::{ADC1, IWDG};
 use embassy_stm32::spi::Spi;
 use embassy_stm32::time::Hertz;
-use embassy_stm32::timer::input_capture::{CapturePin, InputCapture};
-use embassy_stm32::timer::low_level::CountingMode;
 use embassy_stm32::usart::{self, RingBufferedUartRx, Uart, UartTx};
 use embassy_stm32::Peri;
 use embassy_time::{Delay, Instant};
@@ -35,6 +34,7 @@ use embedded_sdmmc::VolumeManager;
 use static_cell::StaticCell;
 use wobble_core::app::sampler::{Sampler, SamplerPorts};
 use wobble_core::app::{gps, sampler, writer};
+use wobble_core::boot;
 use wobble_core::channels::{RecordQueue, SharedStatus};
 use wobble_core::config::{self, Config, Loaded, KEY_COUNT, MAX_TEXT_LEN};
 use wobble_core::detector::Detector;
@@ -94,8 +94,42 @@ unsafe fn UART5() {
 
 #[entry]
 fn main() -> ! {
-    let board = Board::new(embassy_stm32::init(clocks::config()));
+    // RTT needs no clock: this line appears even if the clocks never come up.
     defmt::info!("{} starting", FIRMWARE);
+    let reset = startup::take_reset_cause();
+    defmt::info!("reset cause: {}", reset);
+    let crystal = startup::start_hse();
+    if !crystal {
+        defmt::error!(
+            "HSE did not start in {} ms: running on HSI",
+            clocks::HSE_STARTUP_TIMEOUT_MS
+        );
+    }
+    let mut board = Board::new(embassy_stm32::init(clocks::config(crystal)));
+    startup::enable_flash_accelerator();
+    let bor = startup::ensure_bor_level3();
+    if let Some(code) = bor {
+        defmt::warn!("brown-out reset level 3: system fault {}", code);
+    }
+    let boot_faults = [
+        Some(reset.fault_code()),
+        (!crystal).then_some(boot::FAULT_HSE_FAILED),
+        bor,
+    ];
+    for code in boot_faults.into_iter().flatten() {
+        QUEUE.push(Record::Fault(boot::system_fault(code, 0)));
+    }
+    if reset.is_abnormal() || !crystal {
+        // Shown on the alert LED before logging starts: the cause, or 9
+        // for the crystal.
+        let code = if crystal {
+            reset.fault_code()
+        } else {
+            boot::FAULT_HSE_FAILED
+        };
+        let mut led = Output::new(board.rider.alert_led.reborrow(), Level::Low, Speed::Low);
+        startup::blink_code(&mut led, code);
+    }
 
     let (card, loaded) = card_and_config(board.card);
     let config = loaded.config;
@@ -110,14 +144,13 @@ fn main() -> ! {
         LoggerConfig::DEFAULT,
     );
 
-    let (sampler, ports, capture) =
-        sampler_parts(board.imu, board.steering, board.wheel, board.rider, &config);
+    let _wheel_timer = adapters::wheel::start(board.wheel);
+    let (sampler, ports) = sampler_parts(board.imu, board.steering, board.rider, &config);
     let (gps_tx, gps_rx) = gps_uart(board.gps);
 
     interrupt::UART4.set_priority(Priority::P6);
     let high = EXECUTOR_HIGH.start(interrupt::UART4);
     high.spawn(defmt::unwrap!(sampler_task(sampler, ports)));
-    high.spawn(defmt::unwrap!(wheel_task(capture)));
 
     interrupt::UART5.set_priority(Priority::P7);
     let medium = EXECUTOR_MEDIUM.start(interrupt::UART5);
@@ -171,10 +204,9 @@ fn header(config: &Config) -> HeaderSpec<'static> {
 fn sampler_parts(
     imu: pins::ImuPins,
     steering: pins::SteeringPins,
-    wheel: pins::WheelPins,
     rider: pins::RiderPins,
     config: &Config,
-) -> (Sampler, Ports, InputCapture<'static, TIM5>) {
+) -> (Sampler, Ports) {
     let mut spi_config = embassy_stm32::spi::Config::default();
     spi_config.frequency = Hertz(clocks::IMU_SPI_HZ);
     let bus = Spi::new(
@@ -190,17 +222,6 @@ fn sampler_parts(
     let steering = SteeringAdapter::new(
         steering_adc(steering.adc, steering.wiper, steering.dma),
         defmt::unwrap!(Steering::try_new(config.steering).ok()),
-    );
-
-    let capture = InputCapture::new(
-        wheel.timer,
-        Some(CapturePin::new(wheel.hall, Pull::Up)),
-        None,
-        None,
-        None,
-        Irqs,
-        Hertz(1_000_000),
-        CountingMode::EdgeAlignedUp,
     );
 
     let ports = SamplerPorts {
@@ -224,7 +245,7 @@ fn sampler_parts(
         defmt::unwrap!(Detector::new(config.detector).ok()),
         config.alert.pattern,
     );
-    (sampler, ports, capture)
+    (sampler, ports)
 }
 
 /// ADC1 converting the wiper continuously into a DMA ring, the slowest
@@ -278,11 +299,6 @@ async fn sampler_task(mut sampler: Sampler, mut ports: Ports) {
         },
     )
     .await;
-}
-
-#[embassy_executor::task]
-async fn wheel_task(capture: InputCapture<'static, TIM5>) {
-    adapters::wheel::capture_edges(capture).await
 }
 
 #[embassy_executor::task]

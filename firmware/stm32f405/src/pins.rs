@@ -11,7 +11,7 @@ use embassy_stm32::peripherals::{
     ADC1, DMA1_CH5, DMA1_CH6, DMA2_CH2, DMA2_CH3, DMA2_CH4, IWDG, PA0, PA2, PA3, PA4, PA5, PA6,
     PA7, PB0, PB1, PB12, PB13, PB14, PB15, PB9, PC0, PC4, SPI1, SPI2, TIM5, USART2,
 };
-use embassy_stm32::{bind_interrupts, dma, timer, usart, Peri, Peripherals};
+use embassy_stm32::{bind_interrupts, dma, usart, Peri, Peripherals};
 
 bind_interrupts!(
     /// Interrupt handlers of the drivers in use.
@@ -22,7 +22,6 @@ bind_interrupts!(
         DMA1_STREAM5 => dma::InterruptHandler<DMA1_CH5>;
         DMA1_STREAM6 => dma::InterruptHandler<DMA1_CH6>;
         USART2 => usart::InterruptHandler<USART2>;
-        TIM5 => timer::CaptureCompareInterruptHandler<TIM5>;
     }
 );
 
@@ -72,7 +71,8 @@ pub struct SteeringPins {
 pub struct WheelPins {
     /// TIM5, 32-bit, counting at 1 MHz.
     pub timer: Peri<'static, TIM5>,
-    /// PA0: TIM5_CH1, the sensor's open-collector output (pulled up).
+    /// PA0: TIM5_CH1, the sensor's open-collector output (pulled up; the
+    /// timer's own interrupt handler reads it, see `adapters::wheel`).
     pub hall: Peri<'static, PA0>,
 }
 

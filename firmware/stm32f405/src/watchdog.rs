@@ -1,23 +1,26 @@
 //! The independent watchdog, fed only while every task shows progress.
 //!
-//! The feeding task runs in thread mode, behind the SD writer: if the
-//! writer hangs, the feeder never runs. The sampler (high priority) and the
-//! GPS task (medium priority) count heartbeats; the feeder checks that both
-//! moved since its last round.
+//! The sampler (high priority) and the GPS task (medium priority) count
+//! heartbeats; the thread-mode writer proves itself by asking for a feed:
+//! after every card operation (`adapters::card`) and from a task that runs
+//! only when the writer yields. A feed happens at most once a round and
+//! only if both heartbeats moved (the core's `watchdog::Liveness`); the
+//! timeout is sized there for the slowest card operation and the LSI's
+//! full 17-47 kHz range.
 
+use core::cell::RefCell;
 use core::sync::atomic::{AtomicU32, Ordering};
 
 use embassy_stm32::peripherals::IWDG;
 use embassy_stm32::wdg::IndependentWatchdog;
 use embassy_stm32::Peri;
-use embassy_time::Timer;
+use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
+use embassy_sync::blocking_mutex::Mutex;
+use embassy_time::{Instant, Timer};
+use wobble_core::watchdog::{Liveness, Verdict, TIMEOUT_REQUEST_US};
 
-/// Reset after this long without feeding: above the longest legitimate
-/// block of thread mode (a missing card's acquisition, about 0.7 s, or a
-/// card's 0.5 s write stall) with margin.
-pub const TIMEOUT_US: u32 = 4_000_000;
-/// One round of checks.
-const ROUND_MS: u64 = 1_000;
+/// How often the task behind the writer asks.
+const ASK_MS: u64 = 250;
 
 /// A task's heartbeat counter.
 pub struct Heartbeat(AtomicU32);
@@ -42,19 +45,43 @@ pub static SAMPLER: Heartbeat = Heartbeat::new();
 /// Beats at least every 100 ms (each wait for GPS bytes).
 pub static GPS: Heartbeat = Heartbeat::new();
 
-/// Starts the watchdog and feeds it while the heartbeats move.
-pub async fn feed(iwdg: Peri<'static, IWDG>) -> ! {
-    let mut dog = IndependentWatchdog::new(iwdg, TIMEOUT_US);
-    dog.unleash();
-    let mut last = [SAMPLER.count(), GPS.count()];
-    loop {
-        Timer::after_millis(ROUND_MS).await;
-        let now = [SAMPLER.count(), GPS.count()];
-        if now.iter().zip(last).all(|(&n, l)| n != l) {
-            dog.pet();
-        } else {
-            defmt::error!("watchdog: a task stopped (sampler, gps beats {})", now);
+struct Dog {
+    iwdg: Option<IndependentWatchdog<'static, IWDG>>,
+    liveness: Liveness<2>,
+}
+
+static DOG: Mutex<CriticalSectionRawMutex, RefCell<Dog>> = Mutex::new(RefCell::new(Dog {
+    iwdg: None,
+    liveness: Liveness::new(),
+}));
+
+/// Feeds the watchdog if a round is due and every heartbeat moved (thread
+/// mode: the writer's side). Does nothing before [`feed`] started it.
+pub fn prove_alive() {
+    DOG.lock(|dog| {
+        let mut dog = dog.borrow_mut();
+        let beats = [SAMPLER.count(), GPS.count()];
+        match dog.liveness.check(Instant::now().as_micros(), beats) {
+            Verdict::NotDue => {}
+            Verdict::Alive => {
+                if let Some(iwdg) = dog.iwdg.as_mut() {
+                    iwdg.pet();
+                }
+            }
+            Verdict::Stalled(task) => {
+                defmt::error!("watchdog: task {} (0 sampler, 1 gps) stopped", task);
+            }
         }
-        last = now;
+    });
+}
+
+/// Starts the watchdog and asks for feeds behind the writer.
+pub async fn feed(iwdg: Peri<'static, IWDG>) -> ! {
+    let mut dog = IndependentWatchdog::new(iwdg, TIMEOUT_REQUEST_US as u32);
+    dog.unleash();
+    DOG.lock(|d| d.borrow_mut().iwdg = Some(dog));
+    loop {
+        prove_alive();
+        Timer::after_millis(ASK_MS).await;
     }
 }

@@ -6,6 +6,7 @@ use std::path::{Path, PathBuf};
 
 use wobble_core::detector::{AlertEvent, Detector, DetectorConfig};
 
+use crate::csv_input::{number_in, Cell, Step, TimeSteps};
 use crate::CliError;
 
 const AFTER_HELP: &str = "\
@@ -17,7 +18,8 @@ firmware does; without it, it runs on the steering alone.
 
 A gap in t_s longer than 1.5 sample periods restarts the detector (an alert
 that was on is reported off at the last sample before the gap, and a note goes
-to stderr); samples closer than 7.5 ms are an error (not 100 Hz).
+to stderr). Samples closer than 7.5 ms, or three gaps of the same length in a
+row, are an error: the CSV is not at 100 Hz.
 
 Output with --json: one JSON object per line for each alert change,
   {\"t_s\": 17.12, \"event\": \"alert_on\", \"freq_hz\": 6.4, \"amp_deg\": 0.8}
@@ -65,17 +67,13 @@ pub struct Replay {
     pub restarts: Vec<u64>,
 }
 
-/// Shortest sample spacing accepted, seconds (100 Hz with 25 % jitter).
-const MIN_DT_S: f64 = 0.0075;
-/// Longest sample spacing before the detector restarts, seconds.
-const MAX_DT_S: f64 = 0.015;
-
 /// Replays CSV text from `input` through a fresh detector with `cfg`.
 /// `path` only names the input in errors.
 ///
 /// # Errors
 /// [`CliError::File`] naming `path`, the line and the problem.
 pub fn replay(path: &Path, input: impl Read, cfg: DetectorConfig) -> Result<Replay, CliError> {
+    let cfg_rate_hz = cfg.sample_rate_hz;
     let mut det = Detector::new(cfg).map_err(|e| CliError::Usage(format!("detector: {e}")))?;
     let mut reader = csv::ReaderBuilder::new()
         .has_headers(true)
@@ -102,6 +100,7 @@ pub fn replay(path: &Path, input: impl Read, cfg: DetectorConfig) -> Result<Repl
     };
     let mut record = csv::StringRecord::new();
     let mut last: Option<(f64, u64)> = None;
+    let mut steps = TimeSteps::new(f64::from(cfg_rate_hz));
     loop {
         match reader.read_record(&mut record) {
             Ok(true) => {}
@@ -113,12 +112,16 @@ pub fn replay(path: &Path, input: impl Read, cfg: DetectorConfig) -> Result<Repl
             continue;
         }
         let number = |col: usize, name: &str| -> Result<Option<f64>, CliError> {
+            let cell = Cell {
+                line,
+                column: col + 1,
+                name,
+            };
             match record.get(col) {
                 None | Some("") => Ok(None),
-                Some(text) => match text.parse::<f64>() {
-                    Ok(v) if v.is_finite() => Ok(Some(v)),
-                    _ => Err(at_line(line, format!("`{name}` is not a number: {text:?}"))),
-                },
+                Some(text) => number_in(text, (f64::MIN, f64::MAX), "")
+                    .map(Some)
+                    .map_err(|e| cell.error(path, e)),
             }
         };
         let t_s = number(t_col, "t_s")?.ok_or_else(|| at_line(line, "`t_s` is empty".into()))?;
@@ -128,30 +131,23 @@ pub fn replay(path: &Path, input: impl Read, cfg: DetectorConfig) -> Result<Repl
             Some(c) => number(c, "speed_mps")?,
             None => None,
         };
-        if let Some((t_prev, line_prev)) = last {
-            let dt = t_s - t_prev;
-            if dt <= 0.0 {
-                return Err(at_line(
-                    line,
-                    format!("t_s {t_s} does not come after {t_prev} (line {line_prev})"),
-                ));
+        let step = steps.step(t_s, line).map_err(|e| {
+            let cell = Cell {
+                line,
+                column: t_col + 1,
+                name: "t_s",
+            };
+            cell.error(path, e)
+        })?;
+        if let (Step::Gap(_), Some((t_prev, _))) = (step, last) {
+            if det.alert_active() {
+                out.changes.push(Change {
+                    t_s: t_prev,
+                    event: AlertEvent::Off,
+                });
             }
-            if dt < MIN_DT_S {
-                return Err(at_line(
-                    line,
-                    format!("samples {dt:.4} s apart: the detector needs 100 Hz (0.01 s)"),
-                ));
-            }
-            if dt > MAX_DT_S {
-                if det.alert_active() {
-                    out.changes.push(Change {
-                        t_s: t_prev,
-                        event: AlertEvent::Off,
-                    });
-                }
-                det.reset();
-                out.restarts.push(line);
-            }
+            det.reset();
+            out.restarts.push(line);
         }
         last = Some((t_s, line));
         out.samples += 1;

@@ -1,7 +1,7 @@
 //! `wobblog encode`: build a card log from a CSV, through the firmware's encoder.
 
 use std::fs::File;
-use std::io::{BufWriter, Write};
+use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use wobble_core::format::header::header_records;
@@ -10,7 +10,9 @@ use wobble_core::format::{
     Record, ACCEL_COUNTS_PER_G, EDGE_AGE_NONE, GYRO_COUNTS_PER_DPS, STEER_COUNTS_PER_DEG,
 };
 
+use crate::csv_input::{number_in, Cell, TimeSteps};
 use crate::export::CSV_COLUMNS;
+use crate::output::Output;
 use crate::CliError;
 
 /// Arguments of `wobblog encode`.
@@ -25,15 +27,19 @@ pub struct Args {
     pub output: PathBuf,
 }
 
+/// The frame rate of the logs `encode` writes, as the firmware's.
+const SAMPLE_RATE_HZ: u16 = 100;
+
 /// A GPS fix is repeated at least this often while the CSV's GPS columns
 /// stay the same, so decoded rows keep their fix.
 const GPS_REPEAT_US: u64 = 500_000;
 
 /// Runs `wobblog encode`.
 pub fn run(args: &Args) -> Result<(), CliError> {
+    let mut output = Output::create(&args.output, &[&args.csv])?;
     let input = File::open(&args.csv).map_err(|e| CliError::file(&args.csv, e))?;
-    let output = File::create(&args.output).map_err(|e| CliError::file(&args.output, e))?;
-    encode(input, &args.csv, BufWriter::new(output), &args.output)
+    encode(input, &args.csv, &mut output, &args.output)?;
+    output.commit()
 }
 
 /// Index of each known column in the CSV, if present.
@@ -75,19 +81,28 @@ pub fn encode(
     let mut last_gps: Option<(u64, GpsFix)> = None;
     let mut record = csv::StringRecord::new();
     let mut rows = 0u64;
+    let mut steps = TimeSteps::new(f64::from(SAMPLE_RATE_HZ));
     while reader
         .read_record(&mut record)
         .map_err(|e| CliError::file(in_name, e))?
     {
         let line = record.position().map_or(0, |p| p.line());
-        let row = parse_row(&columns, &record)
-            .map_err(|e| CliError::file(in_name, format!("line {line}: {e}")))?;
+        let row = parse_row(&columns, &record, in_name, line)?;
+        let t_col = columns.0[0].unwrap_or(0);
+        steps.step(row.frame.t_us as f64 / 1e6, line).map_err(|e| {
+            let cell = Cell {
+                line,
+                column: t_col + 1,
+                name: "t_s",
+            };
+            cell.error(in_name, e)
+        })?;
         if rows == 0 {
             let info = LogInfo {
                 t_us: row.frame.t_us,
                 firmware: concat!("wobblog-encode ", env!("CARGO_PKG_VERSION")),
                 device_id: [0; 12],
-                sample_rate_hz: 100,
+                sample_rate_hz: SAMPLE_RATE_HZ,
                 run: 0,
             };
             for rec in header_records(info, []) {
@@ -122,56 +137,84 @@ struct Row {
     gps: Option<GpsFix>,
 }
 
-fn parse_row(columns: &Columns, record: &csv::StringRecord) -> Result<Row, String> {
+fn parse_row(
+    columns: &Columns,
+    record: &csv::StringRecord,
+    path: &Path,
+    line: u64,
+) -> Result<Row, CliError> {
+    let cell = |i: usize, c: usize| Cell {
+        line,
+        column: c + 1,
+        name: CSV_COLUMNS[i],
+    };
     let field = |i: usize| {
         columns.0[i]
-            .and_then(|c| record.get(c))
-            .filter(|f| !f.is_empty())
+            .and_then(|c| Some((c, record.get(c)?)))
+            .filter(|(_, f)| !f.is_empty())
     };
-    let number = |i: usize| -> Result<f64, String> {
-        field(i).map_or(Ok(0.0), |f| {
-            f.parse::<f64>()
-                .map_err(|_| format!("{}: not a number: {f:?}", CSV_COLUMNS[i]))
+    // A missing column or empty cell is zero (or no GPS); a value that is
+    // given must be one the log can store.
+    let number = |i: usize, range: (f64, f64), unit: &str| -> Result<f64, CliError> {
+        field(i).map_or(Ok(0.0), |(c, text)| {
+            number_in(text, range, unit).map_err(|e| cell(i, c).error(path, e))
         })
     };
-    let t_s = number(0)?;
-    if !(0.0..=1.8e13).contains(&t_s) {
-        return Err(format!("t_s: {t_s} is not a time since boot in seconds"));
+    let counts = |scale: f32| {
+        let k = f64::from(scale);
+        (f64::from(i16::MIN) / k, f64::from(i16::MAX) / k)
+    };
+    if field(0).is_none() {
+        let c = columns.0[0].unwrap_or(0);
+        return Err(cell(0, c).error(path, "is empty"));
     }
+    // Microseconds since boot in a u64, with room to spare.
+    let t_s = number(0, (0.0, 1.8e13), " s")?;
     let t_us = (t_s * 1e6).round() as u64;
-    let q = |i: usize, scale: f32| number(i).map(|v| quantise_i16(v, scale));
+    let q = |i: usize, scale: f32, unit: &str| {
+        number(i, counts(scale), unit).map(|v| quantise_i16(v, scale))
+    };
     let frame = Frame {
         t_us,
         accel: [
-            q(1, ACCEL_COUNTS_PER_G)?,
-            q(2, ACCEL_COUNTS_PER_G)?,
-            q(3, ACCEL_COUNTS_PER_G)?,
+            q(1, ACCEL_COUNTS_PER_G, " g")?,
+            q(2, ACCEL_COUNTS_PER_G, " g")?,
+            q(3, ACCEL_COUNTS_PER_G, " g")?,
         ],
         gyro: [
-            q(4, GYRO_COUNTS_PER_DPS)?,
-            q(5, GYRO_COUNTS_PER_DPS)?,
-            q(6, GYRO_COUNTS_PER_DPS)?,
+            q(4, GYRO_COUNTS_PER_DPS, " deg/s")?,
+            q(5, GYRO_COUNTS_PER_DPS, " deg/s")?,
+            q(6, GYRO_COUNTS_PER_DPS, " deg/s")?,
         ],
-        steer_cdeg: q(7, STEER_COUNTS_PER_DEG)?,
+        steer_cdeg: q(7, STEER_COUNTS_PER_DEG, " deg")?,
         wheel_count: 0,
         wheel_edge_age_us: EDGE_AGE_NONE,
-        speed_mm_s: quantise_u16(number(8)?, 1000.0),
+        speed_mm_s: quantise_u16(number(8, (0.0, 65.535), " m/s")?, 1000.0),
         status: Default::default(),
     };
     let gps = match (field(9), field(10)) {
         (Some(_), Some(_)) => {
-            let fix = match field(12) {
-                Some("3d") => FixMode::Fix3d,
-                Some("2d") => FixMode::Fix2d,
-                Some("none") => FixMode::None,
-                other => return Err(format!("gps_fix: expected 2d, 3d or none, found {other:?}")),
-            };
+            let fix =
+                match field(12) {
+                    Some((_, "3d")) => FixMode::Fix3d,
+                    Some((_, "2d")) => FixMode::Fix2d,
+                    Some((_, "none")) => FixMode::None,
+                    Some((c, other)) => {
+                        return Err(cell(12, c)
+                            .error(path, format!("must be 2d, 3d or none, not {other:?}")))
+                    }
+                    None => {
+                        let c = columns.0[12].unwrap_or(record.len());
+                        return Err(cell(12, c)
+                            .error(path, "must be 2d, 3d or none when a position is given"));
+                    }
+                };
             Some(GpsFix {
                 t_us,
-                lat_e7: Some(quantise_i32(number(9)?, 1e7)),
-                lon_e7: Some(quantise_i32(number(10)?, 1e7)),
+                lat_e7: Some(quantise_i32(number(9, (-90.0, 90.0), " deg")?, 1e7)),
+                lon_e7: Some(quantise_i32(number(10, (-180.0, 180.0), " deg")?, 1e7)),
                 speed_cm_s: field(11)
-                    .map(|_| number(11))
+                    .map(|_| number(11, (0.0, 655.35), " m/s"))
                     .transpose()?
                     .map(|v| quantise_u16(v, 100.0)),
                 fix,
@@ -179,7 +222,13 @@ fn parse_row(columns: &Columns, record: &csv::StringRecord) -> Result<Row, Strin
             })
         }
         (None, None) => None,
-        _ => return Err("gps_lat_deg and gps_lon_deg must both be given or both empty".into()),
+        (Some((c, _)), None) | (None, Some((c, _))) => {
+            let i = if field(9).is_some() { 9 } else { 10 };
+            return Err(cell(i, c).error(
+                path,
+                "is given without its partner: gps_lat_deg and gps_lon_deg go together",
+            ));
+        }
     };
     Ok(Row { frame, gps })
 }

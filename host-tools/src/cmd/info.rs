@@ -107,8 +107,12 @@ fn render(path: &std::path::Path, s: &Summary) -> String {
     for line in &s.config {
         let _ = writeln!(o, "  {line}");
     }
-    for line in s.losses.describe() {
-        let _ = writeln!(o, "  {line}");
+    let losses = s.losses.describe();
+    if !losses.is_empty() {
+        let _ = writeln!(o, "losses:");
+        for line in losses {
+            let _ = writeln!(o, "  {line}");
+        }
     }
     o
 }

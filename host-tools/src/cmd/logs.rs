@@ -7,6 +7,7 @@ use std::path::{Path, PathBuf};
 use indicatif::{ProgressBar, ProgressStyle};
 
 use crate::analysis::Run;
+use crate::output::Output;
 use crate::CliError;
 
 /// Calls `visit` for every log in turn behind a progress bar (drawn only on
@@ -26,25 +27,22 @@ pub fn for_each_log(
         bar.set_style(style.progress_chars("=> "));
     }
     bar.set_message(message);
-    let mut failed: Vec<&Path> = Vec::new();
+    let mut failed = 0usize;
     for log in logs {
         if let Err(e) = visit(log) {
             bar.suspend(|| eprintln!("wobblog: {e}"));
-            failed.push(log);
+            failed += 1;
         }
         bar.inc(1);
     }
     bar.finish_and_clear();
-    match failed.as_slice() {
-        [] => Ok(()),
-        [first, ..] => Err(CliError::file(
-            first,
-            format!(
-                "{} of {} logs could not be read (see above); the others were processed",
-                failed.len(),
-                logs.len()
-            ),
-        )),
+    match failed {
+        0 => Ok(()),
+        _ => Err(CliError::Failed(format!(
+            "{} of {} logs could not be read (see above); the others were processed",
+            failed,
+            logs.len()
+        ))),
     }
 }
 
@@ -59,11 +57,9 @@ pub fn warn_losses(run: &Run) {
 /// Writes `text` to standard output. A closed pipe (`| head`) ends the
 /// output quietly, where `print!` would panic; other errors are reported.
 pub fn print_stdout(text: &str) -> Result<(), CliError> {
-    let mut out = std::io::stdout().lock();
-    match out.write_all(text.as_bytes()).and_then(|()| out.flush()) {
-        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => {
-            Err(CliError::file(Path::new("<stdout>"), e))
-        }
-        _ => Ok(()),
+    let mut out = Output::stdout();
+    match out.write_all(text.as_bytes()) {
+        Ok(()) => out.commit(),
+        Err(e) => Err(out.error(e)),
     }
 }

@@ -1,11 +1,15 @@
 //! One module per `wobblog` subcommand: its clap arguments and its `run`.
 
+pub mod completions;
+pub mod config;
 pub mod decode;
 pub mod detect;
 pub mod encode;
+pub mod events;
 pub mod gpx;
 pub mod info;
 pub mod logs;
+pub mod model;
 pub mod nmea;
 pub mod plot;
 pub mod summary;

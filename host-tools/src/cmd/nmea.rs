@@ -6,13 +6,14 @@
 //! fix it emits is printed as one JSON object per line; counted faults are
 //! summarised on stderr.
 
-use std::io::{self, BufWriter, Write};
-use std::path::{Path, PathBuf};
+use std::io::{self, Write};
+use std::path::PathBuf;
 
 use serde::Serialize;
 use wobble_core::format::GpsFix;
 use wobble_core::gps::{self, GpsConfig, GpsEvent, GpsReceiver, GpsStats};
 
+use crate::output::Output;
 use crate::time::iso8601;
 use crate::CliError;
 
@@ -77,14 +78,10 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         baud: args.baud,
         ..GpsConfig::default()
     };
-    let mut out = BufWriter::new(io::stdout().lock());
+    let mut out = Output::stdout();
     let replayed = replay(&capture, config, &mut |fix| write_fix(&mut out, fix));
-    let stats = match replayed.and_then(|stats| out.flush().map(|()| stats)) {
-        Ok(stats) => stats,
-        // A closed pipe (`| head`) ends the output quietly.
-        Err(e) if e.kind() == io::ErrorKind::BrokenPipe => return Ok(()),
-        Err(e) => return Err(CliError::file(Path::new("<stdout>"), e)),
-    };
+    let stats = replayed.map_err(|e| out.error(e))?;
+    out.commit()?;
     for (code, &count) in (1u8..).zip(&stats.faults) {
         if count > 0 {
             let what = gps::fault_name(code).unwrap_or("other faults");

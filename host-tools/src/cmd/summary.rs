@@ -120,8 +120,8 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         rows.push(RunRow::of(&run));
         Ok(())
     });
-    print_stdout(&render(&rows, args.format))?;
-    result
+    let printed = print_stdout(&render(&rows, args.format));
+    result.and(printed)
 }
 
 fn opt(v: Option<f64>) -> String {

@@ -5,10 +5,12 @@ use std::path::{Path, PathBuf};
 
 use serde::Serialize;
 
-use crate::analysis::{find_episodes, wobble_speed_mps, Episode, Run};
+use crate::analysis::{find_episodes, wobble_speed_mps, Episode, Run, Stability};
 use crate::cmd::logs::{for_each_log, print_stdout, warn_losses};
+use crate::output::Output;
 use crate::plot::modes::ModePlot;
 use crate::plot::{render, ImageKind};
+use crate::time::WindowArgs;
 use crate::CliError;
 
 /// Arguments of `wobblog wobble`.
@@ -24,6 +26,9 @@ pub struct Args {
     /// `.png` or `.svg` file.
     #[arg(long, value_name = "OUT")]
     pub plot: Option<PathBuf>,
+    /// Only episodes whose onset falls in this window (`--from`, `--to`).
+    #[command(flatten)]
+    pub window: WindowArgs,
 }
 
 /// The episodes of one run, as printed.
@@ -43,12 +48,21 @@ pub fn run(args: &Args) -> Result<(), CliError> {
     if let Some(plot) = &args.plot {
         ImageKind::of(plot)?;
     }
+    let inputs: Vec<&Path> = args.logs.iter().map(PathBuf::as_path).collect();
+    let plot_out = args
+        .plot
+        .as_deref()
+        .map(|p| Output::create(p, &inputs))
+        .transpose()?;
     let mut reports = Vec::new();
     let mut names = Vec::new();
     let result = for_each_log(&args.logs, "analysing", |log| {
         let run = Run::load(log)?;
         warn_losses(&run);
-        let episodes = find_episodes(&run);
+        let (from, to) = args.window.window().boot_s(&run.summary.utc_syncs, log)?;
+        let mut episodes = find_episodes(&run);
+        episodes
+            .retain(|e| from.is_none_or(|a| e.onset_s >= a) && to.is_none_or(|b| e.onset_s <= b));
         reports.push(RunEpisodes {
             log: log.display().to_string(),
             wobble_speed_mps: wobble_speed_mps(&episodes),
@@ -68,16 +82,17 @@ pub fn run(args: &Args) -> Result<(), CliError> {
             text.push_str(&render_text(report));
         }
     }
-    print_stdout(&text)?;
-    if let Some(plot) = &args.plot {
+    // The figure is drawn even when the table's reader went away.
+    let printed = print_stdout(&text);
+    if let Some(out) = plot_out {
         let runs = names
             .into_iter()
             .zip(reports)
             .map(|(name, r)| (name, r.episodes))
             .collect();
-        render(&ModePlot::new(runs), plot)?;
+        render(&ModePlot::new(runs), out)?;
     }
-    result
+    result.and(printed)
 }
 
 fn render_text(r: &RunEpisodes) -> String {
@@ -90,27 +105,26 @@ fn render_text(r: &RunEpisodes) -> String {
         });
     let _ = writeln!(
         o,
-        "{}: {} episodes, wobble speed {speed}",
+        "{}: {}, wobble speed {speed}",
         r.log,
-        r.episodes.len()
+        crate::words::plural(r.episodes.len(), "episode")
     );
+    // The same names as the JSON fields.
     if !r.episodes.is_empty() {
         let _ = writeln!(
             o,
-            "  onset_s    end_s  freq_hz  sigma_per_s  peak_deg  speed_mps  stability"
+            "  onset_s    end_s  freq_hz  sigma_per_s  peak_amp_deg  speed_at_onset_mps  stability"
         );
     }
     for e in &r.episodes {
+        let stability = match e.stability {
+            Stability::Stable => "stable",
+            Stability::Unstable => "unstable",
+        };
         let _ = writeln!(
             o,
-            "  {:7.2}  {:7.2}  {:7.2}  {:11.2}  {:8.2}  {:9.2}  {:?}",
-            e.onset_s,
-            e.end_s,
-            e.freq_hz,
-            e.sigma_per_s,
-            e.peak_amp_deg,
-            e.speed_at_onset_mps,
-            e.stability
+            "  {:7.2}  {:7.2}  {:7.2}  {:11.2}  {:12.2}  {:18.2}  {stability}",
+            e.onset_s, e.end_s, e.freq_hz, e.sigma_per_s, e.peak_amp_deg, e.speed_at_onset_mps,
         );
     }
     o

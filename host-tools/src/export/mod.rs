@@ -1,14 +1,21 @@
-//! Writing rows as CSV, JSON lines or Parquet.
+//! Writing rows as CSV, JSON lines or Parquet, with the columns of
+//! [`columns::COLUMNS`] (or a selection of them).
 
+pub mod columns;
+pub mod metadata;
 pub mod parquet;
 
 use std::io::Write;
+use std::path::Path;
 
-use serde::Serialize;
+use columns::{Column, Value};
+pub use metadata::LogMetadata;
 
 use crate::rows::Row;
+use crate::CliError;
 
-/// CSV column names, units in the names. `wobblog encode` reads the same.
+/// The CSV columns `wobblog encode` reads: the documented ones, units in
+/// the names (the first columns of [`columns::COLUMNS`]).
 pub const CSV_COLUMNS: [&str; 13] = [
     "t_s",
     "ax_g",
@@ -36,32 +43,79 @@ pub enum Format {
     Parquet,
 }
 
+impl Format {
+    /// The format an output file's extension names, if any.
+    #[must_use]
+    pub fn of_extension(path: &Path) -> Option<Self> {
+        let ext = path.extension()?.to_string_lossy().to_ascii_lowercase();
+        match ext.as_str() {
+            "csv" => Some(Self::Csv),
+            "jsonl" | "ndjson" => Some(Self::Jsonl),
+            "parquet" => Some(Self::Parquet),
+            _ => None,
+        }
+    }
+
+    /// The format to write: `--format` if given, else the output's
+    /// extension, else CSV.
+    ///
+    /// # Errors
+    /// A usage error when `--format` contradicts the extension.
+    pub fn resolve(given: Option<Self>, output: Option<&Path>) -> Result<Self, CliError> {
+        let implied = output.and_then(Self::of_extension);
+        match (given, implied) {
+            (Some(g), Some(i)) if g != i => Err(CliError::Usage(format!(
+                "--format {} contradicts the output file {} (a {} name)",
+                g.name(),
+                output.map_or(String::new(), |p| p.display().to_string()),
+                i.name()
+            ))),
+            (Some(f), _) | (None, Some(f)) => Ok(f),
+            (None, None) => Ok(Self::Csv),
+        }
+    }
+
+    /// The name as `--format` takes it.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Csv => "csv",
+            Self::Jsonl => "jsonl",
+            Self::Parquet => "parquet",
+        }
+    }
+}
+
 /// Writes rows in one format.
+pub struct RowWriter<W: Write + Send> {
+    columns: Vec<Column>,
+    sink: Sink<W>,
+}
+
 // One writer per export: the variants' sizes do not matter.
 #[allow(clippy::large_enum_variant)]
-pub enum RowWriter<W: Write + Send> {
+enum Sink<W: Write + Send> {
     /// CSV; the flag says whether the header line is out.
     Csv(csv::Writer<W>, bool),
-    /// JSON lines.
     Jsonl(W),
-    /// Parquet.
     Parquet(parquet::ParquetWriter<W>),
 }
 
 impl<W: Write + Send> RowWriter<W> {
-    /// A writer. Nothing is written until the first row or [`Self::flush`],
-    /// so a log that cannot be read leaves no half output.
-    pub fn new(format: Format, out: W) -> Self {
-        match format {
-            Format::Csv => Self::Csv(csv::Writer::from_writer(out), false),
-            Format::Jsonl => Self::Jsonl(out),
-            Format::Parquet => Self::Parquet(parquet::ParquetWriter::new(out)),
-        }
+    /// A writer of `columns`. Nothing is written until the first row or
+    /// [`Self::finish`], so a log that cannot be read leaves no half output.
+    pub fn new(format: Format, columns: Vec<Column>, out: W) -> Self {
+        let sink = match format {
+            Format::Csv => Sink::Csv(csv::Writer::from_writer(out), false),
+            Format::Jsonl => Sink::Jsonl(out),
+            Format::Parquet => Sink::Parquet(parquet::ParquetWriter::new(out, &columns)),
+        };
+        Self { columns, sink }
     }
 
     fn header(&mut self) -> csv::Result<()> {
-        if let Self::Csv(w, done @ false) = self {
-            w.write_record(CSV_COLUMNS)?;
+        if let Sink::Csv(w, done @ false) = &mut self.sink {
+            w.write_record(self.columns.iter().map(|c| c.name))?;
             *done = true;
         }
         Ok(())
@@ -70,99 +124,106 @@ impl<W: Write + Send> RowWriter<W> {
     /// Writes one row.
     pub fn write(&mut self, row: &Row) -> std::io::Result<()> {
         self.header().map_err(csv_io_error)?;
-        match self {
-            Self::Csv(w, _) => write_csv(w, row).map_err(csv_io_error),
-            Self::Jsonl(w) => {
-                serde_json::to_writer(&mut *w, &JsonRow::from(row))?;
-                w.write_all(b"\n")
-            }
-            Self::Parquet(w) => w.write(row).map_err(std::io::Error::other),
+        match &mut self.sink {
+            Sink::Csv(w, _) => write_csv(w, &self.columns, row).map_err(csv_io_error),
+            Sink::Jsonl(w) => write_json(w, &self.columns, row),
+            Sink::Parquet(w) => w.write(row).map_err(std::io::Error::other),
         }
     }
 
-    /// Writes the CSV header if no row came (the Parquet footer), and
-    /// flushes buffered output.
-    pub fn flush(&mut self) -> std::io::Result<()> {
+    /// Writes the CSV header if no row came, or the Parquet footer with
+    /// `meta`, and flushes buffered output.
+    pub fn finish(&mut self, meta: &LogMetadata) -> std::io::Result<()> {
         self.header().map_err(csv_io_error)?;
-        match self {
-            Self::Csv(w, _) => w.flush(),
-            Self::Jsonl(w) => w.flush(),
-            Self::Parquet(w) => w.finish().map_err(std::io::Error::other),
+        match &mut self.sink {
+            Sink::Csv(w, _) => w.flush(),
+            Sink::Jsonl(w) => w.flush(),
+            Sink::Parquet(w) => w.finish(meta).map_err(std::io::Error::other),
         }
     }
 }
 
-fn write_csv<W: Write>(w: &mut csv::Writer<W>, row: &Row) -> csv::Result<()> {
+fn write_csv<W: Write>(w: &mut csv::Writer<W>, columns: &[Column], row: &Row) -> csv::Result<()> {
     let mut num = ryu::Buffer::new();
-    w.write_field(num.format(row.t_s))?;
-    for v in row
-        .accel_g
-        .iter()
-        .chain(&row.gyro_dps)
-        .chain([&row.steer_deg, &row.speed_mps])
-    {
-        w.write_field(num.format(*v))?;
-    }
-    match &row.gps {
-        Some(gps) => {
-            w.write_field(num.format(gps.lat_deg))?;
-            w.write_field(num.format(gps.lon_deg))?;
-            w.write_field(gps.speed_mps.map_or("", |v| num.format(v)))?;
-            w.write_field(gps.fix.as_str())?;
+    for column in columns {
+        match (column.value)(row) {
+            Value::Number(Some(v)) => w.write_field(num.format(v))?,
+            Value::Label(Some(s)) => w.write_field(s)?,
+            Value::Utc(Some(us)) => w.write_field(utc_text(us))?,
+            Value::Number(None) | Value::Label(None) | Value::Utc(None) => w.write_field("")?,
         }
-        None => (0..4).try_for_each(|_| w.write_field(""))?,
     }
     w.write_record(None::<&[u8]>)
 }
 
-#[derive(Serialize)]
-struct JsonRow {
-    t_s: f64,
-    ax_g: f64,
-    ay_g: f64,
-    az_g: f64,
-    gx_dps: f64,
-    gy_dps: f64,
-    gz_dps: f64,
-    steer_deg: f64,
-    speed_mps: f64,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    gps_lat_deg: Option<f64>,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    gps_lon_deg: Option<f64>,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    gps_speed_mps: Option<f64>,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    gps_fix: Option<&'static str>,
+/// One JSON object per row; absent values are left out. Written by hand:
+/// every key is a plain column name and every string value a fixed name or
+/// an ISO time, so nothing needs escaping, and no map is built per row.
+fn write_json<W: Write>(w: &mut W, columns: &[Column], row: &Row) -> std::io::Result<()> {
+    let mut num = ryu::Buffer::new();
+    let mut line = String::with_capacity(256);
+    line.push('{');
+    for column in columns {
+        let text = match (column.value)(row) {
+            Value::Number(Some(v)) => num.format(v).to_string(),
+            Value::Label(Some(s)) => format!("\"{s}\""),
+            Value::Utc(Some(us)) => format!("\"{}\"", utc_text(us)),
+            Value::Number(None) | Value::Label(None) | Value::Utc(None) => continue,
+        };
+        if line.len() > 1 {
+            line.push(',');
+        }
+        line.push('"');
+        line.push_str(column.name);
+        line.push_str("\":");
+        line.push_str(&text);
+    }
+    line.push_str("}\n");
+    w.write_all(line.as_bytes())
 }
 
-impl From<&Row> for JsonRow {
-    fn from(r: &Row) -> Self {
-        let [ax_g, ay_g, az_g] = r.accel_g;
-        let [gx_dps, gy_dps, gz_dps] = r.gyro_dps;
-        Self {
-            t_s: r.t_s,
-            ax_g,
-            ay_g,
-            az_g,
-            gx_dps,
-            gy_dps,
-            gz_dps,
-            steer_deg: r.steer_deg,
-            speed_mps: r.speed_mps,
-            gps_lat_deg: r.gps.map(|g| g.lat_deg),
-            gps_lon_deg: r.gps.map(|g| g.lon_deg),
-            gps_speed_mps: r.gps.and_then(|g| g.speed_mps),
-            gps_fix: r.gps.map(|g| g.fix.as_str()),
-        }
-    }
+/// UTC in ISO 8601 to the millisecond (rounded down).
+fn utc_text(us: i64) -> String {
+    crate::time::iso8601_unix_ms(us.div_euclid(1000)).unwrap_or_default()
 }
 
 /// Keeps the kind of an I/O error wrapped by `csv` (its own conversion
 /// turns every error into `Other`, hiding a closed pipe).
 fn csv_io_error(err: csv::Error) -> std::io::Error {
+    let message = err.to_string();
     match err.into_kind() {
         csv::ErrorKind::Io(e) => e,
-        other => std::io::Error::other(format!("{other:?}")),
+        _ => std::io::Error::other(message),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_documented_csv_columns_come_first() {
+        let names: Vec<&str> = columns::COLUMNS.iter().map(|c| c.name).collect();
+        assert_eq!(names[..CSV_COLUMNS.len()], CSV_COLUMNS);
+    }
+
+    #[test]
+    fn format_follows_the_extension_and_refuses_contradictions() {
+        fn p(s: &str) -> Option<&Path> {
+            Some(Path::new(s))
+        }
+        assert_eq!(
+            Format::resolve(None, p("a.parquet")).unwrap(),
+            Format::Parquet
+        );
+        assert_eq!(Format::resolve(None, p("a.JSONL")).unwrap(), Format::Jsonl);
+        assert_eq!(Format::resolve(None, p("a.txt")).unwrap(), Format::Csv);
+        assert_eq!(Format::resolve(None, None).unwrap(), Format::Csv);
+        assert_eq!(
+            Format::resolve(Some(Format::Jsonl), p("a.txt")).unwrap(),
+            Format::Jsonl
+        );
+        let err = Format::resolve(Some(Format::Csv), p("a.parquet")).unwrap_err();
+        assert_eq!(err.exit_code(), 2);
     }
 }

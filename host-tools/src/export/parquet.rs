@@ -1,40 +1,45 @@
 //! Rows as an Apache Parquet file, so pandas, Polars and DuckDB read a run
-//! directly, with its column types. Same columns as the CSV; GPS columns are
-//! nullable.
+//! directly, with its column types: numbers as doubles (GPS ones nullable),
+//! `gps_fix` as a dictionary-encoded string, `utc` as a UTC timestamp, and
+//! the log's identity, configuration and units as key-value metadata.
 
 use std::io::Write;
 use std::sync::Arc;
 
 use parquet::basic::Compression;
-use parquet::data_type::{ByteArray, ByteArrayType, DoubleType};
+use parquet::data_type::{ByteArray, ByteArrayType, DoubleType, Int64Type};
 use parquet::errors::ParquetError;
+use parquet::file::metadata::KeyValue;
 use parquet::file::properties::WriterProperties;
 use parquet::file::writer::{
     SerializedColumnWriter, SerializedFileWriter, SerializedRowGroupWriter,
 };
 use parquet::schema::parser::parse_message_type;
+use parquet::schema::types::ColumnPath;
 
-use super::CSV_COLUMNS;
+use super::columns::{Column, Kind, Value};
+use super::LogMetadata;
 use crate::rows::Row;
 
 /// Rows per row group: a few MB per group, so memory stays bounded on long
 /// runs while readers still get large, efficient column chunks.
 const ROW_GROUP_ROWS: usize = 65_536;
-/// Columns always present: `t_s` to `speed_mps`.
-const REQUIRED: usize = 9;
-/// Nullable numeric GPS columns that follow them.
-const GPS_NUMERIC: usize = 3;
 
 /// Writes rows into a Parquet file on any writer (the format is written
 /// front to back; only readers need to seek).
 pub struct ParquetWriter<W: Write + Send> {
     state: State<W>,
-    required: [Vec<f64>; REQUIRED],
-    gps: [Vec<f64>; GPS_NUMERIC],
-    gps_defined: [Vec<i16>; GPS_NUMERIC],
-    fix: Vec<ByteArray>,
-    fix_defined: Vec<i16>,
+    columns: Vec<Column>,
+    buffers: Vec<Buffer>,
     rows: usize,
+}
+
+/// One column's values of the row group being built, with the definition
+/// levels of a nullable column (1 present, 0 absent).
+enum Buffer {
+    Number(Vec<f64>, Option<Vec<i16>>),
+    Label(Vec<ByteArray>, Vec<i16>),
+    Utc(Vec<i64>, Vec<i16>),
 }
 
 enum State<W: Write + Send> {
@@ -45,34 +50,41 @@ enum State<W: Write + Send> {
 }
 
 impl<W: Write + Send> ParquetWriter<W> {
-    /// A writer on `out`.
-    pub fn new(out: W) -> Self {
+    /// A writer of `columns` on `out`.
+    pub fn new(out: W, columns: &[Column]) -> Self {
+        let buffers = columns
+            .iter()
+            .map(|c| match c.kind {
+                Kind::Number => Buffer::Number(Vec::new(), None),
+                Kind::OptNumber => Buffer::Number(Vec::new(), Some(Vec::new())),
+                Kind::Label => Buffer::Label(Vec::new(), Vec::new()),
+                Kind::Utc => Buffer::Utc(Vec::new(), Vec::new()),
+            })
+            .collect();
         Self {
             state: State::Idle(out),
-            required: Default::default(),
-            gps: Default::default(),
-            gps_defined: Default::default(),
-            fix: Vec::new(),
-            fix_defined: Vec::new(),
+            columns: columns.to_vec(),
+            buffers,
             rows: 0,
         }
     }
 
-    /// The schema, built from the CSV column names.
-    fn schema() -> String {
+    /// The schema of the columns.
+    fn schema(&self) -> String {
         let mut s = String::from("message wobblog_row {\n");
-        for (i, name) in CSV_COLUMNS.iter().enumerate() {
-            let field = match i {
-                i if i < REQUIRED => "REQUIRED DOUBLE",
-                i if i < REQUIRED + GPS_NUMERIC => "OPTIONAL DOUBLE",
-                _ => "OPTIONAL BYTE_ARRAY",
+        for c in &self.columns {
+            let field = match c.kind {
+                Kind::Number => "REQUIRED DOUBLE",
+                Kind::OptNumber => "OPTIONAL DOUBLE",
+                Kind::Label => "OPTIONAL BYTE_ARRAY",
+                Kind::Utc => "OPTIONAL INT64",
             };
-            let annotation = if field.ends_with("BYTE_ARRAY") {
-                " (UTF8)"
-            } else {
-                ""
+            let annotation = match c.kind {
+                Kind::Label => " (UTF8)",
+                Kind::Utc => " (TIMESTAMP(MICROS,true))",
+                _ => "",
             };
-            s.push_str(&format!("  {field} {name}{annotation};\n"));
+            s.push_str(&format!("  {field} {}{annotation};\n", c.name));
         }
         s.push('}');
         s
@@ -80,15 +92,22 @@ impl<W: Write + Send> ParquetWriter<W> {
 
     fn file(&mut self) -> Result<&mut SerializedFileWriter<W>, ParquetError> {
         if let State::Idle(_) = self.state {
-            let schema = Arc::new(parse_message_type(&Self::schema())?);
-            let props = WriterProperties::builder()
+            let schema = Arc::new(parse_message_type(&self.schema())?);
+            let mut props = WriterProperties::builder()
                 .set_compression(Compression::SNAPPY)
                 .set_created_by(concat!("wobblog ", env!("CARGO_PKG_VERSION")).into())
-                .build();
+                // Numbers are nearly all distinct: a dictionary would be
+                // built and thrown away for every page.
+                .set_dictionary_enabled(false);
+            for c in self.columns.iter().filter(|c| c.kind == Kind::Label) {
+                props = props.set_column_dictionary_enabled(ColumnPath::from(c.name), true);
+            }
             self.state = match std::mem::replace(&mut self.state, State::Closed) {
-                State::Idle(out) => {
-                    State::Open(SerializedFileWriter::new(out, schema, Arc::new(props))?)
-                }
+                State::Idle(out) => State::Open(SerializedFileWriter::new(
+                    out,
+                    schema,
+                    Arc::new(props.build()),
+                )?),
                 other => other,
             };
         }
@@ -102,28 +121,37 @@ impl<W: Write + Send> ParquetWriter<W> {
 
     /// Adds one row.
     pub fn write(&mut self, row: &Row) -> Result<(), ParquetError> {
-        let values = [row.t_s]
-            .into_iter()
-            .chain(row.accel_g)
-            .chain(row.gyro_dps)
-            .chain([row.steer_deg, row.speed_mps]);
-        for (column, v) in self.required.iter_mut().zip(values) {
-            column.push(v);
+        for (column, buffer) in self.columns.iter().zip(&mut self.buffers) {
+            match (buffer, (column.value)(row)) {
+                (Buffer::Number(values, levels), Value::Number(v)) => {
+                    match levels {
+                        Some(levels) => levels.push(i16::from(v.is_some())),
+                        None if v.is_none() => {
+                            return Err(ParquetError::General(format!(
+                                "{} has no value in a row",
+                                column.name
+                            )))
+                        }
+                        None => {}
+                    }
+                    values.extend(v);
+                }
+                (Buffer::Label(values, levels), Value::Label(v)) => {
+                    levels.push(i16::from(v.is_some()));
+                    values.extend(v.map(|s| ByteArray::from(s.as_bytes().to_vec())));
+                }
+                (Buffer::Utc(values, levels), Value::Utc(v)) => {
+                    levels.push(i16::from(v.is_some()));
+                    values.extend(v);
+                }
+                _ => {
+                    return Err(ParquetError::General(format!(
+                        "{}: value of the wrong type",
+                        column.name
+                    )))
+                }
+            }
         }
-        let gps = [
-            row.gps.map(|g| g.lat_deg),
-            row.gps.map(|g| g.lon_deg),
-            row.gps.and_then(|g| g.speed_mps),
-        ];
-        for ((column, defined), v) in self.gps.iter_mut().zip(&mut self.gps_defined).zip(gps) {
-            defined.push(i16::from(v.is_some()));
-            column.extend(v);
-        }
-        self.fix_defined.push(i16::from(row.gps.is_some()));
-        self.fix.extend(
-            row.gps
-                .map(|g| ByteArray::from(g.fix.as_str().as_bytes().to_vec())),
-        );
         self.rows += 1;
         if self.rows >= ROW_GROUP_ROWS {
             self.write_group()?;
@@ -133,44 +161,56 @@ impl<W: Write + Send> ParquetWriter<W> {
 
     fn write_group(&mut self) -> Result<(), ParquetError> {
         let rows = std::mem::take(&mut self.rows);
-        let required = std::mem::take(&mut self.required);
-        let gps = std::mem::take(&mut self.gps);
-        let gps_defined = std::mem::take(&mut self.gps_defined);
-        let fix = std::mem::take(&mut self.fix);
-        let fix_defined = std::mem::take(&mut self.fix_defined);
+        let buffers: Vec<Buffer> = self
+            .buffers
+            .iter_mut()
+            .map(|b| match b {
+                Buffer::Number(v, l) => {
+                    Buffer::Number(std::mem::take(v), l.as_mut().map(std::mem::take))
+                }
+                Buffer::Label(v, l) => Buffer::Label(std::mem::take(v), std::mem::take(l)),
+                Buffer::Utc(v, l) => Buffer::Utc(std::mem::take(v), std::mem::take(l)),
+            })
+            .collect();
         let file = self.file()?;
         if rows == 0 {
             return Ok(());
         }
         let mut group = file.next_row_group()?;
-        for values in &required {
+        for buffer in &buffers {
             let mut column = next_column(&mut group)?;
-            column
-                .typed::<DoubleType>()
-                .write_batch(values, None, None)?;
+            match buffer {
+                Buffer::Number(values, levels) => {
+                    column
+                        .typed::<DoubleType>()
+                        .write_batch(values, levels.as_deref(), None)?;
+                }
+                Buffer::Label(values, levels) => {
+                    column
+                        .typed::<ByteArrayType>()
+                        .write_batch(values, Some(levels), None)?;
+                }
+                Buffer::Utc(values, levels) => {
+                    column
+                        .typed::<Int64Type>()
+                        .write_batch(values, Some(levels), None)?;
+                }
+            }
             column.close()?;
         }
-        for (values, defined) in gps.iter().zip(&gps_defined) {
-            let mut column = next_column(&mut group)?;
-            column
-                .typed::<DoubleType>()
-                .write_batch(values, Some(defined), None)?;
-            column.close()?;
-        }
-        let mut column = next_column(&mut group)?;
-        column
-            .typed::<ByteArrayType>()
-            .write_batch(&fix, Some(&fix_defined), None)?;
-        column.close()?;
         group.close()?;
         Ok(())
     }
 
-    /// Writes the rows still buffered and the file footer; the file is
-    /// complete after this (also with no rows at all).
-    pub fn finish(&mut self) -> Result<(), ParquetError> {
+    /// Writes the rows still buffered and the file footer with `meta` as
+    /// key-value metadata; the file is complete after this (also with no
+    /// rows at all).
+    pub fn finish(&mut self, meta: &LogMetadata) -> Result<(), ParquetError> {
         self.write_group()?;
         if let State::Open(mut file) = std::mem::replace(&mut self.state, State::Closed) {
+            for (key, value) in meta.pairs(&self.columns) {
+                file.append_key_value_metadata(KeyValue::new(key, value));
+            }
             file.finish()?;
             file.inner_mut().flush()?;
         }

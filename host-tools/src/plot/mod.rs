@@ -7,12 +7,14 @@
 pub mod modes;
 pub mod timeplot;
 
+use std::io::Write;
 use std::path::Path;
 use std::sync::Once;
 
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
+use crate::output::Output;
 use crate::CliError;
 
 /// The font every figure uses.
@@ -53,26 +55,53 @@ impl ImageKind {
     }
 }
 
-/// Draws `figure` into the file at `path` (PNG or SVG by its extension).
-pub fn render(figure: &impl Figure, path: &Path) -> Result<(), CliError> {
-    let kind = ImageKind::of(path)?;
+/// Draws `figure` into `out`, PNG or SVG by the output's extension, and
+/// commits it. The image is drawn in memory (plotters' own file writing
+/// would bypass the atomic output and report errors as debug text).
+pub fn render(figure: &impl Figure, mut out: Output) -> Result<(), CliError> {
+    let kind = ImageKind::of(out.name())?;
     register_font();
+    let bytes = draw(figure, kind)
+        .map_err(|e| CliError::file(out.name(), format!("cannot draw the plot: {e}")))?;
+    out.write_all(&bytes).map_err(|e| out.error(e))?;
+    out.commit()
+}
+
+fn draw(figure: &impl Figure, kind: ImageKind) -> Result<Vec<u8>, String> {
     let size = figure.size_px();
-    let drawn = match kind {
+    match kind {
         ImageKind::Png => {
-            let root = BitMapBackend::new(path, size).into_drawing_area();
-            figure
-                .draw(&root)
-                .and_then(|()| root.present().map_err(|e| e.to_string()))
+            let (w, h) = size;
+            let mut pixels = vec![0u8; w as usize * h as usize * 3];
+            {
+                let root = BitMapBackend::with_buffer(&mut pixels, size).into_drawing_area();
+                figure.draw(&root)?;
+                root.present().map_err(|e| e.to_string())?;
+            }
+            encode_png(&pixels, size).map_err(|e| e.to_string())
         }
         ImageKind::Svg => {
-            let root = SVGBackend::new(path, size).into_drawing_area();
-            figure
-                .draw(&root)
-                .and_then(|()| root.present().map_err(|e| e.to_string()))
+            let mut svg = String::new();
+            {
+                let root = SVGBackend::with_string(&mut svg, size).into_drawing_area();
+                figure.draw(&root)?;
+                root.present().map_err(|e| e.to_string())?;
+            }
+            Ok(svg.into_bytes())
         }
-    };
-    drawn.map_err(|e| CliError::file(path, format!("cannot draw the plot: {e}")))
+    }
+}
+
+/// 8-bit RGB pixels, row by row, as a PNG file.
+fn encode_png(pixels: &[u8], (w, h): (u32, u32)) -> Result<Vec<u8>, png::EncodingError> {
+    let mut bytes = Vec::new();
+    let mut encoder = png::Encoder::new(&mut bytes, w, h);
+    encoder.set_color(png::ColorType::Rgb);
+    encoder.set_depth(png::BitDepth::Eight);
+    let mut writer = encoder.write_header()?;
+    writer.write_image_data(pixels)?;
+    writer.finish()?;
+    Ok(bytes)
 }
 
 fn register_font() {
@@ -114,6 +143,18 @@ pub fn decimate(points: &[(f64, f64)], bucket_s: f64) -> Vec<(f64, f64)> {
     out
 }
 
+/// An axis tick: the shortest of up to three decimals that shows the
+/// value, and never `-0` (a tick at zero that rounding left negative).
+#[must_use]
+pub fn tick_label(v: f64) -> String {
+    let text = format!("{v:.3}");
+    let text = text.trim_end_matches('0').trim_end_matches('.');
+    match text {
+        "-0" | "" => "0".to_string(),
+        t => t.to_string(),
+    }
+}
+
 /// A range covering `values` with a margin, never empty.
 #[must_use]
 pub fn padded_range(values: impl Iterator<Item = f64>, min_span: f64) -> std::ops::Range<f64> {
@@ -134,6 +175,16 @@ pub fn padded_range(values: impl Iterator<Item = f64>, min_span: f64) -> std::op
 mod tests {
     use super::*;
     use proptest::prelude::*;
+
+    #[test]
+    fn ticks_have_no_negative_zero() {
+        assert_eq!(tick_label(-0.0), "0");
+        assert_eq!(tick_label(-1e-17), "0");
+        assert_eq!(tick_label(-0.0004), "0");
+        assert_eq!(tick_label(2.5), "2.5");
+        assert_eq!(tick_label(-120.0), "-120");
+        assert_eq!(tick_label(0.125), "0.125");
+    }
 
     proptest! {
         /// Decimation keeps every bucket's extremes, in time order, and

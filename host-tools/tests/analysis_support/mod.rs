@@ -10,7 +10,7 @@ use assert_cmd::Command;
 use wobble_core::format::header::header_records;
 use wobble_core::format::{
     quantise_i16, quantise_i32, quantise_u16, Alert, BlockEncoder, FixMode, Frame, GpsFix, LogInfo,
-    Marker, Record, UtcTime, ACCEL_COUNTS_PER_G, EDGE_AGE_NONE, GYRO_COUNTS_PER_DPS,
+    Marker, Record, UtcSync, UtcTime, ACCEL_COUNTS_PER_G, EDGE_AGE_NONE, GYRO_COUNTS_PER_DPS,
     STEER_COUNTS_PER_DEG,
 };
 use wobblog::analysis::Run;
@@ -195,7 +195,16 @@ pub struct Extras {
     pub gps_outages_s: Vec<(f64, f64)>,
     /// Whether to write GPS at all.
     pub gps: bool,
+    /// Records written after the frame at their time (faults, dropouts, ...).
+    pub records: Vec<Record<'static>>,
+    /// Configuration lines for the header.
+    pub config: Vec<String>,
 }
+
+/// How often [`write_log`] writes a UTC sync pair, µs.
+pub const SYNC_INTERVAL_US: u64 = 10_000_000;
+/// UTC of the fixes at 0 s since boot: 2020-03-18T10:00:00Z, ms since 1970.
+pub const UTC_AT_BOOT_MS: i64 = 1_584_525_600_000;
 
 /// Latitude of the GPS track's start, degrees.
 pub const START_LAT_DEG: f64 = 52.2;
@@ -254,9 +263,10 @@ pub fn write_log(path: &Path, ride: &Ride, extras: &Extras) {
         sample_rate_hz: 100,
         run: 3,
     };
-    for rec in header_records(info, []) {
+    for rec in header_records(info, extras.config.iter().map(String::as_str)) {
         put(&mut encoder, rec);
     }
+    let mut last_sync_us: Option<u64> = None;
     for i in 0..ride.t_s.len() {
         let t = ride.t_s[i];
         let frame = Frame {
@@ -272,6 +282,21 @@ pub fn write_log(path: &Path, ride: &Ride, extras: &Extras) {
         put(&mut encoder, Record::Frame(frame));
         if let Some(fix) = gps_fix(ride, i, extras) {
             put(&mut encoder, Record::Gps(fix));
+            // A sync pair with the first fix with UTC, then every 10 s, as
+            // the firmware's GPS path writes them.
+            if let Some(utc) = fix.utc {
+                if last_sync_us.is_none_or(|last| fix.t_us - last >= SYNC_INTERVAL_US) {
+                    last_sync_us = Some(fix.t_us);
+                    let unix_ms = utc.unix_ms();
+                    put(
+                        &mut encoder,
+                        Record::UtcSync(UtcSync {
+                            t_us: fix.t_us,
+                            unix_ms,
+                        }),
+                    );
+                }
+            }
         }
         let now = |s: f64| (s - t).abs() < 0.5 / FS_HZ;
         for &(on, off) in &extras.alerts_s {
@@ -285,6 +310,11 @@ pub fn write_log(path: &Path, ride: &Ride, extras: &Extras) {
                     };
                     put(&mut encoder, Record::Alert(alert));
                 }
+            }
+        }
+        for rec in &extras.records {
+            if now(rec.t_us() as f64 / 1e6) {
+                put(&mut encoder, *rec);
             }
         }
         for (id, &m) in extras.markers_s.iter().enumerate() {
@@ -314,6 +344,7 @@ pub fn standard_log(path: &Path) -> (Ride, Extras) {
         markers_s: vec![5.0, 20.0],
         gps_outages_s: vec![(22.0, 29.0)],
         gps: true,
+        ..Extras::default()
     };
     write_log(path, &ride, &extras);
     (ride, extras)

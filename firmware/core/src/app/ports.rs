@@ -23,6 +23,8 @@ pub enum SensorError {
     Stale,
     /// It answered with a value outside its range.
     OutOfRange,
+    /// Its converter overran (samples lost) and has been restarted.
+    Overrun,
 }
 
 /// The 6-DOF IMU, read once per frame.

@@ -35,6 +35,8 @@ pub const FAULT_IMU_NO_RESPONSE: u8 = 1;
 pub const FAULT_IMU_BAD_SAMPLE: u8 = 2;
 /// Steering fault 1: the steering sensor could not be read.
 pub const FAULT_STEER_READ: u8 = 1;
+/// Steering fault 2: the steering ADC overran and was restarted.
+pub const FAULT_STEER_OVERRUN: u8 = 2;
 
 /// Status bits that make the status LED show [`LoggerHealth::Degraded`]: a
 /// sensor not delivering live values, or no recent GPS fix.
@@ -75,7 +77,7 @@ pub struct Sampler {
     detector: Detector,
     pattern: AlertPattern,
     imu_faults: FaultCounter<2>,
-    steer_faults: FaultCounter<1>,
+    steer_faults: FaultCounter<2>,
     marker_held: bool,
     markers: u16,
     status: FrameStatus,
@@ -144,9 +146,13 @@ impl Sampler {
         if let Some(code) = imu_fault {
             self.imu_faults.count(code, now_us, &mut emit_fault);
         }
-        if inputs.steering.is_err() {
-            self.steer_faults
-                .count(FAULT_STEER_READ, now_us, &mut emit_fault);
+        if let Err(e) = inputs.steering {
+            let code = if e == SensorError::Overrun {
+                FAULT_STEER_OVERRUN
+            } else {
+                FAULT_STEER_READ
+            };
+            self.steer_faults.count(code, now_us, &mut emit_fault);
         }
         self.imu_faults.poll(now_us, &mut emit_fault);
         self.steer_faults.poll(now_us, &mut emit_fault);

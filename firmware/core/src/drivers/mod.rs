@@ -4,4 +4,5 @@
 
 pub mod gnss_setup;
 pub mod icm42688;
+pub mod sd_spi;
 pub mod sdcard;

@@ -2,9 +2,54 @@
 //! chip-select frame per call the driver makes.
 #![allow(dead_code)] // Each test file uses the helpers it needs.
 
+use embedded_hal_mock::eh1::digital::{State, Transaction as Pin};
 use embedded_hal_mock::eh1::spi::Transaction;
+use wobble_core::drivers::sd_spi::WAKE_UP_BYTES;
 
 pub type Spi = Vec<Transaction<u8>>;
+
+/// The same exchange on the bus with chip select held by the device for
+/// the whole operation: no frame per driver call.
+pub fn held(device_level: Spi) -> Spi {
+    let frame = [
+        Transaction::transaction_start(),
+        Transaction::transaction_end(),
+    ];
+    device_level
+        .into_iter()
+        .filter(|t| !frame.contains(t))
+        .collect()
+}
+
+/// A card operation on the bus: `exchange` with chip select held, then the
+/// operation's end (flush, CS high, one byte so the card releases MISO).
+pub fn operation(exchange: Spi) -> Spi {
+    let end = [
+        Transaction::flush(),
+        Transaction::write_vec(vec![0xFF]),
+        Transaction::flush(),
+    ];
+    [held(exchange), end.to_vec()].concat()
+}
+
+/// The wake-up clocks before an identification (chip select high).
+pub fn wake_up_clocks() -> Spi {
+    vec![
+        Transaction::write_vec(vec![0xFF; WAKE_UP_BYTES]),
+        Transaction::flush(),
+    ]
+}
+
+/// Chip-select pin levels, in order.
+pub fn cs(levels: &[State]) -> Vec<Pin> {
+    levels.iter().map(|&l| Pin::set(l)).collect()
+}
+
+/// Chip select around an identification: high for the wake-up clocks,
+/// low for the operation, high after it.
+pub const IDENTIFY_CS: [State; 3] = [State::High, State::Low, State::High];
+/// Chip select around any other card operation.
+pub const OPERATION_CS: [State; 2] = [State::Low, State::High];
 
 /// R1 response: idle state (initialising).
 pub const R1_IDLE: u8 = 0x01;
@@ -86,13 +131,18 @@ pub fn crc16(bytes: &[u8]) -> u16 {
 
 /// A data block answered after its start token, with its CRC16.
 pub fn data_block(data: &[u8]) -> Spi {
+    data_block_with_crc(data, crc16(data))
+}
+
+/// A data block answered after its start token, with `crc`.
+pub fn data_block_with_crc(data: &[u8], crc: u16) -> Spi {
     let mut out = byte(0xFF, 0xFE);
     out.extend([
         Transaction::transaction_start(),
         Transaction::transfer_in_place(vec![0xFF; data.len()], data.to_vec()),
         Transaction::transaction_end(),
         Transaction::transaction_start(),
-        Transaction::transfer_in_place(vec![0xFF; 2], crc16(data).to_be_bytes().to_vec()),
+        Transaction::transfer_in_place(vec![0xFF; 2], crc.to_be_bytes().to_vec()),
         Transaction::transaction_end(),
     ]);
     out

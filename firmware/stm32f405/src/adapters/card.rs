@@ -1,19 +1,22 @@
-//! The microSD card on SPI2, blocking, as the core's [`Card`] block device.
+//! The microSD card on SPI2, blocking, as the core's [`Card`] block device:
+//! chip select held for each card operation, wake-up clocks before each
+//! identification, each operation bounded and followed by a watchdog
+//! liveness proof (all in the core's `drivers::sd_spi` and
+//! `drivers::sdcard`).
 
 use embassy_stm32::gpio::Output;
 use embassy_stm32::mode::Blocking;
 use embassy_stm32::spi::{self, mode::Master, Spi};
 use embassy_stm32::time::Hertz;
-use embassy_time::Delay;
-use embedded_hal_bus::spi::ExclusiveDevice;
-use wobble_core::drivers::sdcard::{wake_up, Card, IDENTIFICATION_CLOCK_HZ};
+use embassy_time::{Delay, Instant};
+use wobble_core::drivers::sdcard::{Card, CardHooks};
 
 use crate::clocks::CARD_SPI_HZ;
 
-/// The card's SPI device: SPI2 with its chip select.
-pub type CardSpi = ExclusiveDevice<Spi<'static, Blocking, Master>, Output<'static>, Delay>;
+/// The card's bus.
+pub type CardBus = Spi<'static, Blocking, Master>;
 /// The card as the logger's block device.
-pub type SdCard = Card<CardSpi, Delay>;
+pub type SdCard = Card<CardBus, Output<'static>, Delay>;
 
 /// SPI mode 0 at `hz` (rounded down by the prescaler).
 pub fn spi_config(hz: u32) -> spi::Config {
@@ -24,23 +27,25 @@ pub fn spi_config(hz: u32) -> spi::Config {
     config
 }
 
-fn set_clock(device: &mut CardSpi, hz: u32) {
-    device
-        .bus_mut()
-        .set_config(&spi_config(hz))
-        .unwrap_or_else(|()| {
-            defmt::warn!("card SPI: clock {} Hz refused", hz);
-        });
+fn set_clock(bus: &mut CardBus, hz: u32) {
+    if bus.set_config(&spi_config(hz)).is_err() {
+        defmt::warn!("card SPI: clock {} Hz refused", hz);
+    } else if hz < CARD_SPI_HZ && hz > wobble_core::drivers::sdcard::IDENTIFICATION_CLOCK_HZ {
+        // Only after repeated CRC errors (logged at each identification).
+        defmt::warn!("card SPI: data clock lowered to {} Hz", hz);
+    }
 }
 
-/// Wakes the card (clocks with chip select high) and wraps it.
-pub fn card(mut bus: Spi<'static, Blocking, Master>, mut cs: Output<'static>) -> SdCard {
-    bus.set_config(&spi_config(IDENTIFICATION_CLOCK_HZ))
-        .unwrap_or_else(|()| defmt::warn!("card SPI: slow clock refused"));
-    cs.set_high();
-    if wake_up(&mut bus).is_err() {
-        defmt::warn!("card SPI: wake-up clocks failed");
-    }
-    let device = ExclusiveDevice::new(bus, cs, Delay).unwrap_or_else(|e| match e {});
-    Card::new(device, Delay, set_clock, CARD_SPI_HZ)
+fn now_us() -> u64 {
+    Instant::now().as_micros()
+}
+
+/// Wraps the card (nothing is sent until the first access).
+pub fn card(bus: CardBus, cs: Output<'static>) -> SdCard {
+    let hooks = CardHooks {
+        set_clock,
+        now_us,
+        after_operation: crate::watchdog::prove_alive,
+    };
+    Card::new(bus, cs, Delay, hooks, CARD_SPI_HZ)
 }

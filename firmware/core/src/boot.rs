@@ -1,0 +1,244 @@
+//! What the board learns at boot and writes into the next log as system
+//! fault records (source 7): why the MCU reset, whether the crystal
+//! started, whether the brown-out reset had to be switched on.
+//!
+//! The decoding works on the raw register words of the STM32F4 (RM0090:
+//! RCC_CSR, FLASH_OPTCR), so the board only reads and writes registers.
+
+use crate::format::{Fault, FaultSource};
+
+/// System fault 1: power-on (or power-down) reset.
+pub const FAULT_RESET_POWER_ON: u8 = 1;
+/// System fault 2: brown-out reset: the supply fell below the BOR threshold.
+pub const FAULT_RESET_BROWN_OUT: u8 = 2;
+/// System fault 3: the independent watchdog reset the MCU (a task hung).
+pub const FAULT_RESET_WATCHDOG: u8 = 3;
+/// System fault 4: the window watchdog reset the MCU.
+pub const FAULT_RESET_WINDOW_WATCHDOG: u8 = 4;
+/// System fault 5: software reset: the firmware reset itself after a panic
+/// or a hard fault.
+pub const FAULT_RESET_SOFTWARE: u8 = 5;
+/// System fault 6: reset from the NRST pin (reset button or debug probe).
+pub const FAULT_RESET_PIN: u8 = 6;
+/// System fault 7: low-power management reset.
+pub const FAULT_RESET_LOW_POWER: u8 = 7;
+/// System fault 8: no reset flag set (flags cleared by a debugger).
+pub const FAULT_RESET_UNKNOWN: u8 = 8;
+/// System fault 9: the crystal (HSE) did not start in time; the clocks run
+/// from the internal RC oscillator (HSI, ±1 % at 25 °C).
+pub const FAULT_HSE_FAILED: u8 = 9;
+/// System fault 10: the brown-out reset level was below 2.7 V (factory:
+/// off) and has been programmed to level 3.
+pub const FAULT_BOR_PROGRAMMED: u8 = 10;
+/// System fault 11: programming the brown-out level failed.
+pub const FAULT_BOR_FAILED: u8 = 11;
+
+/// Why the MCU started, from the reset flags in RCC_CSR.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum ResetCause {
+    /// Power-on or power-down reset.
+    PowerOn,
+    /// Brown-out reset (supply dip without a full power-down).
+    BrownOut,
+    /// Independent watchdog.
+    Watchdog,
+    /// Window watchdog.
+    WindowWatchdog,
+    /// `SYSRESETREQ`: the firmware reset itself.
+    Software,
+    /// The NRST pin.
+    Pin,
+    /// Low-power management.
+    LowPower,
+    /// No flag set.
+    Unknown,
+}
+
+/// RCC_CSR reset flags (RM0090 7.3.21).
+mod csr {
+    pub const LPWRRSTF: u32 = 1 << 31;
+    pub const WWDGRSTF: u32 = 1 << 30;
+    pub const IWDGRSTF: u32 = 1 << 29;
+    pub const SFTRSTF: u32 = 1 << 28;
+    pub const PORRSTF: u32 = 1 << 27;
+    pub const PINRSTF: u32 = 1 << 26;
+    pub const BORRSTF: u32 = 1 << 25;
+}
+
+impl ResetCause {
+    /// Decodes RCC_CSR. Every reset drives NRST low, so PINRSTF comes with
+    /// each cause, and a power-on sets BORRSTF as well: the specific flags
+    /// are tested first, the pin last.
+    #[must_use]
+    pub fn from_rcc_csr(csr: u32) -> Self {
+        const BY_PRIORITY: [(u32, ResetCause); 7] = [
+            (csr::IWDGRSTF, ResetCause::Watchdog),
+            (csr::WWDGRSTF, ResetCause::WindowWatchdog),
+            (csr::LPWRRSTF, ResetCause::LowPower),
+            (csr::SFTRSTF, ResetCause::Software),
+            (csr::PORRSTF, ResetCause::PowerOn),
+            (csr::BORRSTF, ResetCause::BrownOut),
+            (csr::PINRSTF, ResetCause::Pin),
+        ];
+        BY_PRIORITY
+            .iter()
+            .find(|(flag, _)| csr & flag != 0)
+            .map_or(Self::Unknown, |&(_, cause)| cause)
+    }
+
+    /// The system fault code recorded for it.
+    #[must_use]
+    pub const fn fault_code(self) -> u8 {
+        match self {
+            Self::PowerOn => FAULT_RESET_POWER_ON,
+            Self::BrownOut => FAULT_RESET_BROWN_OUT,
+            Self::Watchdog => FAULT_RESET_WATCHDOG,
+            Self::WindowWatchdog => FAULT_RESET_WINDOW_WATCHDOG,
+            Self::Software => FAULT_RESET_SOFTWARE,
+            Self::Pin => FAULT_RESET_PIN,
+            Self::LowPower => FAULT_RESET_LOW_POWER,
+            Self::Unknown => FAULT_RESET_UNKNOWN,
+        }
+    }
+
+    /// Whether a rider should hear of it: anything but a normal power-on or
+    /// a deliberate reset from the pin.
+    #[must_use]
+    pub const fn is_abnormal(self) -> bool {
+        !matches!(self, Self::PowerOn | Self::Pin)
+    }
+}
+
+/// A system fault record with `code` at `t_us`, counted once.
+#[must_use]
+pub const fn system_fault(code: u8, t_us: u64) -> Fault {
+    Fault {
+        t_us,
+        source: FaultSource::System,
+        code,
+        count: 1,
+    }
+}
+
+/// Brown-out reset threshold (FLASH_OPTCR BOR_LEV, RM0090 3.7.1).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum BorLevel {
+    /// Level 3: 2.70-3.60 V. What the logger needs: the card and the MCU
+    /// stop before a sagging supply corrupts a FAT write.
+    Level3,
+    /// Level 2: 2.40-2.70 V.
+    Level2,
+    /// Level 1: 2.10-2.40 V.
+    Level1,
+    /// Off (factory setting): reset only at 1.8 V (POR/PDR).
+    Off,
+}
+
+/// BOR_LEV field of FLASH_OPTCR: bits 3:2.
+const BOR_LEV_SHIFT: u32 = 2;
+const BOR_LEV_MASK: u32 = 0b11 << BOR_LEV_SHIFT;
+/// OPTLOCK (bit 0) and OPTSTRT (bit 1): control bits, not option bytes.
+const OPTCR_CONTROL_MASK: u32 = 0b11;
+
+impl BorLevel {
+    /// The level programmed in FLASH_OPTCR.
+    #[must_use]
+    pub const fn from_optcr(optcr: u32) -> Self {
+        match (optcr & BOR_LEV_MASK) >> BOR_LEV_SHIFT {
+            0b00 => Self::Level3,
+            0b01 => Self::Level2,
+            0b10 => Self::Level1,
+            _ => Self::Off,
+        }
+    }
+}
+
+/// The FLASH_OPTCR word to program for BOR level 3: every other option
+/// byte (read protection, write protection, watchdog and reset options) as
+/// read, the control bits clear (the board sets OPTSTRT itself).
+#[must_use]
+pub const fn optcr_with_bor_level3(optcr: u32) -> u32 {
+    optcr & !BOR_LEV_MASK & !OPTCR_CONTROL_MASK
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// RCC_CSR as read after each kind of reset (RM0090 7.3.21 and 5.3:
+    /// every reset pulls NRST, a POR also sets BORRSTF).
+    const AFTER_POWER_ON: u32 = csr::PORRSTF | csr::PINRSTF | csr::BORRSTF;
+    const AFTER_WATCHDOG: u32 = csr::IWDGRSTF | csr::PINRSTF;
+    const AFTER_SOFTWARE: u32 = csr::SFTRSTF | csr::PINRSTF;
+    const AFTER_BROWN_OUT: u32 = csr::BORRSTF | csr::PINRSTF;
+
+    #[test]
+    fn each_reset_decodes_to_its_cause() {
+        let cases = [
+            (AFTER_POWER_ON, ResetCause::PowerOn),
+            (AFTER_WATCHDOG, ResetCause::Watchdog),
+            (AFTER_SOFTWARE, ResetCause::Software),
+            (AFTER_BROWN_OUT, ResetCause::BrownOut),
+            (csr::WWDGRSTF | csr::PINRSTF, ResetCause::WindowWatchdog),
+            (csr::LPWRRSTF | csr::PINRSTF, ResetCause::LowPower),
+            (csr::PINRSTF, ResetCause::Pin),
+            (0, ResetCause::Unknown),
+        ];
+        for (csr, cause) in cases {
+            // LSION/LSIRDY (bits 0, 1) and RMVF never change the cause.
+            assert_eq!(ResetCause::from_rcc_csr(csr | 0b11), cause);
+        }
+    }
+
+    #[test]
+    fn a_watchdog_reset_after_power_on_flags_still_reads_as_watchdog() {
+        // Flags accumulate until cleared: the most telling one wins.
+        let csr = AFTER_POWER_ON | AFTER_WATCHDOG;
+        assert_eq!(ResetCause::from_rcc_csr(csr), ResetCause::Watchdog);
+    }
+
+    #[test]
+    fn every_cause_has_its_own_system_fault_code() {
+        let causes = [
+            ResetCause::PowerOn,
+            ResetCause::BrownOut,
+            ResetCause::Watchdog,
+            ResetCause::WindowWatchdog,
+            ResetCause::Software,
+            ResetCause::Pin,
+            ResetCause::LowPower,
+            ResetCause::Unknown,
+        ];
+        let codes: Vec<u8> = causes.iter().map(|c| c.fault_code()).collect();
+        assert_eq!(codes, (1..=8).collect::<Vec<u8>>());
+        let fault = system_fault(ResetCause::Watchdog.fault_code(), 42);
+        assert_eq!(
+            fault,
+            Fault {
+                t_us: 42,
+                source: FaultSource::System,
+                code: 3,
+                count: 1
+            }
+        );
+        let abnormal: Vec<bool> = causes.iter().map(|c| c.is_abnormal()).collect();
+        assert_eq!(abnormal, [false, true, true, true, true, false, true, true]);
+    }
+
+    #[test]
+    fn bor_level_reads_and_programs_only_its_field() {
+        // Factory option bytes: RDP 0xAA, no write protection, BOR off,
+        // software watchdog, no reset on stop/standby; OPTLOCK set.
+        let factory = 0x0FFF_AAED;
+        assert_eq!(BorLevel::from_optcr(factory), BorLevel::Off);
+        let programmed = optcr_with_bor_level3(factory);
+        assert_eq!(programmed, 0x0FFF_AAE0);
+        assert_eq!(BorLevel::from_optcr(programmed), BorLevel::Level3);
+        // Read protection and write protection bits are kept exactly.
+        assert_eq!(programmed & 0xFFFF_FFF0, factory & 0xFFFF_FFF0);
+        assert_eq!(BorLevel::from_optcr(0b0100), BorLevel::Level2);
+        assert_eq!(BorLevel::from_optcr(0b1000), BorLevel::Level1);
+    }
+}

@@ -1,0 +1,61 @@
+//! Eigenvalues and eigenvectors of a real state matrix.
+//!
+//! Eigenvalues come from nalgebra's real Schur decomposition. nalgebra has
+//! no eigenvectors for a non-symmetric matrix, so each one is found by two
+//! steps of inverse iteration on `A - lambda I` in complex arithmetic (LU):
+//! the vectors only serve to tell modes apart, so that is accurate enough.
+
+use nalgebra::{Complex, DMatrix, DVector, Schur};
+
+/// One eigenvalue with its (unit-norm) eigenvector.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Eigen {
+    /// The eigenvalue, 1/s (real part) and rad/s (imaginary part).
+    pub value: Complex<f64>,
+    /// The right eigenvector, unit Euclidean norm.
+    pub vector: DVector<Complex<f64>>,
+}
+
+/// Schur iterations before giving up on a matrix (NaN or pathological input).
+const MAX_SCHUR_ITERATIONS: usize = 10_000;
+
+/// The eigenvalues of `a`, or `None` if the decomposition does not
+/// converge (a matrix with NaN or infinite entries).
+#[must_use]
+pub fn eigenvalues(a: &DMatrix<f64>) -> Option<Vec<Complex<f64>>> {
+    if a.iter().any(|v| !v.is_finite()) {
+        return None;
+    }
+    let schur = Schur::try_new(a.clone(), f64::EPSILON, MAX_SCHUR_ITERATIONS)?;
+    Some(schur.complex_eigenvalues().iter().copied().collect())
+}
+
+/// Every eigenvalue of `a` with its eigenvector.
+#[must_use]
+pub fn eigen(a: &DMatrix<f64>) -> Option<Vec<Eigen>> {
+    let values = eigenvalues(a)?;
+    let n = a.nrows();
+    let ac: DMatrix<Complex<f64>> = a.map(|v| Complex::new(v, 0.0));
+    let scale = a.iter().fold(1.0_f64, |m, v| m.max(v.abs()));
+    Some(
+        values
+            .into_iter()
+            .map(|value| {
+                // A shift just off the eigenvalue keeps the LU regular.
+                let shift = value + Complex::new(1e-10 * scale, 1e-10 * scale);
+                let b = &ac - DMatrix::from_diagonal_element(n, n, shift);
+                let lu = b.lu();
+                let mut x = DVector::from_fn(n, |i, _| Complex::new(1.0 + 0.1 * i as f64, 0.0));
+                for _ in 0..2 {
+                    if let Some(y) = lu.solve(&x) {
+                        let norm = y.norm();
+                        if norm.is_finite() && norm > 0.0 {
+                            x = y / Complex::new(norm, 0.0);
+                        }
+                    }
+                }
+                Eigen { value, vector: x }
+            })
+            .collect(),
+    )
+}

@@ -1,0 +1,20 @@
+//! Linear bicycle models, host-only: parameter sets with units and sources,
+//! the Whipple benchmark bicycle (Meijaard et al. 2007) and the extended
+//! wobble model, each a pure function from parameters and forward speed to
+//! a state matrix; on top of it eigenvalues against speed, modes followed
+//! across speed, and critical speeds.
+#![warn(missing_docs)]
+
+pub mod critical;
+pub mod eig;
+pub mod model;
+pub mod multibody;
+pub mod params;
+pub mod sweep;
+pub mod whipple;
+pub mod wobble;
+
+pub use critical::{critical_speeds, CriticalSpeed};
+pub use model::{Model, StateRole};
+pub use params::{ModelKind, ParamError, ParamSet, Problem, Quantity, Unit};
+pub use sweep::{Branch, Mode, Sweep, SweepError};

@@ -1,0 +1,99 @@
+//! A linear bicycle model as a pure function: parameters and forward speed
+//! to the state matrix `A(u)` of `x' = A x`, with the meaning of each state.
+
+use nalgebra::DMatrix;
+
+use crate::params::{ModelKind, ParamError, ParamSet};
+use crate::whipple::{self, Benchmark, WhippleMatrices};
+use crate::wobble::{WobbleModel, WobbleParams};
+
+/// What a state is, for telling modes apart by their eigenvectors.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum StateRole {
+    /// Roll angle of the main frame.
+    Roll,
+    /// Steer angle.
+    Steer,
+    /// Rider torso roll relative to the main frame.
+    Torso,
+    /// Steering-head twist.
+    Twist,
+    /// A tyre's transient slip or camber angle.
+    Tyre,
+    /// A velocity or rate.
+    Rate,
+}
+
+/// A linear model ready to evaluate at any speed.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Model {
+    /// The Whipple bicycle (4 states).
+    Whipple(WhippleMatrices),
+    /// The extended wobble model (14 states).
+    Wobble(Box<WobbleModel>),
+}
+
+impl Model {
+    /// The model a parameter set describes.
+    pub fn from_set(set: &ParamSet) -> Result<Self, ParamError> {
+        Ok(match set.model {
+            ModelKind::Whipple => Self::Whipple(Benchmark::from_set(set)?.matrices()),
+            ModelKind::Wobble => Self::Wobble(Box::new(WobbleModel::from_set(set)?)),
+        })
+    }
+
+    /// The Whipple model of the same bicycle: the wobble model's bodies
+    /// lumped into the benchmark's four (rider locked, head rigid, tyres
+    /// without slip).
+    pub fn whipple_of(set: &ParamSet) -> Result<Self, ParamError> {
+        Ok(match set.model {
+            ModelKind::Whipple => Self::Whipple(Benchmark::from_set(set)?.matrices()),
+            ModelKind::Wobble => {
+                Self::Whipple(WobbleParams::from_set(set)?.to_benchmark().matrices())
+            }
+        })
+    }
+
+    /// The Whipple matrices, if this is the Whipple model.
+    #[must_use]
+    pub fn whipple_matrices(&self) -> Option<&WhippleMatrices> {
+        match self {
+            Self::Whipple(m) => Some(m),
+            Self::Wobble(_) => None,
+        }
+    }
+
+    /// The state matrix at `speed_mps`.
+    #[must_use]
+    pub fn state_matrix(&self, speed_mps: f64) -> DMatrix<f64> {
+        match self {
+            Self::Whipple(m) => m.state_matrix(speed_mps),
+            Self::Wobble(m) => m.state_matrix(speed_mps),
+        }
+    }
+
+    /// The states' names, in state order.
+    #[must_use]
+    pub fn state_names(&self) -> Vec<&'static str> {
+        match self {
+            Self::Whipple(_) => whipple::STATES.to_vec(),
+            Self::Wobble(m) => m.state_names(),
+        }
+    }
+
+    /// The role of each state, in state order.
+    #[must_use]
+    pub fn state_roles(&self) -> Vec<StateRole> {
+        self.state_names()
+            .iter()
+            .map(|n| match *n {
+                "phi" => StateRole::Roll,
+                "delta" => StateRole::Steer,
+                "phi_r" => StateRole::Torso,
+                "beta" => StateRole::Twist,
+                n if n.starts_with("alpha") || n.starts_with("gamma") => StateRole::Tyre,
+                _ => StateRole::Rate,
+            })
+            .collect()
+    }
+}

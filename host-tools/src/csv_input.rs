@@ -1,0 +1,204 @@
+//! Checks on CSV input shared by `encode` and `detect`: every value is a
+//! finite number the log can store, and the time column advances at the
+//! log's sample rate. Errors name the file, the line and the column.
+
+use std::path::Path;
+
+use crate::CliError;
+
+/// Where a value sits in the CSV, for messages.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Cell<'a> {
+    /// Line in the file, from 1 (the header is line 1).
+    pub line: u64,
+    /// Column, from 1.
+    pub column: usize,
+    /// The column's name in the header.
+    pub name: &'a str,
+}
+
+impl Cell<'_> {
+    /// An error about this cell of `path`.
+    pub fn error(&self, path: &Path, what: impl std::fmt::Display) -> CliError {
+        CliError::file(
+            path,
+            format!(
+                "line {}, column {}: `{}` {what}",
+                self.line, self.column, self.name
+            ),
+        )
+    }
+}
+
+/// The value of `text` if it is a finite number within `range` (both ends
+/// included), else what is wrong with it. NaN and infinities are never
+/// accepted: a log stores neither, and clamping them would invent data.
+pub fn number_in(text: &str, range: (f64, f64), unit: &str) -> Result<f64, String> {
+    let v: f64 = text
+        .parse()
+        .map_err(|_| format!("is not a number: {text:?}"))?;
+    if !v.is_finite() {
+        return Err(format!("is {text}: only finite numbers can be stored"));
+    }
+    let (lo, hi) = range;
+    if !(lo..=hi).contains(&v) {
+        return Err(format!(
+            "is {v}, outside what the log stores ({lo} to {hi}{unit})"
+        ));
+    }
+    Ok(v)
+}
+
+/// What one time step of the CSV was.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Step {
+    /// The first row.
+    First,
+    /// About one frame period after the previous row.
+    Regular,
+    /// A gap (frames missing) of this many seconds.
+    Gap(f64),
+}
+
+/// Steps shorter than this share of the frame period mean a faster rate.
+const MIN_STEP: f64 = 0.75;
+/// Steps longer than this share of the frame period are gaps.
+const MAX_STEP: f64 = 1.5;
+/// This many gaps in a row, each of about the same length, are a slower
+/// rate, not missing frames: a log's gaps are separated by frames.
+const SLOW_RATE_RUN: u32 = 3;
+
+/// Follows the time column of a CSV that claims the log's sample rate.
+#[derive(Debug)]
+pub struct TimeSteps {
+    rate_hz: f64,
+    last: Option<(f64, u64)>,
+    /// Consecutive gaps so far and the first one's length.
+    gap_run: (u32, f64),
+}
+
+impl TimeSteps {
+    /// A checker for a log sampled at `rate_hz`.
+    #[must_use]
+    pub fn new(rate_hz: f64) -> Self {
+        Self {
+            rate_hz,
+            last: None,
+            gap_run: (0, 0.0),
+        }
+    }
+
+    /// Takes the time of the row on `line`; an error says why the time
+    /// cannot be a frame of the log: it does not advance, or the steps say
+    /// the CSV was sampled at another rate.
+    pub fn step(&mut self, t_s: f64, line: u64) -> Result<Step, String> {
+        let Some((prev, prev_line)) = self.last.replace((t_s, line)) else {
+            return Ok(Step::First);
+        };
+        let dt = t_s - prev;
+        if dt <= 0.0 {
+            self.last = Some((prev, prev_line));
+            let how = if dt == 0.0 {
+                "repeats"
+            } else {
+                "goes backwards"
+            };
+            return Err(format!(
+                "{t_s} does not come after {prev} (line {prev_line}): time {how}"
+            ));
+        }
+        let period = 1.0 / self.rate_hz;
+        let rate = |dt: f64| format!("{:.0} Hz", 1.0 / dt);
+        if dt < MIN_STEP * period {
+            return Err(format!(
+                "steps by {dt} s, about {}, but a log is sampled at {} Hz",
+                rate(dt),
+                self.rate_hz
+            ));
+        }
+        if dt <= MAX_STEP * period {
+            self.gap_run = (0, 0.0);
+            return Ok(Step::Regular);
+        }
+        let (run, first) = self.gap_run;
+        self.gap_run = if run > 0 && (dt - first).abs() < 0.25 * first {
+            (run + 1, first)
+        } else {
+            (1, dt)
+        };
+        if self.gap_run.0 >= SLOW_RATE_RUN {
+            return Err(format!(
+                "steps by {dt} s {SLOW_RATE_RUN} times in a row, about {}, but a log \
+                 is sampled at {} Hz",
+                rate(dt),
+                self.rate_hz
+            ));
+        }
+        Ok(Step::Gap(dt))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    fn steps(times: &[f64]) -> Result<Vec<Step>, (usize, String)> {
+        let mut t = TimeSteps::new(100.0);
+        times
+            .iter()
+            .enumerate()
+            .map(|(i, &s)| t.step(s, i as u64 + 2).map_err(|e| (i, e)))
+            .collect()
+    }
+
+    #[test]
+    fn a_gap_between_frames_is_a_gap_but_a_slower_rate_is_an_error() {
+        let s = steps(&[0.0, 0.01, 0.02, 0.5, 0.51, 0.52]).unwrap();
+        assert_eq!(s[3], Step::Gap(0.48));
+        assert_eq!(s[4], Step::Regular);
+        let (i, e) = steps(&[0.0, 0.02, 0.04, 0.06, 0.08]).unwrap_err();
+        assert_eq!(i, 3);
+        assert!(e.contains("50 Hz") && e.contains("100 Hz"), "{e}");
+    }
+
+    #[test]
+    fn faster_rates_and_time_not_advancing_are_errors() {
+        let (i, e) = steps(&[0.0, 0.005]).unwrap_err();
+        assert_eq!(i, 1);
+        assert!(e.contains("200 Hz"), "{e}");
+        let (_, e) = steps(&[0.0, 0.01, 0.005]).unwrap_err();
+        assert!(e.contains("goes backwards") && e.contains("line 3"), "{e}");
+        let (_, e) = steps(&[0.0, 0.01, 0.01]).unwrap_err();
+        assert!(e.contains("repeats"), "{e}");
+    }
+
+    #[test]
+    fn non_finite_and_unstorable_values_are_refused() {
+        let r = (-327.68, 327.67);
+        assert_eq!(number_in("1.5", r, " deg"), Ok(1.5));
+        for bad in ["NaN", "inf", "-inf", "1e9", "abc", ""] {
+            assert!(number_in(bad, r, " deg").is_err(), "{bad}");
+        }
+        assert!(number_in("327.68", r, " deg")
+            .unwrap_err()
+            .contains("outside"));
+    }
+
+    proptest! {
+        /// 100 Hz with jitter and occasional dropouts always passes.
+        #[test]
+        fn jittered_100_hz_with_dropouts_passes(
+            jitter in proptest::collection::vec(-0.002..0.002f64, 10..300),
+            gaps in proptest::collection::vec((0usize..60).prop_map(|g| g * 5), 0..5),
+        ) {
+            let mut t = 0.0;
+            let mut times = Vec::new();
+            for (i, j) in jitter.iter().enumerate() {
+                t += 0.01 + j + if gaps.contains(&i) { 0.1 } else { 0.0 };
+                times.push(t);
+            }
+            prop_assert!(steps(&times).is_ok());
+        }
+    }
+}

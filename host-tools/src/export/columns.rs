@@ -1,0 +1,115 @@
+//! The columns of a decoded row: one table giving every export format the
+//! same names, order and types, and `--columns` its choices.
+
+use crate::rows::Row;
+
+/// The type of a column's values.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Kind {
+    /// A number in every row.
+    Number,
+    /// A number, absent in some rows.
+    OptNumber,
+    /// A lower-case name from a small set, absent in some rows.
+    Label,
+    /// A UTC time, absent before the first GPS sync pair.
+    Utc,
+}
+
+/// One cell.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Value {
+    /// A number, or none.
+    Number(Option<f64>),
+    /// A name, or none.
+    Label(Option<&'static str>),
+    /// µs since 1970, or none.
+    Utc(Option<i64>),
+}
+
+/// A column: its name (unit in the name), type and value in a row.
+#[derive(Clone, Copy)]
+pub struct Column {
+    /// Header name, as in the CSV.
+    pub name: &'static str,
+    /// Type of its values.
+    pub kind: Kind,
+    /// Its value in a row.
+    pub value: fn(&Row) -> Value,
+}
+
+/// A column of numbers present in every row.
+macro_rules! number {
+    ($name:literal, $row:ident => $value:expr) => {
+        Column {
+            name: $name,
+            kind: Kind::Number,
+            value: |$row| Value::Number(Some($value)),
+        }
+    };
+}
+
+/// Every column in export order: the CSV's documented columns first, new
+/// ones after them.
+pub const COLUMNS: [Column; 14] = [
+    number!("t_s", r => r.t_s),
+    number!("ax_g", r => r.accel_g[0]),
+    number!("ay_g", r => r.accel_g[1]),
+    number!("az_g", r => r.accel_g[2]),
+    number!("gx_dps", r => r.gyro_dps[0]),
+    number!("gy_dps", r => r.gyro_dps[1]),
+    number!("gz_dps", r => r.gyro_dps[2]),
+    number!("steer_deg", r => r.steer_deg),
+    number!("speed_mps", r => r.speed_mps),
+    Column {
+        name: "gps_lat_deg",
+        kind: Kind::OptNumber,
+        value: |r| Value::Number(r.gps.map(|g| g.lat_deg)),
+    },
+    Column {
+        name: "gps_lon_deg",
+        kind: Kind::OptNumber,
+        value: |r| Value::Number(r.gps.map(|g| g.lon_deg)),
+    },
+    Column {
+        name: "gps_speed_mps",
+        kind: Kind::OptNumber,
+        value: |r| Value::Number(r.gps.and_then(|g| g.speed_mps)),
+    },
+    Column {
+        name: "gps_fix",
+        kind: Kind::Label,
+        value: |r| Value::Label(r.gps.map(|g| g.fix.as_str())),
+    },
+    Column {
+        name: "utc",
+        kind: Kind::Utc,
+        value: |r| Value::Utc(r.utc_us),
+    },
+];
+
+/// The columns named in `list` (comma-separated, in the order given), or
+/// every column for `None`.
+///
+/// # Errors
+/// An unknown or repeated name, with the known ones.
+pub fn select(list: Option<&str>) -> Result<Vec<Column>, String> {
+    let Some(list) = list else {
+        return Ok(COLUMNS.to_vec());
+    };
+    let mut chosen: Vec<Column> = Vec::new();
+    for name in list.split(',').map(str::trim).filter(|n| !n.is_empty()) {
+        let column = COLUMNS.iter().find(|c| c.name == name).ok_or_else(|| {
+            let known: Vec<&str> = COLUMNS.iter().map(|c| c.name).collect();
+            format!("no column {name:?}; the columns are {}", known.join(","))
+        })?;
+        if chosen.iter().any(|c| c.name == name) {
+            return Err(format!("column {name:?} is named twice"));
+        }
+        chosen.push(*column);
+    }
+    if chosen.is_empty() {
+        return Err("--columns names no column".into());
+    }
+    Ok(chosen)
+}
