@@ -74,6 +74,10 @@ pub struct Summary {
     pub faults: BTreeMap<&'static str, u64>,
     /// Everything lost, in detail.
     pub losses: Losses,
+    /// The GPS sync pairs (s since boot, UTC ms since 1970), in time order:
+    /// what places a UTC time on the log's clock.
+    #[serde(skip)]
+    pub utc_syncs: Vec<crate::time::SyncPair>,
 }
 
 /// Builds a [`Summary`] from decoder events.
@@ -113,7 +117,11 @@ impl SummaryBuilder {
                     s.first_utc = fix.utc.map(crate::time::iso8601);
                 }
             }
-            Record::UtcSync(_) => {}
+            Record::UtcSync(sync) => {
+                if let Ok(ms) = i64::try_from(sync.unix_ms) {
+                    s.utc_syncs.push((t_s, ms));
+                }
+            }
             Record::Alert(a) if a.on => s.alerts.push(AlertSpan {
                 on_s: t_s,
                 off_s: None,

@@ -103,6 +103,15 @@ impl TimeBound {
     }
 }
 
+/// UTC at `t_s` since boot through the latest pair at or before it (else
+/// the first), ms since 1970; `None` without pairs.
+#[must_use]
+pub fn utc_ms_at(pairs: &[SyncPair], t_s: f64) -> Option<i64> {
+    let at = pairs.partition_point(|p| p.0 <= t_s).saturating_sub(1);
+    let (pair_s, pair_ms) = *pairs.get(at)?;
+    Some(pair_ms + ((t_s - pair_s) * 1e3).round() as i64)
+}
+
 /// The `--from/--to` of a command.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct TimeWindow {
@@ -134,24 +143,33 @@ impl TimeWindow {
         self.from.is_none_or(from_ok) && self.to.is_none_or(to_ok)
     }
 
-    /// The window in seconds since boot, through the log's sync pairs.
+    /// The window in seconds since boot, through the sync pairs of `log`.
     ///
     /// # Errors
-    /// A UTC bound in a log without UTC.
-    pub fn boot_s(&self, pairs: &[SyncPair]) -> Result<(Option<f64>, Option<f64>), String> {
+    /// A UTC bound in a log without UTC (a failure about `log`), or a
+    /// window that ends before it starts (a usage error).
+    pub fn boot_s(
+        &self,
+        pairs: &[SyncPair],
+        log: &std::path::Path,
+    ) -> Result<(Option<f64>, Option<f64>), crate::CliError> {
         let convert = |b: Option<TimeBound>| {
             b.map(|b| {
-                b.boot_s(pairs)
-                    .ok_or_else(|| "the log has no UTC time (no GPS sync), so a UTC --from/--to cannot be placed".to_string())
+                b.boot_s(pairs).ok_or_else(|| {
+                    crate::CliError::file(
+                        log,
+                        "the log has no UTC time (no GPS sync pair), so a UTC --from/--to cannot be placed",
+                    )
+                })
             })
             .transpose()
         };
         let (from, to) = (convert(self.from)?, convert(self.to)?);
         if let (Some(a), Some(b)) = (from, to) {
             if a >= b {
-                return Err(format!(
+                return Err(crate::CliError::Usage(format!(
                     "--from ({a:.3} s since boot) is not before --to ({b:.3} s)"
-                ));
+                )));
             }
         }
         Ok((from, to))
@@ -213,11 +231,22 @@ mod tests {
         assert_eq!(TimeBound::Utc(1_010_150).boot_s(&pairs), Some(20.1));
         assert_eq!(TimeBound::Utc(999_000).boot_s(&pairs), Some(9.0));
         assert_eq!(TimeBound::Utc(999_000).boot_s(&[]), None);
+        assert_eq!(utc_ms_at(&pairs, 10.5), Some(1_000_500));
+        assert_eq!(utc_ms_at(&pairs, 20.1), Some(1_010_150));
+        assert_eq!(utc_ms_at(&pairs, 9.0), Some(999_000));
+        assert_eq!(utc_ms_at(&[], 9.0), None);
         let w = TimeWindow {
             from: Some(TimeBound::Boot(5.0)),
             to: Some(TimeBound::Utc(1_000_500)),
         };
-        assert_eq!(w.boot_s(&pairs), Ok((Some(5.0), Some(10.5))));
+        let log = std::path::Path::new("x.wbl");
+        assert_eq!(w.boot_s(&pairs, log).unwrap(), (Some(5.0), Some(10.5)));
+        assert_eq!(w.boot_s(&[], log).unwrap_err().exit_code(), 1);
+        let backwards = TimeWindow {
+            from: Some(TimeBound::Boot(11.0)),
+            ..w
+        };
+        assert_eq!(backwards.boot_s(&pairs, log).unwrap_err().exit_code(), 2);
         assert!(w.contains(5.0, Some(0)) && w.contains(10.0, Some(1_000_500)));
         assert!(!w.contains(4.99, Some(0)) && !w.contains(6.0, None));
         assert!(!w.contains(10.0, Some(1_000_501)));

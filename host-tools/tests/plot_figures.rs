@@ -6,7 +6,7 @@ mod analysis_support;
 use std::path::Path;
 
 use analysis_support::{stdout_of, wobblog};
-use wobblog::plot::timeplot::{ALERT_COLOUR, LINE_COLOUR, MARKER_COLOUR, PANELS};
+use wobblog::plot::timeplot::{ALERT_COLOUR, LINE_COLOUR, LOST_COLOUR, MARKER_COLOUR, PANELS};
 
 fn hex(c: plotters::style::RGBColor) -> String {
     format!("#{:02X}{:02X}{:02X}", c.0, c.1, c.2)
@@ -50,10 +50,74 @@ fn figure_6_has_four_panels_alerts_and_markers() {
         assert!(labels.contains(&panel), "no panel {panel:?} in {labels:?}");
     }
     // One line per panel (the log has no gaps), one shaded alert and two
-    // markers in each of the four panels.
+    // markers in each of the four panels, and one of each in the key.
     assert_eq!(count(&svg, "polyline", &hex(LINE_COLOUR)), 4);
-    assert_eq!(count(&svg, "rect", &hex(ALERT_COLOUR)), 4);
-    assert_eq!(count(&svg, "polyline", &hex(MARKER_COLOUR)), 8);
+    assert_eq!(count(&svg, "rect", &hex(ALERT_COLOUR)), 4 + 1);
+    assert_eq!(count(&svg, "polyline", &hex(MARKER_COLOUR)), 8 + 1);
+    assert!(labels.contains(&"wobble alert (on board)"), "{labels:?}");
+    assert!(labels.contains(&"rider marker"), "{labels:?}");
+    assert!(
+        !labels.contains(&"data lost (missing blocks)"),
+        "{labels:?}"
+    );
+    assert!(
+        labels
+            .iter()
+            .all(|l| !l.starts_with("-0") || l.starts_with("-0.")),
+        "{labels:?}"
+    );
+    assert!(!labels.contains(&"-0"), "{labels:?}");
+}
+
+#[test]
+fn lost_blocks_are_shaded_and_keyed() {
+    let dir = tempfile::tempdir().unwrap();
+    let log = dir.path().join("RUN00003.WBL");
+    analysis_support::standard_log(&log);
+    let mut bytes = std::fs::read(&log).unwrap();
+    bytes[40 * 512 + 100] ^= 0x40;
+    std::fs::write(&log, &bytes).unwrap();
+    let svg = plot_svg(&log, &dir.path().join("lost.svg"), &[]);
+    assert_eq!(count(&svg, "rect", &hex(LOST_COLOUR)), 4 + 1);
+    assert!(texts(&svg).contains(&"data lost (missing blocks)"));
+}
+
+#[test]
+fn utc_axis_is_labelled_from_the_sync_pairs() {
+    let dir = tempfile::tempdir().unwrap();
+    let log = dir.path().join("RUN00003.WBL");
+    analysis_support::standard_log(&log);
+    let svg = plot_svg(
+        &log,
+        &dir.path().join("utc.svg"),
+        &["--utc", "--from", "2020-03-18T10:00:10Z", "--to", "15"],
+    );
+    let labels = texts(&svg);
+    assert!(
+        labels.contains(&"UTC on 2020-03-18 (hh:mm:ss)"),
+        "{labels:?}"
+    );
+    assert!(labels.contains(&"10:00:12"), "{labels:?}");
+    assert!(
+        labels.contains(&"RUN00003.WBL: 10.0 to 15.0 s"),
+        "{labels:?}"
+    );
+    // Without GPS, --utc has nothing to go by.
+    let bare = dir.path().join("BARE.WBL");
+    analysis_support::write_log(
+        &bare,
+        &analysis_support::Ride::new(5.0, 5.0, 0.0, 0.0, 0.0),
+        &analysis_support::Extras::default(),
+    );
+    let out = wobblog()
+        .arg("plot")
+        .arg(&bare)
+        .args(["--utc", "-o"])
+        .arg(dir.path().join("bare.svg"))
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("no UTC"));
 }
 
 #[test]
@@ -74,8 +138,8 @@ fn time_window_keeps_only_what_falls_in_it() {
         &dir.path().join("w2.svg"),
         &["--from", "15", "--to", "21"],
     );
-    assert_eq!(count(&svg, "rect", &hex(ALERT_COLOUR)), 4);
-    assert_eq!(count(&svg, "polyline", &hex(MARKER_COLOUR)), 4);
+    assert_eq!(count(&svg, "rect", &hex(ALERT_COLOUR)), 4 + 1);
+    assert_eq!(count(&svg, "polyline", &hex(MARKER_COLOUR)), 4 + 1);
 }
 
 #[test]

@@ -8,9 +8,11 @@
 pub mod critical;
 pub mod eig;
 pub mod model;
+pub mod multibody;
 pub mod params;
 pub mod sweep;
 pub mod whipple;
+pub mod wobble;
 
 pub use critical::{critical_speeds, CriticalSpeed};
 pub use model::{Model, StateRole};

@@ -5,6 +5,7 @@ use nalgebra::DMatrix;
 
 use crate::params::{ModelKind, ParamError, ParamSet};
 use crate::whipple::{self, Benchmark, WhippleMatrices};
+use crate::wobble::{WobbleModel, WobbleParams};
 
 /// What a state is, for telling modes apart by their eigenvectors.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -28,6 +29,8 @@ pub enum StateRole {
 pub enum Model {
     /// The Whipple bicycle (4 states).
     Whipple(WhippleMatrices),
+    /// The extended wobble model (14 states).
+    Wobble(Box<WobbleModel>),
 }
 
 impl Model {
@@ -35,12 +38,7 @@ impl Model {
     pub fn from_set(set: &ParamSet) -> Result<Self, ParamError> {
         Ok(match set.model {
             ModelKind::Whipple => Self::Whipple(Benchmark::from_set(set)?.matrices()),
-            ModelKind::Wobble => {
-                return Err(set.error(
-                    "model",
-                    crate::params::Problem::Syntax("the wobble model is not available yet".into()),
-                ))
-            }
+            ModelKind::Wobble => Self::Wobble(Box::new(WobbleModel::from_set(set)?)),
         })
     }
 
@@ -51,10 +49,7 @@ impl Model {
         Ok(match set.model {
             ModelKind::Whipple => Self::Whipple(Benchmark::from_set(set)?.matrices()),
             ModelKind::Wobble => {
-                return Err(set.error(
-                    "model",
-                    crate::params::Problem::Syntax("the wobble model is not available yet".into()),
-                ))
+                Self::Whipple(WobbleParams::from_set(set)?.to_benchmark().matrices())
             }
         })
     }
@@ -64,6 +59,7 @@ impl Model {
     pub fn whipple_matrices(&self) -> Option<&WhippleMatrices> {
         match self {
             Self::Whipple(m) => Some(m),
+            Self::Wobble(_) => None,
         }
     }
 
@@ -72,6 +68,7 @@ impl Model {
     pub fn state_matrix(&self, speed_mps: f64) -> DMatrix<f64> {
         match self {
             Self::Whipple(m) => m.state_matrix(speed_mps),
+            Self::Wobble(m) => m.state_matrix(speed_mps),
         }
     }
 
@@ -80,6 +77,7 @@ impl Model {
     pub fn state_names(&self) -> Vec<&'static str> {
         match self {
             Self::Whipple(_) => whipple::STATES.to_vec(),
+            Self::Wobble(m) => m.state_names(),
         }
     }
 

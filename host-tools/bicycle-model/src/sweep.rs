@@ -174,21 +174,63 @@ fn assign(tracks: &mut [Vec<Eigen>], found: Vec<Eigen>, k: usize) {
     }
 }
 
-/// The angle that dominates an eigenvector.
-fn dominant(e: &Eigen, roles: &[StateRole]) -> StateRole {
-    roles
+/// What an eigenvector says about its mode: the largest of the mechanical
+/// angles (roll, steer, torso, twist), the roll-to-steer ratio, and whether
+/// the tyre lags dominate everything.
+#[derive(Clone, Copy)]
+struct Shape {
+    role: StateRole,
+    roll_over_steer: f64,
+    tyre_only: bool,
+}
+
+/// A mode whose tyre lags are this many times its largest angle is a tyre mode.
+const TYRE_DOMINANCE: f64 = 4.0;
+/// Weave rolls: at least this much roll per steer.
+const WEAVE_MIN_ROLL_PER_STEER: f64 = 0.2;
+/// Wobble is faster than this, rad/s (2 Hz; the weave stays below it in
+/// the speed range of interest).
+const WOBBLE_MIN_RAD_S: f64 = 4.0 * std::f64::consts::PI;
+
+fn shape(e: &Eigen, roles: &[StateRole]) -> Shape {
+    let size = |want: StateRole| {
+        roles
+            .iter()
+            .zip(e.vector.iter())
+            .filter(|(r, _)| **r == want)
+            .map(|(_, c)| c.norm())
+            .fold(0.0, f64::max)
+    };
+    let mech = [
+        StateRole::Roll,
+        StateRole::Steer,
+        StateRole::Torso,
+        StateRole::Twist,
+    ]
+    .map(|r| (r, size(r)));
+    let (role, largest) = mech
         .iter()
-        .zip(e.vector.iter())
-        .filter(|(r, _)| **r != StateRole::Rate)
-        .max_by(|a, b| a.1.norm().total_cmp(&b.1.norm()))
-        .map_or(StateRole::Rate, |(r, _)| *r)
+        .copied()
+        .max_by(|a, b| a.1.total_cmp(&b.1))
+        .unwrap_or((StateRole::Rate, 0.0));
+    let steer = size(StateRole::Steer);
+    Shape {
+        role,
+        roll_over_steer: if steer > 0.0 {
+            size(StateRole::Roll) / steer
+        } else {
+            f64::INFINITY
+        },
+        tyre_only: size(StateRole::Tyre) > TYRE_DOMINANCE * largest,
+    }
 }
 
 fn name_branches(tracks: &[Vec<Eigen>], roles: &[StateRole]) -> Vec<Branch> {
     struct Seen {
-        role: StateRole,
+        shape: Shape,
         oscillates: bool,
         freq: f64,
+        re_at: f64,
         mean_re: f64,
     }
     let seen: Vec<Seen> = tracks
@@ -202,45 +244,65 @@ fn name_branches(tracks: &[Vec<Eigen>], roles: &[StateRole]) -> Vec<Branch> {
                 .copied()
                 .unwrap_or(t.len() / 2);
             Seen {
-                role: dominant(&t[at], roles),
+                shape: shape(&t[at], roles),
                 oscillates: !complex.is_empty(),
                 freq: t[at].value.im.abs(),
+                re_at: t[at].value.re,
                 mean_re: t.iter().map(|e| e.value.re).sum::<f64>() / t.len() as f64,
             }
         })
         .collect();
-    let swinging = |s: &Seen| s.oscillates && matches!(s.role, StateRole::Roll | StateRole::Steer);
-    // Oscillation frequencies of roll/steer branches, lowest first; the two
-    // members of a pair share theirs exactly.
-    let mut freqs: Vec<f64> = seen
-        .iter()
-        .filter(|s| swinging(s))
-        .map(|s| s.freq)
-        .collect();
-    freqs.sort_by(f64::total_cmp);
-    freqs.dedup_by(|a, b| (*a - *b).abs() <= 1e-9 * b.abs().max(1.0));
+    let planar =
+        |s: &Seen| !s.shape.tyre_only && matches!(s.shape.role, StateRole::Roll | StateRole::Steer);
+    let weave_like =
+        |s: &Seen| planar(s) && s.oscillates && s.shape.roll_over_steer >= WEAVE_MIN_ROLL_PER_STEER;
+    let wobble_like = |s: &Seen| {
+        planar(s) && s.oscillates && s.shape.role == StateRole::Steer && s.freq >= WOBBLE_MIN_RAD_S
+    };
+    // The lowest frequency of each kind; both members of a pair share it.
+    let lowest = |keep: &dyn Fn(&Seen) -> bool| {
+        seen.iter()
+            .filter(|s| keep(s))
+            .map(|s| s.freq)
+            .min_by(f64::total_cmp)
+    };
+    let weave_freq = lowest(&weave_like);
+    let wobble_freq = lowest(&|s: &Seen| wobble_like(s) && Some(s.freq) != weave_freq);
+    // The two members of an oscillating pair.
+    let partners = |a: &Seen, b: &Seen| {
+        a.oscillates
+            && (a.freq - b.freq).abs() <= 1e-9 * a.freq.max(1.0)
+            && (a.re_at - b.re_at).abs() <= 1e-9 * a.re_at.abs().max(1.0)
+    };
+    let same =
+        |s: &Seen, f: Option<f64>| f.is_some_and(|f| (s.freq - f).abs() <= 1e-9 * f.max(1.0));
     let capsize = pick(
         &seen,
-        |s| !s.oscillates && s.role == StateRole::Roll,
+        |s| planar(s) && !s.oscillates && s.shape.role == StateRole::Roll,
         |s| -s.mean_re.abs(),
     );
     let castering = pick(
         &seen,
-        |s| !s.oscillates && s.role == StateRole::Steer,
+        |s| {
+            planar(s)
+                && s.shape.role == StateRole::Steer
+                && s.freq < WOBBLE_MIN_RAD_S
+                && !weave_like(s)
+        },
         |s| -s.mean_re,
     );
     seen.iter()
         .zip(tracks)
         .enumerate()
         .map(|(i, (s, t))| {
-            let same = |f: Option<&f64>| f.is_some_and(|f| (s.freq - f).abs() <= 1e-9 * f.max(1.0));
-            let mode = match s.role {
+            let mode = match s.shape.role {
+                _ if s.shape.tyre_only => Mode::Other,
                 StateRole::Torso => Mode::Lean,
                 StateRole::Twist => Mode::Twist,
-                _ if swinging(s) && same(freqs.first()) => Mode::Weave,
-                _ if swinging(s) && same(freqs.get(1)) => Mode::Wobble,
+                _ if weave_like(s) && same(s, weave_freq) => Mode::Weave,
+                _ if wobble_like(s) && same(s, wobble_freq) => Mode::Wobble,
                 _ if Some(i) == capsize => Mode::Capsize,
-                _ if Some(i) == castering => Mode::Castering,
+                _ if castering.is_some_and(|c| i == c || partners(&seen[c], s)) => Mode::Castering,
                 _ => Mode::Other,
             };
             Branch {

@@ -10,6 +10,7 @@ use wobble_core::format::{Event as LogEvent, GpsFix, Record};
 use crate::output::Output;
 use crate::reader::read_log;
 use crate::rows::GpsColumns;
+use crate::time::{TimeWindow, WindowArgs};
 use crate::CliError;
 
 /// Arguments of `wobblog gpx`.
@@ -20,6 +21,10 @@ pub struct Args {
     /// Output file; standard output if absent.
     #[arg(short, long)]
     pub output: Option<PathBuf>,
+    /// Only fixes in this window (`--from`, `--to`; a UTC bound is compared
+    /// with each fix's own UTC time).
+    #[command(flatten)]
+    pub window: WindowArgs,
 }
 
 /// A new track segment starts after this long without a fix, µs, or after
@@ -29,7 +34,7 @@ const SEGMENT_GAP_US: u64 = 5_000_000;
 /// Runs `wobblog gpx`.
 pub fn run(args: &Args) -> Result<(), CliError> {
     let mut out = Output::create_or_stdout(args.output.as_deref(), &[&args.log])?;
-    let segments = track(&args.log)?;
+    let segments = track(&args.log, args.window.window())?;
     if segments.is_empty() {
         eprintln!(
             "wobblog: {}: warning: no GPS fix with a position; the track is empty",
@@ -44,8 +49,8 @@ pub fn run(args: &Args) -> Result<(), CliError> {
     out.commit()
 }
 
-/// The fixes with a position, split into segments at gaps.
-pub fn track(log: &Path) -> Result<Vec<Vec<GpsFix>>, CliError> {
+/// The fixes with a position inside `window`, split into segments at gaps.
+pub fn track(log: &Path, window: TimeWindow) -> Result<Vec<Vec<GpsFix>>, CliError> {
     let mut segments: Vec<Vec<GpsFix>> = Vec::new();
     let mut open = false;
     read_log(log, |event| {
@@ -54,7 +59,8 @@ pub fn track(log: &Path) -> Result<Vec<Vec<GpsFix>>, CliError> {
             open &= !matches!(event, LogEvent::Gap(_));
             return;
         };
-        if GpsColumns::from_fix(&fix).is_none() {
+        let utc_ms = fix.utc.and_then(|u| i64::try_from(u.unix_ms()).ok());
+        if GpsColumns::from_fix(&fix).is_none() || !window.contains(fix.t_us as f64 / 1e6, utc_ms) {
             open = false;
             return;
         }

@@ -7,6 +7,7 @@ use crate::cmd::logs::warn_losses;
 use crate::output::Output;
 use crate::plot::timeplot::TimePlot;
 use crate::plot::{render, ImageKind};
+use crate::time::WindowArgs;
 use crate::CliError;
 
 /// Arguments of `wobblog plot`.
@@ -17,28 +18,34 @@ pub struct Args {
     /// The image to write: `.png` or `.svg`.
     #[arg(short, long)]
     pub output: PathBuf,
-    /// Start of the time window, s since boot (default: the first frame).
+    /// The time window (`--from`, `--to`).
+    #[command(flatten)]
+    pub window: WindowArgs,
+    /// Label the time axis in UTC (from the log's GPS sync pairs) instead
+    /// of seconds since boot.
     #[arg(long)]
-    pub from: Option<f64>,
-    /// End of the time window, s since boot (default: the last frame).
-    #[arg(long)]
-    pub to: Option<f64>,
+    pub utc: bool,
 }
 
 /// Runs `wobblog plot`.
 pub fn run(args: &Args) -> Result<(), CliError> {
     ImageKind::of(&args.output)?;
-    if let (Some(a), Some(b)) = (args.from, args.to) {
-        if a >= b {
-            return Err(CliError::Usage(format!(
-                "--from {a} is not before --to {b}"
-            )));
-        }
-    }
+    let window = args.window.window();
     let out = Output::create(&args.output, &[&args.log])?;
     let run = Run::load(&args.log)?;
     warn_losses(&run);
-    let figure = TimePlot::new(&run, args.from, args.to)
+    let pairs = &run.summary.utc_syncs;
+    let (from, to) = window.boot_s(pairs, &args.log)?;
+    if args.utc && pairs.is_empty() {
+        return Err(CliError::file(
+            &args.log,
+            "--utc: the log has no UTC time (no GPS sync pair)",
+        ));
+    }
+    let mut figure = TimePlot::new(&run, from, to)
         .ok_or_else(|| CliError::file(&args.log, "no frames in the requested time window"))?;
+    if args.utc {
+        figure.label_utc(pairs.clone());
+    }
     render(&figure, out)
 }

@@ -10,6 +10,7 @@ use crate::cmd::logs::{for_each_log, print_stdout, warn_losses};
 use crate::output::Output;
 use crate::plot::modes::ModePlot;
 use crate::plot::{render, ImageKind};
+use crate::time::WindowArgs;
 use crate::CliError;
 
 /// Arguments of `wobblog wobble`.
@@ -25,6 +26,9 @@ pub struct Args {
     /// `.png` or `.svg` file.
     #[arg(long, value_name = "OUT")]
     pub plot: Option<PathBuf>,
+    /// Only episodes whose onset falls in this window (`--from`, `--to`).
+    #[command(flatten)]
+    pub window: WindowArgs,
 }
 
 /// The episodes of one run, as printed.
@@ -55,7 +59,10 @@ pub fn run(args: &Args) -> Result<(), CliError> {
     let result = for_each_log(&args.logs, "analysing", |log| {
         let run = Run::load(log)?;
         warn_losses(&run);
-        let episodes = find_episodes(&run);
+        let (from, to) = args.window.window().boot_s(&run.summary.utc_syncs, log)?;
+        let mut episodes = find_episodes(&run);
+        episodes
+            .retain(|e| from.is_none_or(|a| e.onset_s >= a) && to.is_none_or(|b| e.onset_s <= b));
         reports.push(RunEpisodes {
             log: log.display().to_string(),
             wobble_speed_mps: wobble_speed_mps(&episodes),

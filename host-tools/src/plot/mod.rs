@@ -143,6 +143,18 @@ pub fn decimate(points: &[(f64, f64)], bucket_s: f64) -> Vec<(f64, f64)> {
     out
 }
 
+/// An axis tick: the shortest of up to three decimals that shows the
+/// value, and never `-0` (a tick at zero that rounding left negative).
+#[must_use]
+pub fn tick_label(v: f64) -> String {
+    let text = format!("{v:.3}");
+    let text = text.trim_end_matches('0').trim_end_matches('.');
+    match text {
+        "-0" | "" => "0".to_string(),
+        t => t.to_string(),
+    }
+}
+
 /// A range covering `values` with a margin, never empty.
 #[must_use]
 pub fn padded_range(values: impl Iterator<Item = f64>, min_span: f64) -> std::ops::Range<f64> {
@@ -163,6 +175,16 @@ pub fn padded_range(values: impl Iterator<Item = f64>, min_span: f64) -> std::op
 mod tests {
     use super::*;
     use proptest::prelude::*;
+
+    #[test]
+    fn ticks_have_no_negative_zero() {
+        assert_eq!(tick_label(-0.0), "0");
+        assert_eq!(tick_label(-1e-17), "0");
+        assert_eq!(tick_label(-0.0004), "0");
+        assert_eq!(tick_label(2.5), "2.5");
+        assert_eq!(tick_label(-120.0), "-120");
+        assert_eq!(tick_label(0.125), "0.125");
+    }
 
     proptest! {
         /// Decimation keeps every bucket's extremes, in time order, and

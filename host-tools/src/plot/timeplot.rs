@@ -4,9 +4,10 @@
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::{decimate, padded_range, Figure, FONT};
+use super::{decimate, padded_range, tick_label, Figure, FONT};
 use crate::analysis::filter::contiguous_spans;
 use crate::analysis::{estimate_roll_deg, Run};
+use crate::time::{iso8601_unix_ms, utc_ms_at, SyncPair};
 
 /// Panel titles (y-axis labels), top to bottom.
 pub const PANELS: [&str; 4] = [
@@ -21,6 +22,11 @@ pub const LINE_COLOUR: RGBColor = RGBColor(0x1f, 0x4e, 0x9a);
 pub const ALERT_COLOUR: RGBColor = RGBColor(0xe0, 0x30, 0x30);
 /// Colour of rider markers.
 pub const MARKER_COLOUR: RGBColor = RGBColor(0x20, 0x90, 0x30);
+/// Colour of stretches lost from the file (drawn with transparency).
+pub const LOST_COLOUR: RGBColor = RGBColor(0x70, 0x70, 0x70);
+/// Width of the y tick labels and axis title, px: room for `-1000.0`
+/// beside a two-line-free title in 14 px text.
+const Y_LABEL_AREA_PX: u32 = 84;
 
 /// Figure 6 of one run over a time window.
 pub struct TimePlot {
@@ -30,6 +36,10 @@ pub struct TimePlot {
     series: [Vec<Vec<(f64, f64)>>; 4],
     alerts_s: Vec<(f64, f64)>,
     markers_s: Vec<f64>,
+    /// Stretches lost from the file (missing blocks), s.
+    lost_s: Vec<(f64, f64)>,
+    /// Sync pairs, when the time axis is labelled in UTC.
+    utc: Option<Vec<SyncPair>>,
 }
 
 /// Figure width, px.
@@ -87,6 +97,15 @@ impl TimePlot {
             .copied()
             .filter(|t| window_s.contains(t))
             .collect();
+        let lost_s = run
+            .summary
+            .losses
+            .lost_blocks
+            .iter()
+            .map(|g| (g.from_s.unwrap_or(first), g.to_s))
+            .filter(|&(a, b)| overlaps(a, b))
+            .map(|(a, b)| (a.max(window_s.start), b.min(window_s.end)))
+            .collect();
         Some(Self {
             title: format!(
                 "{}: {:.1} to {:.1} s",
@@ -98,7 +117,43 @@ impl TimePlot {
             series,
             alerts_s,
             markers_s,
+            lost_s,
+            utc: None,
         })
+    }
+
+    /// Labels the time axis in UTC through the log's sync `pairs`.
+    pub fn label_utc(&mut self, pairs: Vec<SyncPair>) {
+        self.utc = Some(pairs);
+    }
+
+    /// Stretches lost from the file drawn, s.
+    #[must_use]
+    pub fn lost_s(&self) -> &[(f64, f64)] {
+        &self.lost_s
+    }
+
+    /// The time axis's label.
+    fn x_desc(&self) -> String {
+        match &self.utc {
+            Some(pairs) => {
+                let day = utc_ms_at(pairs, self.window_s.start)
+                    .and_then(iso8601_unix_ms)
+                    .map_or(String::new(), |iso| iso[..10].to_string());
+                format!("UTC on {day} (hh:mm:ss)")
+            }
+            None => "time since boot (s)".into(),
+        }
+    }
+
+    /// A time axis tick.
+    fn x_tick(&self, t_s: f64) -> String {
+        match &self.utc {
+            Some(pairs) => utc_ms_at(pairs, t_s)
+                .and_then(iso8601_unix_ms)
+                .map_or(String::new(), |iso| iso[11..19].to_string()),
+            None => tick_label(t_s),
+        }
     }
 
     /// Alert periods drawn, s.
@@ -128,28 +183,62 @@ impl Figure for TimePlot {
         for (k, ((area, label), series)) in panels.iter().zip(PANELS).zip(&self.series).enumerate()
         {
             let y = padded_range(series.iter().flatten().map(|p| p.1), 1.0);
+            // The bottom panel also holds the time axis's title.
+            let x_label_px = if k == last { 48 } else { 28 };
             let mut chart = ChartBuilder::on(area)
                 .margin_right(20)
+                .margin_left(10)
                 .margin_top(6)
-                .x_label_area_size(28)
-                .y_label_area_size(70)
+                .x_label_area_size(x_label_px)
+                .y_label_area_size(Y_LABEL_AREA_PX)
                 .build_cartesian_2d(self.window_s.clone(), y.clone())
                 .map_err(err)?;
+            let x_desc = if k == last {
+                self.x_desc()
+            } else {
+                String::new()
+            };
             chart
                 .configure_mesh()
                 .y_desc(label)
-                .x_desc(if k == last { "time since boot (s)" } else { "" })
+                .x_desc(x_desc)
+                .x_label_formatter(&|t| self.x_tick(*t))
+                .y_label_formatter(&|v| tick_label(*v))
                 .label_style((FONT, 13))
                 .axis_desc_style((FONT, 14))
                 .light_line_style(WHITE.mix(0.0))
                 .draw()
                 .map_err(err)?;
-            chart
-                .draw_series(self.alerts_s.iter().map(|&(a, b)| {
-                    Rectangle::new([(a, y.start), (b, y.end)], ALERT_COLOUR.mix(0.18).filled())
-                }))
+            let span = |&(a, b): &(f64, f64), colour: RGBAColor| {
+                Rectangle::new([(a, y.start), (b, y.end)], colour.filled())
+            };
+            let alerts = chart
+                .draw_series(
+                    self.alerts_s
+                        .iter()
+                        .map(|s| span(s, ALERT_COLOUR.mix(0.18))),
+                )
                 .map_err(err)?;
-            chart
+            if k == 0 && !self.alerts_s.is_empty() {
+                alerts.label("wobble alert (on board)").legend(|(x, y)| {
+                    Rectangle::new(
+                        [(x, y - 6), (x + 16, y + 6)],
+                        ALERT_COLOUR.mix(0.18).filled(),
+                    )
+                });
+            }
+            let lost = chart
+                .draw_series(self.lost_s.iter().map(|s| span(s, LOST_COLOUR.mix(0.35))))
+                .map_err(err)?;
+            if k == 0 && !self.lost_s.is_empty() {
+                lost.label("data lost (missing blocks)").legend(|(x, y)| {
+                    Rectangle::new(
+                        [(x, y - 6), (x + 16, y + 6)],
+                        LOST_COLOUR.mix(0.35).filled(),
+                    )
+                });
+            }
+            let markers = chart
                 .draw_series(self.markers_s.iter().map(|&t| {
                     PathElement::new(
                         vec![(t, y.start), (t, y.end)],
@@ -157,9 +246,29 @@ impl Figure for TimePlot {
                     )
                 }))
                 .map_err(err)?;
+            if k == 0 && !self.markers_s.is_empty() {
+                markers.label("rider marker").legend(|(x, y)| {
+                    PathElement::new(
+                        vec![(x + 8, y - 7), (x + 8, y + 7)],
+                        MARKER_COLOUR.stroke_width(2),
+                    )
+                });
+            }
             for points in series {
                 chart
                     .draw_series(LineSeries::new(points.iter().copied(), LINE_COLOUR))
+                    .map_err(err)?;
+            }
+            let keyed =
+                !(self.alerts_s.is_empty() && self.lost_s.is_empty() && self.markers_s.is_empty());
+            if k == 0 && keyed {
+                chart
+                    .configure_series_labels()
+                    .label_font((FONT, 13))
+                    .background_style(WHITE.mix(0.9))
+                    .border_style(BLACK.mix(0.5))
+                    .position(SeriesLabelPosition::UpperLeft)
+                    .draw()
                     .map_err(err)?;
             }
         }

@@ -1,0 +1,183 @@
+//! The extended wobble model: its Whipple limits, and the behaviour the
+//! seed paper reports for its test bicycle.
+
+use std::path::Path;
+
+use nalgebra::Complex;
+use wobble_model::multibody::{self, constrained_whipple};
+use wobble_model::wobble::{WobbleModel, WobbleParams};
+use wobble_model::{critical_speeds, Mode, Model, ParamSet, Sweep};
+
+fn set(name: &str) -> ParamSet {
+    ParamSet::load(
+        &Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("params")
+            .join(name),
+    )
+    .unwrap()
+}
+
+fn speeds() -> Vec<f64> {
+    (5..=100).map(|i| f64::from(i) * 0.1).collect()
+}
+
+/// The wobble eigenvalue (upper member) at every speed of `speeds()`.
+fn wobble(set: &ParamSet) -> (Vec<Complex<f64>>, Option<f64>) {
+    let model = Model::from_set(set).unwrap();
+    let sweep = Sweep::run(&model, &speeds(), |_| {}).unwrap();
+    let branch = sweep
+        .upper(Mode::Wobble)
+        .expect("a wobble mode")
+        .values
+        .clone();
+    let speed = critical_speeds(&model, &sweep)
+        .into_iter()
+        .find(|c| c.mode == Mode::Wobble && c.unstable_above)
+        .map(|c| c.speed_mps);
+    (branch, speed)
+}
+
+fn hz(v: Complex<f64>) -> f64 {
+    v.im / std::f64::consts::TAU
+}
+
+#[test]
+fn constrained_limit_is_the_lumped_whipple_bicycle_exactly() {
+    for file in ["test-bicycle.toml", "test-bicycle-light-rider.toml"] {
+        let p = WobbleParams::from_set(&set(file)).unwrap();
+        let (geo, bodies) = p.description();
+        let [m, c1, k0g, k2] = constrained_whipple(&multibody::linearise(&geo, &bodies));
+        let want = p.to_benchmark().matrices();
+        for (got, want, what) in [
+            (m, want.m, "M"),
+            (c1, want.c1, "C1"),
+            (k0g / p.gravity, want.k0, "K0"),
+            (k2, want.k2, "K2"),
+        ] {
+            for i in 0..2 {
+                for j in 0..2 {
+                    assert!(
+                        (got[(i, j)] - want[(i, j)]).abs() < 1e-10,
+                        "{file} {what}: {got} vs {want}"
+                    );
+                }
+            }
+        }
+    }
+}
+
+/// Stiffer by `k`: tyres (cornering up, relaxation down: towards no
+/// relaxation), torso and twist springs; the tyre moments off (the
+/// Whipple wheel is a knife edge).
+fn stiffened(p: &WobbleParams, k: f64) -> WobbleParams {
+    let mut s = *p;
+    for t in [&mut s.front_tyre, &mut s.rear_tyre] {
+        t.cornering_stiffness *= k;
+        t.relaxation_length /= k;
+        t.camber_relaxation_length /= k;
+        t.camber_stiffness = 0.0;
+        t.aligning_coefficient = 0.0;
+        t.twisting_coefficient = 0.0;
+        t.overturning_coefficient = 0.0;
+    }
+    s.hip_stiffness = 1e3 * k * k;
+    s.head_stiffness *= k * k;
+    s
+}
+
+#[test]
+fn stiff_tyres_rigid_head_and_locked_torso_converge_to_whipple() {
+    let p = WobbleParams::from_set(&set("test-bicycle.toml")).unwrap();
+    let whipple = p.to_benchmark().matrices();
+    let mut last = f64::INFINITY;
+    for k in [10.0, 100.0, 1000.0] {
+        let model = WobbleModel::new(stiffened(&p, k));
+        let mut worst: f64 = 0.0;
+        for u in [1.0, 3.0, 5.0, 8.0] {
+            let ext = wobble_model::eig::eigenvalues(&model.state_matrix(u)).unwrap();
+            for w in wobble_model::eig::eigenvalues(&whipple.state_matrix(u)).unwrap() {
+                let nearest = ext
+                    .iter()
+                    .map(|e| (e - w).norm())
+                    .fold(f64::INFINITY, f64::min);
+                worst = worst.max(nearest / w.norm().max(1.0));
+            }
+        }
+        println!("stiffness x{k}: worst relative distance {worst:.3e}");
+        assert!(
+            worst < last / 5.0,
+            "x{k}: {worst} does not converge (before {last})"
+        );
+        last = worst;
+    }
+    assert!(last < 1e-3, "{last}");
+}
+
+#[test]
+fn test_bicycle_wobbles_near_6_hz_unstable_from_about_4_mps() {
+    let (w, speed) = wobble(&set("test-bicycle.toml"));
+    let f_low = hz(w[5]); // 1 m/s
+    let f_high = hz(w[95]); // 10 m/s
+    assert!((5.5..6.5).contains(&f_low), "{f_low} Hz at 1 m/s");
+    assert!(
+        f_high > f_low,
+        "frequency rises with speed: {f_low} -> {f_high} Hz"
+    );
+    let speed = speed.expect("a wobble speed");
+    assert!((3.5..4.5).contains(&speed), "wobble speed {speed}");
+    assert!(w[5].re < 0.0 && w[95].re > 0.0);
+}
+
+#[test]
+fn a_light_rider_raises_wobble_speed_and_frequency() {
+    let (heavy, heavy_speed) = wobble(&set("test-bicycle.toml"));
+    let (light, light_speed) = wobble(&set("test-bicycle-light-rider.toml"));
+    let heavy_speed = heavy_speed.unwrap();
+    assert!(
+        light_speed.is_none_or(|s| s > heavy_speed + 1.0),
+        "{light_speed:?} vs {heavy_speed}"
+    );
+    for (k, u) in speeds().into_iter().enumerate() {
+        // The heavier rider's wobble frequency rises faster with speed, so
+        // the light rider's is higher up to the wobble speed only.
+        if u <= heavy_speed {
+            assert!(hz(light[k]) > hz(heavy[k]), "at {u} m/s");
+        }
+        assert!(light[k].re < heavy[k].re, "at {u} m/s");
+    }
+}
+
+fn scaled(file: &str, key: &str, factor: f64) -> ParamSet {
+    let mut s = set(file);
+    let v = s.value(key).unwrap();
+    s.set_value(key, v * factor, "scaled in a test").unwrap();
+    s
+}
+
+#[test]
+fn more_front_cornering_stiffness_raises_wobble_frequency_and_growth() {
+    let (base, _) = wobble(&set("test-bicycle.toml"));
+    let (stiff, _) = wobble(&scaled(
+        "test-bicycle.toml",
+        "front_tyre.cornering_stiffness",
+        1.5,
+    ));
+    for k in 0..base.len() {
+        assert!(
+            hz(stiff[k]) > hz(base[k]),
+            "frequency at {} m/s",
+            speeds()[k]
+        );
+        assert!(stiff[k].re > base[k].re, "growth at {} m/s", speeds()[k]);
+    }
+}
+
+#[test]
+fn steering_head_damping_stabilises_wobble() {
+    let (base, base_speed) = wobble(&set("test-bicycle.toml"));
+    let (damped, damped_speed) = wobble(&scaled("test-bicycle.toml", "steer_head.damping", 2.0));
+    for k in 0..base.len() {
+        assert!(damped[k].re < base[k].re, "at {} m/s", speeds()[k]);
+    }
+    assert!(damped_speed.is_none_or(|s| s > base_speed.unwrap()));
+}
