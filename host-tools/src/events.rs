@@ -84,10 +84,18 @@ pub enum EventKind {
         /// What was wrong.
         error: String,
     },
-    /// A frame whose time went backwards.
+    /// A frame whose time went backwards, or forwards beyond what missing
+    /// frames explain.
     TimeJump {
-        /// The time it went back to, s.
+        /// The time it went to, s.
         to_s: f64,
+    },
+    /// A value the firmware cannot have written, dropped or replaced.
+    OutOfRange {
+        /// Block number.
+        block: u32,
+        /// What it was and what became of it.
+        what: String,
     },
 }
 
@@ -105,6 +113,7 @@ impl EventKind {
             Self::Skipped { .. } => "skipped",
             Self::BadRecord { .. } => "bad_record",
             Self::TimeJump { .. } => "time_jump",
+            Self::OutOfRange { .. } => "out_of_range",
         }
     }
 
@@ -138,7 +147,8 @@ impl EventKind {
                 format!("{len} bytes at offset {offset} ({cause})")
             }
             Self::BadRecord { block, error } => format!("block {block}: {error}"),
-            Self::TimeJump { to_s } => format!("back to {to_s:.6} s"),
+            Self::TimeJump { to_s } => format!("to {to_s:.6} s"),
+            Self::OutOfRange { block, what } => format!("block {block}: {what}"),
         }
     }
 }
@@ -193,6 +203,13 @@ impl EventCollector {
                 EventKind::BadRecord {
                     block: *seq,
                     error: error.to_string(),
+                },
+            ),
+            Event::OutOfRange { seq, what } => (
+                self.last_t_s,
+                EventKind::OutOfRange {
+                    block: *seq,
+                    what: crate::losses::out_of_range_text(*what),
                 },
             ),
             Event::TimeJump { from_us, to_us } => (

@@ -37,7 +37,6 @@ use wobble_core::app::{gps, gps_setup, sampler, writer};
 use wobble_core::boot;
 use wobble_core::channels::{RecordQueue, SharedStatus};
 use wobble_core::config::{self, Config, Loaded, KEY_COUNT, MAX_TEXT_LEN};
-use wobble_core::detector::Detector;
 use wobble_core::drivers::icm42688::{self, Icm42688};
 use wobble_core::format::{Fault, FaultSource, Record};
 use wobble_core::frame_assembly::FrameConfig;
@@ -242,7 +241,7 @@ fn sampler_parts(
     let sampler = Sampler::new(
         defmt::unwrap!(WheelSpeed::try_new(config.wheel).ok()),
         FrameConfig::DEFAULT,
-        defmt::unwrap!(Detector::new(config.detector).ok()),
+        defmt::unwrap!(config.detector().ok()),
         config.alert.pattern,
     );
     (sampler, ports)
