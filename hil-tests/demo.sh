@@ -6,7 +6,7 @@
 #
 # Results in out/demo/ (or the folder given as $1): card.img (the FAT32 SD
 # card image), RUN00001.WBL (the log), ride.csv (decoded frames), summary.txt
-# and summary.json (`wobblog info`), ride.png (`wobblog plot`, when present).
+# and summary.json (`wobblog info`), ride.png (`wobblog plot`).
 # Installs what it needs first, once: the ARM target, qemu-system-arm and
 # dosfstools.
 set -euo pipefail
@@ -16,19 +16,28 @@ OUT="${1:-out/demo}"
 
 source hil-tests/install-tools.sh
 
+# Only a folder that an earlier demo made (it holds the marker) is replaced:
+# a folder given by mistake that holds real logs is never touched.
+MARKER=.wobble-demo
+if [ -e "$OUT" ] && [ ! -e "$OUT/$MARKER" ] && [ -n "$(ls -A "$OUT")" ]; then
+    echo "demo.sh: $OUT exists and was not made by the demo; choose another folder" >&2
+    exit 1
+fi
+# Two builds: `--bin` narrows every package a command selects.
+cargo build -q --release -p wobble-hil --bin qemu-demo
+cargo build -q --release -p wobblog --bin wobblog
+BIN="${CARGO_TARGET_DIR:-target}/release"
+
 rm -rf "$OUT"
 mkdir -p "$OUT"
-cargo build -q --release -p wobble-hil --bin qemu-demo -p wobblog
-BIN="${CARGO_TARGET_DIR:-target}/release"
+touch "$OUT/$MARKER"
 "$BIN/qemu-demo" "$OUT"
 
 LOG="$OUT/RUN00001.WBL"
 "$BIN/wobblog" decode "$LOG" -o "$OUT/ride.csv"
 "$BIN/wobblog" info "$LOG" | tee "$OUT/summary.txt"
 "$BIN/wobblog" info "$LOG" --json > "$OUT/summary.json"
-if "$BIN/wobblog" plot --help >/dev/null 2>&1; then
-    "$BIN/wobblog" plot "$LOG" -o "$OUT/ride.png"
-fi
+"$BIN/wobblog" plot "$LOG" -o "$OUT/ride.png"
 echo
 echo "results in $OUT/:"
 ls -1 "$OUT"

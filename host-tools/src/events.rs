@@ -84,10 +84,18 @@ pub enum EventKind {
         /// What was wrong.
         error: String,
     },
-    /// A frame whose time went backwards.
+    /// A frame whose time went backwards, or forwards beyond what missing
+    /// frames explain.
     TimeJump {
-        /// The time it went back to, s.
+        /// The time it went to, s.
         to_s: f64,
+    },
+    /// A value the firmware cannot have written, dropped or replaced.
+    OutOfRange {
+        /// Block number.
+        block: u32,
+        /// What it was and what became of it.
+        what: String,
     },
 }
 
@@ -105,6 +113,7 @@ impl EventKind {
             Self::Skipped { .. } => "skipped",
             Self::BadRecord { .. } => "bad_record",
             Self::TimeJump { .. } => "time_jump",
+            Self::OutOfRange { .. } => "out_of_range",
         }
     }
 
@@ -138,12 +147,13 @@ impl EventKind {
                 format!("{len} bytes at offset {offset} ({cause})")
             }
             Self::BadRecord { block, error } => format!("block {block}: {error}"),
-            Self::TimeJump { to_s } => format!("back to {to_s:.6} s"),
+            Self::TimeJump { to_s } => format!("to {to_s:.6} s"),
+            Self::OutOfRange { block, what } => format!("block {block}: {what}"),
         }
     }
 }
 
-/// Collects [`LogEvent`]s from decoder events.
+/// Turns decoder events into [`LogEvent`]s, and collects them.
 #[derive(Default)]
 pub struct EventCollector {
     events: Vec<LogEvent>,
@@ -157,16 +167,20 @@ impl EventCollector {
         Self::default()
     }
 
-    /// Takes one decoder event.
+    /// Takes one decoder event and keeps it if it is a [`LogEvent`].
     pub fn observe(&mut self, event: &Event<'_>) {
+        if let Some(e) = self.convert(event) {
+            self.events.push(e);
+        }
+    }
+
+    /// The [`LogEvent`] of a decoder event, if it is one (not kept).
+    pub fn convert(&mut self, event: &Event<'_>) -> Option<LogEvent> {
         let (t_s, kind) = match event {
             Event::Record(record) => {
                 let t_s = record.t_us() as f64 / 1e6;
                 self.last_t_s = t_s;
-                let Some(kind) = record_event(record) else {
-                    return;
-                };
-                (t_s, kind)
+                (t_s, record_event(record)?)
             }
             Event::Gap(gap) => {
                 let lost = LostBlocks::from(gap);
@@ -195,6 +209,13 @@ impl EventCollector {
                     error: error.to_string(),
                 },
             ),
+            Event::OutOfRange { seq, what } => (
+                self.last_t_s,
+                EventKind::OutOfRange {
+                    block: *seq,
+                    what: crate::losses::out_of_range_text(*what),
+                },
+            ),
             Event::TimeJump { from_us, to_us } => (
                 *from_us as f64 / 1e6,
                 EventKind::TimeJump {
@@ -202,7 +223,7 @@ impl EventCollector {
                 },
             ),
         };
-        self.events.push(LogEvent { t_s, kind });
+        Some(LogEvent { t_s, kind })
     }
 
     /// The events in time order (file order among equal times).

@@ -16,6 +16,7 @@ pub mod plot;
 pub mod reader;
 pub mod rows;
 pub mod summary;
+pub mod text;
 pub mod time;
 pub mod words;
 

@@ -1,7 +1,7 @@
 //! What a decode could not recover, collected for reports.
 
 use serde::Serialize;
-use wobble_core::format::{Event, Gap, SkipCause};
+use wobble_core::format::{Event, Gap, OutOfRange, SkipCause};
 
 /// Entries kept per list; beyond that only the totals in `DecodeStats` grow.
 const MAX_ENTRIES: usize = 1000;
@@ -53,8 +53,12 @@ pub struct Losses {
     pub skipped: Vec<Skipped>,
     /// Valid blocks whose records could not all be read: (block, error).
     pub bad_records: Vec<(u32, String)>,
-    /// Frames whose time went backwards: (from s, to s).
+    /// Frames whose time jumped, backwards or forwards beyond what missing
+    /// frames explain: (from s, to s). Each starts a new segment.
     pub time_jumps: Vec<(f64, f64)>,
+    /// Values the firmware cannot have written, dropped or replaced:
+    /// (block, what).
+    pub out_of_range: Vec<(u32, String)>,
 }
 
 impl Losses {
@@ -87,6 +91,9 @@ impl Losses {
                     (*from_us as f64 / 1e6, *to_us as f64 / 1e6),
                 );
             }
+            Event::OutOfRange { seq, what } => {
+                push_capped(&mut self.out_of_range, (*seq, out_of_range_text(*what)))
+            }
             Event::Record(_) => {}
         }
     }
@@ -116,7 +123,13 @@ impl Losses {
             ));
         }
         for (from, to) in &self.time_jumps {
-            lines.push(format!("time jumps back from {from:.6} s to {to:.6} s"));
+            let way = if to < from { "back" } else { "forward" };
+            lines.push(format!(
+                "time jumps {way} from {from:.6} s to {to:.6} s; a new segment starts"
+            ));
+        }
+        for (seq, what) in &self.out_of_range {
+            lines.push(format!("block {seq}: {what}"));
         }
         lines
     }
@@ -136,5 +149,19 @@ pub fn cause_name(cause: SkipCause) -> &'static str {
         SkipCause::BadHeader => "bad block header",
         SkipCause::Garbage => "garbage",
         SkipCause::TruncatedTail => "truncated tail",
+        SkipCause::Repeated => "repeated or stale blocks, decoded once",
+    }
+}
+
+/// What an out-of-range value was and what became of it, in words.
+#[must_use]
+pub fn out_of_range_text(what: OutOfRange) -> String {
+    match what {
+        OutOfRange::SampleRate(hz) => format!(
+            "sample rate {hz} Hz is not one the logger runs at; {} Hz used",
+            wobble_core::format::limits::DEFAULT_SAMPLE_RATE_HZ
+        ),
+        OutOfRange::GpsFields(n) => format!("{n} GPS values out of range dropped"),
+        OutOfRange::UtcSync => "UTC sync outside 2000-2099 dropped".into(),
     }
 }

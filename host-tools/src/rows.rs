@@ -12,6 +12,9 @@ use wobble_core::format::{
 pub const GPS_STALE_US: u64 = 1_000_000;
 /// How long rows wait for a GPS fix stamped before them but written after.
 const GPS_WAIT_US: u64 = 500_000;
+/// Most rows held back, whatever the frame times say (0.5 s at 100 Hz is
+/// 50): times that stand still cannot make the assembler hoard memory.
+const MAX_PENDING_ROWS: usize = 4096;
 
 /// The GPS columns of a row.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -117,6 +120,17 @@ impl RowAssembler {
     pub fn push(&mut self, record: &Record<'_>, emit: &mut impl FnMut(&Row)) {
         match record {
             Record::Frame(frame) => {
+                // Time going back starts a new segment: nothing waits across
+                // it, and a fix from before it fills no row after it.
+                if self.pending.back().is_some_and(|&(t, _)| frame.t_us < t) {
+                    self.finish(emit);
+                    self.gps = None;
+                }
+                if self.pending.len() >= MAX_PENDING_ROWS {
+                    if let Some((_, row)) = self.pending.pop_front() {
+                        emit(&row);
+                    }
+                }
                 let gps = self.gps_at(frame.t_us);
                 let sync = self.sync.filter(|s| s.t_us <= frame.t_us);
                 self.pending

@@ -7,6 +7,7 @@ use wobble_core::format::{DecodeStats, Event, Record};
 
 use crate::losses::Losses;
 use crate::rows::{Row, RowAssembler};
+use crate::text::escape_controls;
 
 /// One wobble alert, from its switching on to its switching off.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
@@ -38,8 +39,12 @@ pub struct Summary {
     pub start_s: Option<f64>,
     /// Time of the last frame, s since boot.
     pub end_s: Option<f64>,
-    /// Length of the run: first to last frame plus one frame period, s.
+    /// Time the frames cover: over each segment, first to last frame plus
+    /// one frame period, s. Time jumps between segments are not in it (they
+    /// are listed in `losses.time_jumps`).
     pub duration_s: f64,
+    /// Stretches of the run between time jumps.
+    pub segments: u64,
     /// Frames decoded.
     pub samples: u64,
     /// Dropout records: frames the logger could not write, by reason.
@@ -58,8 +63,14 @@ pub struct Summary {
     pub bad_records: u64,
     /// Frames whose time went backwards.
     pub time_jumps: u64,
+    /// Frames whose time went forwards by more than missing frames explain.
+    pub forward_time_jumps: u64,
     /// Blocks whose sequence number went backwards (stale data).
     pub out_of_order_blocks: u64,
+    /// Of those, repeats and stale copies, decoded once.
+    pub repeated_blocks: u64,
+    /// Values the firmware cannot have written, dropped or replaced.
+    pub out_of_range: u64,
     /// GPS fix records.
     pub gps_fixes: u64,
     /// Share of frames with a GPS position, percent.
@@ -84,8 +95,10 @@ pub struct Summary {
 #[derive(Default)]
 pub struct SummaryBuilder {
     summary: Summary,
-    /// First and last frame times, µs.
+    /// First and last frame times of the current segment, µs.
     span_us: Option<(u64, u64)>,
+    /// Time covered by the segments before it, µs.
+    closed_us: u64,
     rows: RowAssembler,
     rows_with_gps: u64,
 }
@@ -100,6 +113,9 @@ impl SummaryBuilder {
     /// Takes one decoder event.
     pub fn observe(&mut self, event: &Event<'_>) {
         self.summary.losses.observe(event);
+        if let Event::TimeJump { .. } = event {
+            self.close_segment();
+        }
         let Event::Record(record) = event else { return };
         let s = &mut self.summary;
         let t_s = record.t_us() as f64 / 1e6;
@@ -142,18 +158,30 @@ impl SummaryBuilder {
                 *s.faults.entry(f.source.as_str()).or_default() += u64::from(f.count.max(1))
             }
             Record::LogInfo(info) => {
-                s.firmware = Some(info.firmware.to_string());
+                s.firmware = Some(escape_controls(info.firmware).into_owned());
                 s.device_id = Some(info.device_id.iter().map(|b| format!("{b:02x}")).collect());
                 s.run = Some(info.run);
                 s.sample_rate_hz = Some(info.sample_rate_hz);
             }
             Record::Channel(_) => {}
-            Record::Config(line) => s.config.push(line.text.to_string()),
+            Record::Config(line) => s.config.push(escape_controls(line.text).into_owned()),
         }
         let with_gps = &mut self.rows_with_gps;
         self.rows.push(record, &mut |row: &Row| {
             *with_gps += u64::from(row.gps.is_some())
         });
+    }
+
+    fn period_us(&self) -> u64 {
+        1_000_000 / u64::from(self.summary.sample_rate_hz.unwrap_or(100).max(1))
+    }
+
+    /// Adds the current segment's span to the duration.
+    fn close_segment(&mut self) {
+        if let Some((first, last)) = self.span_us.take() {
+            self.closed_us += last.saturating_sub(first).saturating_add(self.period_us());
+            self.summary.segments += 1;
+        }
     }
 
     /// The summary, given the decoder's totals.
@@ -162,11 +190,9 @@ impl SummaryBuilder {
         let with_gps = &mut self.rows_with_gps;
         self.rows
             .finish(&mut |row: &Row| *with_gps += u64::from(row.gps.is_some()));
+        self.close_segment();
         let mut s = self.summary;
-        let period_us = 1_000_000 / u64::from(s.sample_rate_hz.unwrap_or(100).max(1));
-        s.duration_s = self.span_us.map_or(0.0, |(first, last)| {
-            (last.saturating_sub(first) + period_us) as f64 / 1e6
-        });
+        s.duration_s = self.closed_us as f64 / 1e6;
         s.gps_coverage_pct = if s.samples == 0 {
             0.0
         } else {
@@ -178,7 +204,10 @@ impl SummaryBuilder {
         s.bytes_skipped = stats.bytes_skipped;
         s.bad_records = stats.bad_records;
         s.time_jumps = stats.time_jumps;
+        s.forward_time_jumps = stats.forward_time_jumps;
         s.out_of_order_blocks = stats.out_of_order_blocks;
+        s.repeated_blocks = stats.repeated_blocks;
+        s.out_of_range = stats.out_of_range;
         s
     }
 }

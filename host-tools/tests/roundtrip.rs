@@ -29,7 +29,7 @@ fn rows() -> impl Strategy<Value = Vec<CsvRow>> {
     let gps = proptest::option::of((
         -90.0..90.0f64,
         -180.0..180.0f64,
-        0.0..600.0f64,
+        0.0..514.0f64,
         prop_oneof![Just("2d"), Just("3d")],
     ));
     (vec((value_ranges, gps, 0..40u64), 1..600), 0..10_000u64).prop_map(|(items, start_cs)| {

@@ -238,6 +238,27 @@ fn records<'a>(events: &[Event<'a>]) -> Vec<Record<'a>> {
         .collect()
 }
 
+/// What the decoder passes on of records as written: values the firmware
+/// cannot write are dropped, an impossible sample rate becomes the default.
+fn sanitised<'a>(written: impl IntoIterator<Item = Record<'a>>) -> Vec<Record<'a>> {
+    written
+        .into_iter()
+        .filter_map(|mut r| {
+            match &mut r {
+                Record::Gps(fix) => {
+                    fix.drop_out_of_range();
+                }
+                Record::LogInfo(info) if !info.sample_rate_is_valid() => {
+                    info.sample_rate_hz = limits::DEFAULT_SAMPLE_RATE_HZ;
+                }
+                Record::UtcSync(sync) if !sync.is_valid() => return None,
+                _ => {}
+            }
+            Some(r)
+        })
+        .collect()
+}
+
 fn frames_in(block: &[Record<'_>]) -> u32 {
     block
         .iter()
@@ -253,7 +274,7 @@ proptest! {
         let (file, blocks) = encode(&specs);
         prop_assert_eq!(file.len() % BLOCK_LEN, 0);
         let (events, stats) = decode(&file);
-        let expected: Vec<Record<'_>> = blocks.concat();
+        let expected = sanitised(blocks.concat());
         prop_assert_eq!(records(&events), expected);
         prop_assert_eq!(stats.blocks_lost + stats.bytes_skipped + stats.bad_records, 0);
     }
@@ -297,8 +318,9 @@ proptest! {
         let (events, stats) = decode(&file);
 
         // Every undamaged block comes back exactly.
-        let expected: Vec<Record<'_>> =
-            blocks.iter().zip(&damaged).filter(|(_, d)| !**d).flat_map(|(b, _)| b.clone()).collect();
+        let expected = sanitised(
+            blocks.iter().zip(&damaged).filter(|(_, d)| !**d).flat_map(|(b, _)| b.clone()),
+        );
         prop_assert_eq!(records(&events), expected);
 
         // Every run of damaged blocks followed by a good one is one gap of
@@ -341,7 +363,7 @@ proptest! {
             }
         }
         let (events, stats) = decode(&dirty);
-        prop_assert_eq!(records(&events), blocks.concat());
+        prop_assert_eq!(records(&events), sanitised(blocks.concat()));
         prop_assert_eq!(stats.bytes_skipped as usize, junk_len);
         prop_assert_eq!(stats.blocks_lost, 0);
     }
@@ -408,4 +430,36 @@ fn frames_average_under_32_bytes_with_20hz_gps() {
     }
     let per_frame = bytes as f64 / frames as f64;
     assert!(per_frame <= 32.0, "{per_frame} bytes per frame");
+}
+
+proptest! {
+    // Each case builds a whole ride: fewer cases keep the suite fast.
+    #![proptest_config(ProptestConfig::with_cases(48))]
+
+    #[test]
+    fn repeated_blocks_are_decoded_once(
+        specs in ride(),
+        copies in vec((any::<prop::sample::Index>(), any::<prop::sample::Index>()), 1..8),
+    ) {
+        let (file, blocks) = encode(&specs);
+        let n = blocks.len();
+        // Copies of blocks already in the file put after them: out of their
+        // place and not after the last block before them.
+        let mut order: Vec<usize> = (0..n).collect();
+        for (at, which) in &copies {
+            let at = at.index(order.len()) + 1;
+            let which = order[which.index(at)];
+            order.insert(at, which);
+        }
+        let dirty: Vec<u8> = order
+            .iter()
+            .flat_map(|&b| file[b * BLOCK_LEN..(b + 1) * BLOCK_LEN].iter().copied())
+            .collect();
+        let (events, stats) = decode(&dirty);
+        let repeated = copies.len() as u64;
+        prop_assert_eq!(stats.repeated_blocks, repeated, "{:?}", order);
+        prop_assert_eq!(stats.blocks_lost, 0);
+        prop_assert_eq!(stats.bytes_skipped, repeated * BLOCK_LEN as u64);
+        prop_assert_eq!(records(&events), sanitised(blocks.concat()));
+    }
 }

@@ -33,16 +33,11 @@ pub fn image() -> Result<PathBuf, String> {
 fn build_image() -> Result<PathBuf, String> {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
     let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
+    // From the image's own directory, so its `.cargo/config.toml` gives it
+    // the board's size-optimised release profile.
     let status = Command::new(cargo)
-        .current_dir(&root)
-        .args([
-            "build",
-            "--release",
-            "-p",
-            "wobble-qemu-image",
-            "--target",
-            TARGET,
-        ])
+        .current_dir(root.join("hil-tests/qemu-image"))
+        .args(["build", "--release", "--target", TARGET])
         .status()
         .map_err(|e| format!("cargo: {e}"))?;
     if !status.success() {

@@ -8,6 +8,7 @@ use wobble_core::format::{Event, Record};
 
 use crate::cmd::logs::print_stdout;
 use crate::reader::read_log;
+use crate::text::escape_controls;
 use crate::CliError;
 
 /// Arguments of `wobblog config`.
@@ -60,10 +61,10 @@ impl Header {
         let mut text = format!(
             "# CONFIG.TXT in force for {name} (run {}, firmware {})\n",
             self.run.map_or("?".into(), |r| r.to_string()),
-            self.firmware.as_deref().unwrap_or("unknown"),
+            escape_controls(self.firmware.as_deref().unwrap_or("unknown")),
         );
         for line in &self.config {
-            text.push_str(line);
+            text.push_str(&escape_controls(line));
             text.push('\n');
         }
         text

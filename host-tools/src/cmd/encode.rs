@@ -5,6 +5,7 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use wobble_core::format::header::header_records;
+use wobble_core::format::limits::SPEED_CM_S_MAX;
 use wobble_core::format::{
     quantise_i16, quantise_i32, quantise_u16, BlockEncoder, FixMode, Frame, GpsFix, LogInfo,
     Record, ACCEL_COUNTS_PER_G, EDGE_AGE_NONE, GYRO_COUNTS_PER_DPS, STEER_COUNTS_PER_DEG,
@@ -214,7 +215,7 @@ fn parse_row(
                 lat_e7: Some(quantise_i32(number(9, (-90.0, 90.0), " deg")?, 1e7)),
                 lon_e7: Some(quantise_i32(number(10, (-180.0, 180.0), " deg")?, 1e7)),
                 speed_cm_s: field(11)
-                    .map(|_| number(11, (0.0, 655.35), " m/s"))
+                    .map(|_| number(11, (0.0, f64::from(SPEED_CM_S_MAX) / 100.0), " m/s"))
                     .transpose()?
                     .map(|v| quantise_u16(v, 100.0)),
                 fix,

@@ -50,10 +50,21 @@ fn render(path: &std::path::Path, s: &Summary) -> String {
         s.run.map_or("?".into(), |r| r.to_string())
     );
     let span = match (s.start_s, s.end_s) {
+        (Some(a), Some(b)) if s.segments > 1 => format!(
+            "{} segments between time jumps, first frame {a:.3} s, last {b:.3} s since boot",
+            s.segments
+        ),
         (Some(a), Some(b)) => format!("{a:.3} s to {b:.3} s since boot"),
         _ => "no frames".into(),
     };
     let _ = writeln!(o, "duration:     {:.2} s ({span})", s.duration_s);
+    if s.time_jumps + s.forward_time_jumps > 0 {
+        let _ = writeln!(
+            o,
+            "time jumps:   {} back, {} forward (listed under losses)",
+            s.time_jumps, s.forward_time_jumps
+        );
+    }
     let _ = writeln!(
         o,
         "samples:      {} at {} Hz",
@@ -76,6 +87,13 @@ fn render(path: &std::path::Path, s: &Summary) -> String {
         "lost blocks:  {} ({} frames), {} damaged, {} bytes skipped",
         s.lost_blocks, s.frames_lost, s.damaged_blocks, s.bytes_skipped
     );
+    if s.repeated_blocks + s.out_of_range > 0 {
+        let _ = writeln!(
+            o,
+            "invalid:      {} repeated or stale blocks decoded once, {} impossible values dropped or replaced",
+            s.repeated_blocks, s.out_of_range
+        );
+    }
     let _ = writeln!(
         o,
         "gps:          {} fixes, {:.1} % of samples with a position, first UTC {}",

@@ -11,7 +11,18 @@
 
 use super::block::{Block, BlockError, BlockHeader, BLOCK_LEN, MAGIC};
 use super::codec::{RecordError, Records};
+use super::limits::DEFAULT_SAMPLE_RATE_HZ;
 use super::record::Record;
+
+/// A block at most this many numbers behind the last one decoded, out of
+/// its place, is a repeat or a stale copy. One much further behind means the
+/// earlier block was the odd one (a crafted or stray block numbered high),
+/// so it is decoded: a bad block in front can hide at most this many.
+pub const REPEAT_WINDOW_BLOCKS: u32 = 64;
+
+/// A forward step between frames longer than the frames known to be
+/// missing explain, by more than this, is a time jump (µs).
+pub const TIME_JUMP_SLACK_US: u64 = 1_000_000;
 
 /// A stretch of missing data between two valid blocks.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -43,6 +54,23 @@ pub enum SkipCause {
     Garbage,
     /// The file ends inside a block.
     TruncatedTail,
+    /// A valid block that repeats or predates one already decoded, out of
+    /// its place in the file: its records were already counted, or are stale.
+    Repeated,
+}
+
+/// A value in a CRC-valid record that the firmware cannot have written
+/// (see [`super::limits`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum OutOfRange {
+    /// The log info's sample rate; the record is passed on with the
+    /// documented default instead.
+    SampleRate(u16),
+    /// Fields of a GPS fix (this many), removed from the fix passed on.
+    GpsFields(u32),
+    /// A UTC sync record outside 2000-2099; the record is dropped.
+    UtcSync,
 }
 
 /// Something the decoder found, in file order.
@@ -69,7 +97,16 @@ pub enum Event<'a> {
         /// What was wrong.
         error: RecordError,
     },
-    /// Consecutive frames whose times go backwards.
+    /// A value the firmware cannot have written, dropped or replaced.
+    OutOfRange {
+        /// Sequence number of the block.
+        seq: u32,
+        /// What was out of range.
+        what: OutOfRange,
+    },
+    /// Consecutive frames whose time goes backwards, or forwards by more
+    /// than the frames known to be missing explain: the frames after it
+    /// are a new segment of the run.
     TimeJump {
         /// Time of the previous frame.
         from_us: u64,
@@ -102,8 +139,15 @@ pub struct DecodeStats {
     pub unknown_records: u64,
     /// Frames whose time went backwards.
     pub time_jumps: u64,
+    /// Frames whose time went forwards by more than missing frames explain.
+    pub forward_time_jumps: u64,
     /// Blocks whose sequence number did not follow (stale or reordered data).
     pub out_of_order_blocks: u64,
+    /// Of those, blocks skipped as repeats or stale copies (out of their
+    /// place in the file and not after the last block decoded).
+    pub repeated_blocks: u64,
+    /// Values the firmware cannot have written, dropped or replaced.
+    pub out_of_range: u64,
 }
 
 /// What the decoder remembers of the last valid block.
@@ -119,6 +163,11 @@ pub struct Decoder {
     stats: DecodeStats,
     last: Option<Last>,
     last_frame_us: Option<u64>,
+    /// Frames known to be missing since the last frame: in lost blocks or
+    /// reported dropped by the logger.
+    frames_missing: u64,
+    /// The frame period stated by the log info, µs (0: not yet known).
+    period_us: u64,
     /// Offset in the stream of the next byte the decoder will look at.
     offset: u64,
 }
@@ -152,12 +201,24 @@ impl Decoder {
         while chunk.len() - pos >= BLOCK_LEN {
             let block = as_block(&chunk[pos..]);
             match BlockHeader::parse(block) {
+                Ok(header) if self.is_repeat(&header, pos) => {
+                    self.stats.out_of_order_blocks += 1;
+                    self.stats.repeated_blocks += 1;
+                    if skip.is_some_and(|(_, c)| c != SkipCause::Repeated) {
+                        self.flush_skip(&mut skip, chunk, pos, visit);
+                    }
+                    skip.get_or_insert((pos, SkipCause::Repeated));
+                    pos += BLOCK_LEN;
+                }
                 Ok(header) => {
                     self.flush_skip(&mut skip, chunk, pos, visit);
                     self.block(&header, block, visit);
                     pos += BLOCK_LEN;
                 }
                 Err(err) => {
+                    if skip.is_some_and(|(_, c)| c == SkipCause::Repeated) {
+                        self.flush_skip(&mut skip, chunk, pos, visit);
+                    }
                     if skip.is_none() {
                         skip = Some((pos, cause_of(err)));
                         if err == BlockError::BadCrc {
@@ -211,18 +272,14 @@ impl Decoder {
         let mut records = Records::new(header.payload(block), header.t0_us);
         for item in records.by_ref() {
             match item {
-                Ok(record) => {
+                Ok(mut record) => {
                     self.stats.records += 1;
                     if let Record::Frame(f) = &record {
                         frames += 1;
-                        if let Some(prev) = self.last_frame_us.filter(|&p| f.t_us < p) {
-                            self.stats.time_jumps += 1;
-                            visit(Event::TimeJump {
-                                from_us: prev,
-                                to_us: f.t_us,
-                            });
-                        }
-                        self.last_frame_us = Some(f.t_us);
+                        self.check_time(f.t_us, visit);
+                    }
+                    if !self.check_values(header.seq, &mut record, visit) {
+                        continue;
                     }
                     visit(Event::Record(record));
                 }
@@ -241,6 +298,89 @@ impl Decoder {
             seq: header.seq,
             frames_end: header.first_frame.wrapping_add(frames),
         });
+    }
+
+    /// Whether a valid block at `pos` in the current chunk repeats or
+    /// predates what was decoded: not after the last block (and within
+    /// [`REPEAT_WINDOW_BLOCKS`] of it), and not at its own place in the file
+    /// (block `seq` sits at `seq` x 512; one there is always decoded).
+    fn is_repeat(&self, header: &BlockHeader, pos: usize) -> bool {
+        let at = self.offset + pos as u64;
+        let in_place = u64::from(header.seq) * BLOCK_LEN as u64 == at;
+        !in_place
+            && self.last.is_some_and(|last| {
+                header.seq <= last.seq && last.seq - header.seq < REPEAT_WINDOW_BLOCKS
+            })
+    }
+
+    /// Reports a frame at `t_us` that jumps back, or forward by more than
+    /// the frames known to be missing explain.
+    fn check_time<'c>(&mut self, t_us: u64, visit: &mut impl FnMut(Event<'c>)) {
+        if let Some(prev) = self.last_frame_us {
+            let period = if self.period_us == 0 {
+                1_000_000 / u64::from(DEFAULT_SAMPLE_RATE_HZ)
+            } else {
+                self.period_us
+            };
+            let explained = self
+                .frames_missing
+                .saturating_add(1)
+                .saturating_mul(period)
+                .saturating_add(TIME_JUMP_SLACK_US);
+            let jump = if t_us < prev {
+                self.stats.time_jumps += 1;
+                true
+            } else if t_us - prev > explained {
+                self.stats.forward_time_jumps += 1;
+                true
+            } else {
+                false
+            };
+            if jump {
+                visit(Event::TimeJump {
+                    from_us: prev,
+                    to_us: t_us,
+                });
+            }
+        }
+        self.last_frame_us = Some(t_us);
+        self.frames_missing = 0;
+    }
+
+    /// Drops or replaces values the firmware cannot have written, reporting
+    /// each; `false` when the whole record is dropped.
+    fn check_values<'c>(
+        &mut self,
+        seq: u32,
+        record: &mut Record<'c>,
+        visit: &mut impl FnMut(Event<'c>),
+    ) -> bool {
+        let what = match record {
+            Record::LogInfo(info) => {
+                let bad = (!info.sample_rate_is_valid()).then(|| {
+                    let stated = info.sample_rate_hz;
+                    info.sample_rate_hz = DEFAULT_SAMPLE_RATE_HZ;
+                    OutOfRange::SampleRate(stated)
+                });
+                self.period_us = 1_000_000 / u64::from(info.sample_rate_hz);
+                bad
+            }
+            Record::Gps(fix) => match fix.drop_out_of_range() {
+                0 => None,
+                n => Some(OutOfRange::GpsFields(n)),
+            },
+            Record::UtcSync(sync) if !sync.is_valid() => Some(OutOfRange::UtcSync),
+            Record::Dropout(d) => {
+                self.frames_missing = self.frames_missing.saturating_add(d.frames_lost.into());
+                None
+            }
+            _ => None,
+        };
+        if let Some(what) = what {
+            self.stats.out_of_range += 1;
+            visit(Event::OutOfRange { seq, what });
+        }
+        !matches!(what, Some(OutOfRange::UtcSync))
     }
 
     /// Compares a new block's header with the previous valid block's.
@@ -266,6 +406,7 @@ impl Decoder {
         };
         self.stats.blocks_lost += u64::from(gap.blocks);
         self.stats.frames_lost += u64::from(gap.frames);
+        self.frames_missing = self.frames_missing.saturating_add(gap.frames.into());
         visit(Event::Gap(gap));
     }
 }
