@@ -5,7 +5,7 @@
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use std::hint::black_box;
-use wobble_core::detector::{Detector, DetectorConfig};
+use wobble_core::config::Config;
 use wobble_hil::corpus;
 
 fn bench(c: &mut Criterion) {
@@ -18,7 +18,7 @@ fn bench(c: &mut Criterion) {
     g.throughput(Throughput::Elements(rows.len() as u64));
     g.bench_function("push_30s_fig6", |b| {
         b.iter(|| {
-            let Ok(mut det) = Detector::new(DetectorConfig::default()) else {
+            let Ok(mut det) = Config::default().detector() else {
                 return 0;
             };
             let mut n = 0;

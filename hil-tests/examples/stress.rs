@@ -8,15 +8,13 @@
 //! TRACE=ep5 T0=12 T1=14 ...          # per-hop estimates of one ride
 //! ```
 
-use wobble_core::detector::{DetectorConfig, Estimate};
+use wobble_core::detector::Estimate;
 use wobble_hil::corpus::{catalog, rng::Rng, signal, Fixture};
 use wobble_hil::metrics;
 
 fn main() -> Result<(), String> {
-    let mut c = DetectorConfig::default();
-    for spec in std::env::args().skip(1) {
-        metrics::override_config(&mut c, &spec)?;
-    }
+    let spec: Vec<String> = std::env::args().skip(1).collect();
+    let c = metrics::override_config(&spec.join(","))?;
     let use_speed = std::env::var_os("NOSPEED").is_none();
     let mut rides = Vec::new();
     let mut rng = Rng::new(999);
@@ -63,10 +61,10 @@ fn main() -> Result<(), String> {
                 println!("{}", metrics::trace_line(t, &e, on));
             }
         };
-        metrics::replay(&fx.rows()?, c, use_speed, Some(&mut print)).map_err(|e| e.to_string())?;
+        metrics::replay(&fx.rows()?, &c, use_speed, Some(&mut print)).map_err(|e| e.to_string())?;
         return Ok(());
     }
-    let r = metrics::evaluate(&fixtures, c, use_speed)?;
+    let r = metrics::evaluate(&fixtures, &c, use_speed)?;
     let mut lats = r.latencies_s();
     lats.sort_by(f64::total_cmp);
     println!(

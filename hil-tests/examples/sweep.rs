@@ -6,20 +6,19 @@
 //! NOSPEED=1 cargo run ...   # replay without the speed column
 //! ```
 
-use wobble_core::detector::DetectorConfig;
+use wobble_core::config::Config;
 use wobble_hil::{corpus, metrics};
 
 fn main() -> Result<(), String> {
     let fixtures = corpus::generate();
     let use_speed = std::env::var_os("NOSPEED").is_none();
-    let mut variants = vec![("default".to_owned(), DetectorConfig::default())];
+    let mut variants = vec![("default".to_owned(), Config::default())];
     for spec in std::env::args().skip(1) {
-        let mut c = DetectorConfig::default();
-        metrics::override_config(&mut c, &spec)?;
+        let c = metrics::override_config(&spec)?;
         variants.push((spec, c));
     }
     for (name, c) in variants {
-        let r = metrics::evaluate(&fixtures, c, use_speed)?;
+        let r = metrics::evaluate(&fixtures, &c, use_speed)?;
         let errors: Vec<String> = r
             .episodes
             .iter()

@@ -1,4 +1,4 @@
-//! Host-side test support of the wobble logger: the recorded-signal corpus
+//! Host-side test support of the wobble logger: the synthetic corpus
 //! (signal models, the deterministic generator and its ground truth) and the
 //! detector metrics that score the on-board detector against it.
 //!

@@ -13,7 +13,8 @@
 
 use std::fmt::Write as _;
 
-use wobble_core::detector::{AlertEvent, ConfigError, Detector, DetectorConfig, Estimate};
+use wobble_core::config::Config;
+use wobble_core::detector::{AlertEvent, ConfigError, Estimate};
 
 use crate::corpus::{Fixture, Row};
 
@@ -62,19 +63,20 @@ pub fn trace_line(t_s: f64, e: &Estimate, alert: bool) -> String {
     )
 }
 
-/// Replays `rows` through a fresh detector with `cfg`, giving it the speed
-/// column if `use_speed`; `trace`, if given, receives every analysis (time,
-/// estimate, alert state).
+/// Replays `rows` through a fresh detector as `config` sets it up (its
+/// detector settings on its wheel), giving it the speed column if
+/// `use_speed`; `trace`, if given, receives every analysis (time, estimate,
+/// alert state).
 ///
 /// # Errors
-/// When `cfg` is invalid.
+/// When `config` is invalid.
 pub fn replay(
     rows: &[Row],
-    cfg: DetectorConfig,
+    config: &Config,
     use_speed: bool,
     mut trace: Option<&mut dyn FnMut(f64, Estimate, bool)>,
 ) -> Result<Vec<AlertChange>, ConfigError> {
-    let mut det = Detector::new(cfg)?;
+    let mut det = config.detector()?;
     let mut out = Vec::new();
     for r in rows {
         let speed = use_speed.then_some(r.speed_mps);
@@ -158,7 +160,7 @@ pub struct Report {
     /// Per fixture.
     pub fixtures: Vec<FixtureScore>,
     /// The configuration measured.
-    pub config: DetectorConfig,
+    pub config: Config,
     /// Whether the detector was given the speed.
     pub use_speed: bool,
 }
@@ -280,8 +282,10 @@ pub fn markdown(with_speed: &Report, without_speed: &Report) -> String {
         s,
         "Written by `cargo run -p wobble-hil --release --bin detector-metrics`; \
          `hil-tests/tests/detector_corpus.rs` asserts the goals and that this file is current. \
-         Detector: `DetectorConfig::default()`. Corpus: `hil-tests/fixtures/corpus/manifest.json`. \
-         Definitions: `hil-tests/src/metrics.rs`.\n"
+         Detector: the firmware's complete default configuration, `Config::default()` \
+         (`DetectorConfig::default()` on the default wheel, {:.3} m). Corpus: `hil-tests/fixtures/corpus/manifest.json`. \
+         Definitions: `hil-tests/src/metrics.rs`.\n",
+        w.config.wheel.circumference_m
     );
     let _ = writeln!(s, "## Summary\n");
     let _ = writeln!(
@@ -332,7 +336,7 @@ pub fn markdown(with_speed: &Report, without_speed: &Report) -> String {
         w.wobble_fixture_false_alerts(),
         n.wobble_fixture_false_alerts()
     );
-    if let Ok(c) = w.config.cost() {
+    if let Ok(c) = w.config.detector.cost() {
         let _ = writeln!(
             s,
             "\nArithmetic per sample (analytical, `DetectorConfig::cost`): average {} mul + {} add, \
@@ -396,21 +400,17 @@ pub fn markdown(with_speed: &Report, without_speed: &Report) -> String {
     s
 }
 
-/// Runs the detector with `cfg` over every fixture and scores it; the
-/// detector gets the speed column if `use_speed` (as on the bike).
+/// Runs the detector as `config` sets it up over every fixture and scores
+/// it; the detector gets the speed column if `use_speed` (as on the bike).
 ///
 /// # Errors
-/// An invalid `cfg`, or a fixture whose CSV does not parse.
-pub fn evaluate(
-    fixtures: &[Fixture],
-    cfg: DetectorConfig,
-    use_speed: bool,
-) -> Result<Report, String> {
+/// An invalid `config`, or a fixture whose CSV does not parse.
+pub fn evaluate(fixtures: &[Fixture], config: &Config, use_speed: bool) -> Result<Report, String> {
     let mut episodes = Vec::new();
     let mut scores = Vec::new();
     for fx in fixtures {
         let rows = fx.rows()?;
-        let changes = replay(&rows, cfg, use_speed, None).map_err(|e| e.to_string())?;
+        let changes = replay(&rows, config, use_speed, None).map_err(|e| e.to_string())?;
         let truth = &fx.truth;
         let windows: Vec<(f64, f64)> = truth
             .episodes
@@ -482,56 +482,39 @@ pub fn evaluate(
     Ok(Report {
         episodes,
         fixtures: scores,
-        config: cfg,
+        config: *config,
         use_speed,
     })
 }
 
-/// Applies `key=value` overrides (comma-separated) to `cfg`, for the tuning
-/// examples (`examples/sweep.rs`, `examples/stress.rs`).
+/// The default configuration with `key=value` overrides (comma-separated),
+/// for the tuning examples (`examples/sweep.rs`, `examples/stress.rs`): any
+/// `CONFIG.TXT` key (`wheel.circumference_m=2.13`), and detector keys also
+/// without their `detector.` prefix (`amp_on_deg=0.45`). Read by the
+/// firmware's own config parser, so the examples know every key it knows.
 ///
 /// # Errors
-/// An unknown key or a value that is not a number.
-pub fn override_config(cfg: &mut DetectorConfig, spec: &str) -> Result<(), String> {
-    for kv in spec.split(',').filter(|s| !s.is_empty()) {
-        let (k, v) = kv
-            .split_once('=')
-            .ok_or_else(|| format!("{kv}: not key=value"))?;
-        let v: f32 = v.parse().map_err(|_| format!("{kv}: not a number"))?;
-        let field = match k {
-            "window_s" => &mut cfg.window_s,
-            "hop_s" => &mut cfg.hop_s,
-            "bin_lo_hz" => &mut cfg.bin_lo_hz,
-            "bin_hi_hz" => &mut cfg.bin_hi_hz,
-            "bin_spacing_hz" => &mut cfg.bin_spacing_hz,
-            "band_lo_hz" => &mut cfg.band_lo_hz,
-            "band_hi_hz" => &mut cfg.band_hi_hz,
-            "highpass_hz" => &mut cfg.highpass_hz,
-            "amp_on_deg" => &mut cfg.amp_on_deg,
-            "amp_off_deg" => &mut cfg.amp_off_deg,
-            "off_hold_s" => &mut cfg.off_hold_s,
-            "lookback_s" => &mut cfg.lookback_s,
-            "min_growth_ratio" => &mut cfg.min_growth_ratio,
-            "impulse_fast_s" => &mut cfg.impulse_fast_s,
-            "impulse_ref_s" => &mut cfg.impulse_ref_s,
-            "impulse_ratio" => &mut cfg.impulse_ratio,
-            "impulse_min_deg" => &mut cfg.impulse_min_deg,
-            "impulse_holdoff_s" => &mut cfg.impulse_holdoff_s,
-            "impulse_catchup" => &mut cfg.impulse_catchup,
-            "impulse_capture_s" => &mut cfg.impulse_capture_s,
-            "max_growth_ratio" => &mut cfg.max_growth_ratio,
-            "freq_window_s" => &mut cfg.freq_window_s,
-            "min_speed_mps" => &mut cfg.min_speed_mps,
-            "harmonic_tol_hz" => &mut cfg.harmonic_tol_hz,
-            "harmonic_growth_ratio" => &mut cfg.harmonic_growth_ratio,
-            "harmonic_tau_s" => &mut cfg.harmonic_tau_s,
-            "confirm_hops" => {
-                cfg.confirm_hops = v as u8;
-                continue;
+/// A line the parser reports (unknown key, bad value, rejected section).
+pub fn override_config(spec: &str) -> Result<Config, String> {
+    let text: Vec<String> = spec
+        .split(',')
+        .filter(|s| !s.is_empty())
+        .map(|kv| {
+            if kv.contains('.') {
+                kv.to_owned()
+            } else {
+                format!("detector.{kv}")
             }
-            _ => return Err(format!("{k}: unknown key")),
-        };
-        *field = v;
+        })
+        .collect();
+    let loaded = Config::parse(text.join("\n").as_bytes());
+    match loaded.faults.first().first() {
+        None => Ok(loaded.config),
+        Some(f) => Err(format!(
+            "{spec}: `{}` not used (config fault {})",
+            text.get(usize::from(f.line).saturating_sub(1))
+                .map_or("", String::as_str),
+            f.code
+        )),
     }
-    Ok(())
 }

@@ -1,10 +1,10 @@
-//! The detector against the recorded-signal corpus: the goals, the
+//! The detector against the synthetic corpus: the goals, the
 //! committed fixtures equal to the generator's output, and the metrics file
 //! current.
 
 use std::sync::OnceLock;
 
-use wobble_core::detector::DetectorConfig;
+use wobble_core::config::Config;
 use wobble_hil::corpus::{self, Fixture};
 use wobble_hil::metrics::{self, goals, FixtureScore, Report};
 
@@ -18,8 +18,7 @@ fn report(use_speed: bool) -> &'static Report {
     static WITHOUT: OnceLock<Report> = OnceLock::new();
     let cell = if use_speed { &WITH } else { &WITHOUT };
     cell.get_or_init(|| {
-        metrics::evaluate(fixtures(), DetectorConfig::default(), use_speed)
-            .expect("corpus evaluates")
+        metrics::evaluate(fixtures(), &Config::default(), use_speed).expect("corpus evaluates")
     })
 }
 
@@ -45,6 +44,21 @@ fn committed_fixtures_equal_the_generator() {
     }
     // Keep the repository small: the long rides are regenerated, not committed.
     assert!(committed < 3 << 20, "committed corpus is {committed} bytes");
+}
+
+/// One wheel: the corpus's wheel ripple turns with the firmware's wheel, the
+/// one its speed estimator and detector use.
+#[test]
+fn the_corpus_rides_the_firmware_wheel() {
+    let firmware_m = f64::from(Config::default().wheel.circumference_m);
+    assert_eq!(
+        corpus::manifest(fixtures()).wheel_circumference_m,
+        firmware_m
+    );
+    let committed =
+        std::fs::read_to_string(corpus::corpus_dir().join("manifest.json")).expect("manifest.json");
+    let committed: corpus::Manifest = serde_json::from_str(&committed).expect("manifest parses");
+    assert_eq!(committed.wheel_circumference_m, firmware_m);
 }
 
 #[test]

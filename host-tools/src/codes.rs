@@ -12,7 +12,8 @@ use wobble_core::boot::{
     FAULT_RESET_UNKNOWN, FAULT_RESET_WATCHDOG, FAULT_RESET_WINDOW_WATCHDOG,
 };
 use wobble_core::config::{
-    FAULT_BAD_VALUE, FAULT_REJECTED, FAULT_SYNTAX, FAULT_UNKNOWN_KEY, FAULT_UNREADABLE,
+    FAULT_BAD_VALUE, FAULT_OBSOLETE_KEY, FAULT_REJECTED, FAULT_SYNTAX, FAULT_UNKNOWN_KEY,
+    FAULT_UNREADABLE,
 };
 use wobble_core::format::{DropoutReason, FaultSource};
 use wobble_core::gps::{
@@ -21,7 +22,7 @@ use wobble_core::gps::{
 use wobble_core::logger::{FAULT_CARD_ABSENT, FAULT_CARD_FULL, FAULT_CARD_WRITE};
 
 /// Every fault code the firmware records: (source, code, meaning).
-pub const FAULT_MEANINGS: [(FaultSource, u8, &str); 28] = [
+pub const FAULT_MEANINGS: [(FaultSource, u8, &str); 29] = [
     (
         FaultSource::Imu,
         FAULT_IMU_NO_RESPONSE,
@@ -90,6 +91,11 @@ pub const FAULT_MEANINGS: [(FaultSource, u8, &str); 28] = [
         FaultSource::Config,
         FAULT_UNREADABLE,
         "unreadable bytes or a file too long",
+    ),
+    (
+        FaultSource::Config,
+        FAULT_OBSOLETE_KEY,
+        "obsolete key, skipped: `detector.wheel_circumference_m` (the detector uses `wheel.circumference_m`)",
     ),
     (
         FaultSource::System,

@@ -21,7 +21,9 @@ use core::fmt;
 
 use embedded_sdmmc::{BlockDevice, Mode, TimeSource, VolumeIdx, VolumeManager};
 
-use crate::detector::{DetectorConfig, PatternConfig};
+use crate::detector::{
+    ConfigError as DetectorConfigError, Detector, DetectorConfig, PatternConfig,
+};
 use crate::format::{Fault, FaultSource};
 use crate::imu::{AxisMap, Imu, ImuConfig, SignedAxis};
 use crate::steering::{CalPoint, Steering, SteeringCalibration};
@@ -40,8 +42,13 @@ pub const FAULT_REJECTED: u8 = 4;
 /// Fault code: a line that is not UTF-8, or the part of a file too long to
 /// be read.
 pub const FAULT_UNREADABLE: u8 = 5;
+/// Fault code: a key of an older firmware whose value now comes from another
+/// key; the line is skipped. `detector.wheel_circumference_m`: the detector
+/// places the wheel's harmonics with `wheel.circumference_m`, the wheel the
+/// speed is measured with.
+pub const FAULT_OBSOLETE_KEY: u8 = 6;
 /// Number of config fault codes (`1..=FAULT_CODES`).
-pub const FAULT_CODES: usize = 5;
+pub const FAULT_CODES: usize = 6;
 
 /// The file's name in the card's root directory.
 pub const FILE_NAME: &str = "CONFIG.TXT";
@@ -547,7 +554,6 @@ const KEYS: &[Key] = &[
     key!(Detector: detector.max_growth_ratio),
     key!(Detector: detector.freq_window_s),
     key!(Detector: detector.min_speed_mps),
-    key!(Detector: detector.wheel_circumference_m),
     key!(Detector: detector.harmonic_tol_hz),
     key!(Detector: detector.harmonic_growth_ratio),
     key!(Alert: alert.enabled),
@@ -559,24 +565,18 @@ const KEYS: &[Key] = &[
 /// Number of `key=value` lines [`Config::write_lines`] produces.
 pub const KEY_COUNT: usize = KEYS.len();
 
-const WHEEL_CIRCUMFERENCE_KEY: &str = "wheel.circumference_m";
-const DETECTOR_CIRCUMFERENCE_KEY: &str = "detector.wheel_circumference_m";
+/// Keys of older firmware that are skipped with [`FAULT_OBSOLETE_KEY`].
+const OBSOLETE_KEYS: [&str; 1] = ["detector.wheel_circumference_m"];
 
 impl Config {
     /// Reads a `CONFIG.TXT`. Never fails: what cannot be used is reported in
     /// [`Loaded::faults`] and replaced by defaults.
-    ///
-    /// Setting `wheel.circumference_m` alone also sets
-    /// `detector.wheel_circumference_m` (the detector places the wheel's
-    /// harmonics with it); a file may still set the two apart.
     #[must_use]
     pub fn parse(text: &[u8]) -> Loaded {
         let mut config = Self::default();
         let mut faults = ConfigFaults::default();
         // Per section, the last line that set one of its keys (for reports).
         let mut touched: [Option<u16>; SECTIONS.len()] = [None; SECTIONS.len()];
-        let mut detector_circumference_given = false;
-        let mut wheel_circumference_given = false;
         for (index, raw) in text.split(|&b| b == b'\n').enumerate() {
             let line_no = u16::try_from(index + 1).unwrap_or(u16::MAX);
             let Ok(line) = core::str::from_utf8(raw) else {
@@ -600,7 +600,12 @@ impl Config {
                 continue;
             }
             let Some(key) = KEYS.iter().find(|k| k.name == name) else {
-                faults.push(line_no, FAULT_UNKNOWN_KEY);
+                let code = if OBSOLETE_KEYS.contains(&name) {
+                    FAULT_OBSOLETE_KEY
+                } else {
+                    FAULT_UNKNOWN_KEY
+                };
+                faults.push(line_no, code);
                 continue;
             };
             if !key.apply(&mut config, value) {
@@ -608,11 +613,6 @@ impl Config {
                 continue;
             }
             touched[key.section as usize] = Some(line_no);
-            wheel_circumference_given |= name == WHEEL_CIRCUMFERENCE_KEY;
-            detector_circumference_given |= name == DETECTOR_CIRCUMFERENCE_KEY;
-        }
-        if wheel_circumference_given && !detector_circumference_given {
-            config.detector.wheel_circumference_m = config.wheel.circumference_m;
         }
         for (rules, line) in SECTIONS.iter().zip(touched) {
             if !(rules.valid)(&config) {
@@ -621,6 +621,16 @@ impl Config {
             }
         }
         Loaded { config, faults }
+    }
+
+    /// The wobble detector this configuration runs: its detector settings on
+    /// its wheel, the one the speed is measured with.
+    ///
+    /// # Errors
+    /// When the detector settings or the circumference are out of range
+    /// (never for a configuration from [`Config::parse`]).
+    pub fn detector(&self) -> Result<Detector, DetectorConfigError> {
+        Detector::new(self.detector, self.wheel.circumference_m)
     }
 
     /// Writes the configuration as `key=value` lines, each ending in `\n`,
@@ -817,7 +827,7 @@ mod tests {
         assert!(loaded.faults.is_empty(), "{:?}", loaded.faults);
         let c = loaded.config;
         assert_eq!(c.wheel.circumference_m, 2.05);
-        assert_eq!(c.detector.wheel_circumference_m, 2.05);
+        assert_eq!(c.detector().unwrap().wheel_circumference_m(), 2.05);
         assert_eq!(c.detector.amp_on_deg, 0.6);
         assert!(!c.alert.enabled);
         assert_eq!(c.wheel.holes, WheelConfig::DEFAULT.holes);
@@ -931,6 +941,40 @@ steering.three_point=1:2,3
 ",
         );
         assert_eq!(garbled.faults.count(FAULT_BAD_VALUE), 2);
+    }
+
+    #[test]
+    fn an_old_second_circumference_is_a_counted_fault_and_the_wheel_wins() {
+        for text in [
+            &b"detector.wheel_circumference_m=2.13\nwheel.circumference_m=2.2\n"[..],
+            &b"wheel.circumference_m=2.2\ndetector.wheel_circumference_m=2.13\n"[..],
+        ] {
+            let loaded = Config::parse(text);
+            assert_eq!(loaded.faults.count(FAULT_OBSOLETE_KEY), 1);
+            assert_eq!(loaded.faults.count(FAULT_UNKNOWN_KEY), 0);
+            assert_eq!(loaded.config.wheel.circumference_m, 2.2);
+            let detector = loaded.config.detector().expect("valid");
+            assert_eq!(detector.wheel_circumference_m(), 2.2);
+        }
+        // Alone it leaves the default wheel for both.
+        let alone = Config::parse(b"detector.wheel_circumference_m=2.13\n");
+        assert_eq!(
+            alone.faults.first(),
+            [LineFault {
+                line: 1,
+                code: FAULT_OBSOLETE_KEY
+            }]
+        );
+        assert_eq!(alone.config, Config::default());
+        assert_eq!(
+            alone
+                .config
+                .detector()
+                .expect("valid")
+                .wheel_circumference_m(),
+            WheelConfig::DEFAULT.circumference_m
+        );
+        assert!(!text_of(&alone.config).contains("detector.wheel_circumference_m"));
     }
 
     #[test]

@@ -95,13 +95,8 @@ proptest! {
             .map(|(a, _)| a.to_owned())
             .collect();
         if loaded.faults.is_empty() {
-            // The key itself changed (or kept its value); nothing else did,
-            // except the detector following the wheel's circumference.
-            let allowed = |l: &String| {
-                l.starts_with(&format!("{key}="))
-                    || (key == "wheel.circumference_m"
-                        && l.starts_with("detector.wheel_circumference_m="))
-            };
+            // The key itself changed (or kept its value); nothing else did.
+            let allowed = |l: &String| l.starts_with(&format!("{key}="));
             prop_assert!(changed.iter().all(allowed), "{changed:?}");
             let expected = format!("{key}={new_value}");
             prop_assert!(in_force.lines().any(|l| l == expected), "{expected} not in force");

@@ -3,15 +3,21 @@
 //! numerical stability over hours.
 
 use proptest::prelude::*;
+use wobble_core::config::Config;
 use wobble_core::detector::{
     AlertEvent, AlertOutput, AlertPattern, Detector, DetectorConfig, PatternConfig,
 };
+use wobble_core::wheel::WheelConfig;
 
 const FS: f32 = 100.0;
 const TAU: f32 = core::f32::consts::TAU;
 
+/// The firmware's detector: its complete default configuration (the
+/// detector on the default wheel).
 fn detector() -> Detector {
-    Detector::new(DetectorConfig::default()).expect("default config is valid")
+    Config::default()
+        .detector()
+        .expect("default config is valid")
 }
 
 /// Runs `signal(t)` for `secs` at constant `speed`; returns the alert events
@@ -171,7 +177,7 @@ proptest! {
             lookback_s, harmonic_tau_s: tau, freq_window_s: window_s.max(0.64),
             ..DetectorConfig::default()
         };
-        if let Ok(mut d) = Detector::new(cfg) {
+        if let Ok(mut d) = Detector::new(cfg, WheelConfig::DEFAULT.circumference_m) {
             for i in 0..500 {
                 d.push((i as f32 * 0.7).sin() * 3.0, Some(4.0));
             }
@@ -235,7 +241,7 @@ impl AlertOutput for Recorder {
 #[test]
 fn hours_of_running_do_not_drift() {
     let speed = 4.0;
-    let wheel_hz = speed / DetectorConfig::default().wheel_circumference_m;
+    let wheel_hz = speed / WheelConfig::DEFAULT.circumference_m;
     let signal = |i: u64| {
         let t = (i % 360_000) as f32 / FS; // keep f32 phases accurate
         3.0 * (TAU * 0.65 * t).sin()

@@ -8,7 +8,8 @@ use wobble_core::app::sampler::{
     Inputs, Sampler, FAULT_IMU_BAD_SAMPLE, FAULT_IMU_NO_RESPONSE, FAULT_INTERVAL_US,
     FAULT_STEER_OVERRUN, FAULT_STEER_READ, FRAME_PERIOD_US,
 };
-use wobble_core::detector::{AlertEvent, AlertOutput, Detector, DetectorConfig, PatternConfig};
+use wobble_core::config::Config;
+use wobble_core::detector::{AlertEvent, AlertOutput, PatternConfig};
 use wobble_core::format::{Fault, FaultSource, Frame, FrameStatus, Record};
 use wobble_core::frame_assembly::{FrameAssembler, FrameConfig, TickInputs};
 use wobble_core::wheel::{WheelConfig, WheelSpeed};
@@ -36,7 +37,7 @@ fn sampler() -> Sampler {
     Sampler::new(
         WheelSpeed::try_new(WheelConfig::DEFAULT).expect("default wheel"),
         FrameConfig::DEFAULT,
-        Detector::new(DetectorConfig::default()).expect("default detector"),
+        Config::default().detector().expect("default detector"),
         PatternConfig::DEFAULT,
     )
 }

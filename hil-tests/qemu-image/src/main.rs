@@ -24,7 +24,6 @@ use wobble_core::app::sampler::{Sampler, SamplerPorts};
 use wobble_core::app::{gps, sampler, writer};
 use wobble_core::channels::{RecordQueue, SharedStatus};
 use wobble_core::config::{Config, KEY_COUNT, MAX_TEXT_LEN};
-use wobble_core::detector::Detector;
 use wobble_core::frame_assembly::FrameConfig;
 use wobble_core::gps::{GpsConfig, GpsReceiver};
 use wobble_core::logger::{
@@ -95,10 +94,7 @@ impl StatusLed for StatusLine {
 #[embassy_executor::task]
 async fn sampler_task(ride: &'static RefCell<Ride>, frames: u32) {
     let config = config();
-    let (Ok(wheel), Ok(detector)) = (
-        WheelSpeed::try_new(config.wheel),
-        Detector::new(config.detector),
-    ) else {
+    let (Ok(wheel), Ok(detector)) = (WheelSpeed::try_new(config.wheel), config.detector()) else {
         report::line(format_args!("FATAL default configuration rejected"));
         semihosting::process::exit(2)
     };
@@ -200,7 +196,7 @@ fn bench_detector(ride: &mut Ride) -> ! {
             break;
         }
     }
-    let Ok(mut detector) = Detector::new(config().detector) else {
+    let Ok(mut detector) = config().detector() else {
         report::line(format_args!("FATAL default configuration rejected"));
         semihosting::process::exit(2)
     };

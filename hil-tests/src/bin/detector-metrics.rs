@@ -12,7 +12,7 @@
 
 use std::process::ExitCode;
 
-use wobble_core::detector::DetectorConfig;
+use wobble_core::config::Config;
 use wobble_hil::{corpus, metrics};
 
 fn main() -> ExitCode {
@@ -38,7 +38,7 @@ fn main() -> ExitCode {
         let mut print = |t: f64, e: wobble_core::detector::Estimate, on: bool| {
             println!("{}", metrics::trace_line(t, &e, on));
         };
-        return match metrics::replay(&rows, DetectorConfig::default(), true, Some(&mut print)) {
+        return match metrics::replay(&rows, &Config::default(), true, Some(&mut print)) {
             Ok(_) => ExitCode::SUCCESS,
             Err(e) => {
                 eprintln!("detector-metrics: {e}");
@@ -47,8 +47,8 @@ fn main() -> ExitCode {
         };
     }
     let (report, no_speed) = match (
-        metrics::evaluate(&fixtures, DetectorConfig::default(), true),
-        metrics::evaluate(&fixtures, DetectorConfig::default(), false),
+        metrics::evaluate(&fixtures, &Config::default(), true),
+        metrics::evaluate(&fixtures, &Config::default(), false),
     ) {
         (Ok(a), Ok(b)) => (a, b),
         (Err(e), _) | (_, Err(e)) => {

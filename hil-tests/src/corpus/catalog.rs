@@ -125,14 +125,14 @@ fn wobble_rides() -> Vec<Ride> {
     r.wobble(WobbleSpec::growing(12.0, 6.4, 1.5, 3.0));
     v.push(r);
 
-    // A wobble on top of a wheel harmonic: at 5 m/s the wheel turns at
-    // 2.35 Hz and its 3rd harmonic sits at 7.04 Hz.
+    // A wobble on top of a wheel harmonic: at 5.1 m/s the firmware's wheel
+    // (2.18 m) turns at 2.34 Hz and its 3rd harmonic sits at 7.02 Hz.
     let mut r = cruise(
         "wobble_on_harmonic",
-        "7.0 Hz wobble growing at 1.5/s at 5 m/s, on the wheel's 3rd harmonic (7.04 Hz)",
+        "7.0 Hz wobble growing at 1.5/s at 5.1 m/s, on the wheel's 3rd harmonic (7.02 Hz)",
         32,
         30.0,
-        5.0,
+        5.1,
     );
     r.wobble(WobbleSpec::growing(12.0, 7.0, 1.5, 3.0));
     v.push(r);

@@ -1,4 +1,4 @@
-//! The recorded-signal corpus: deterministic signal models of a ride's
+//! The synthetic corpus: deterministic signal models of a ride's
 //! steering angle and speed, the catalogue of fixtures made from them, and
 //! their ground truth.
 //!

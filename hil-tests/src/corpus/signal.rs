@@ -9,14 +9,17 @@
 use super::rng::Rng;
 use super::truth::{Episode, Event, FixtureTruth};
 use libm::{cos, exp, log, sin};
+use wobble_core::wheel::WheelConfig;
 
 use core::f64::consts::{PI, TAU};
 
 /// Sample rate of every fixture.
 pub const FS_HZ: f64 = 100.0;
-/// Wheel rolling circumference (28" wheel): 4 m/s turns it at 1.88 Hz, putting
-/// the 3rd and 4th harmonics at 5.6 and 7.5 Hz as in the issue.
-pub const WHEEL_CIRCUMFERENCE_M: f64 = 2.13;
+/// Wheel rolling circumference: the firmware's default wheel (28", 2.18 m),
+/// the one its wheel-speed estimator and detector use. 4 m/s turns it at
+/// 1.83 Hz, putting the 3rd and 4th harmonics at 5.5 and 7.3 Hz, inside the
+/// wobble band.
+pub const WHEEL_CIRCUMFERENCE_M: f64 = WheelConfig::DEFAULT.circumference_m as f64;
 /// Steering ADC resolution.
 pub const ADC_BITS: u32 = 12;
 /// Steering angle span of the ADC's full scale (+-60 degrees): 0.029 deg/LSB.

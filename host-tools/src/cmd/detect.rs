@@ -4,7 +4,8 @@
 use std::io::{self, Read};
 use std::path::{Path, PathBuf};
 
-use wobble_core::detector::{AlertEvent, Detector, DetectorConfig};
+use wobble_core::config::Config;
+use wobble_core::detector::AlertEvent;
 
 use crate::csv_input::{number_in, Cell, Step, TimeSteps};
 use crate::CliError;
@@ -67,14 +68,17 @@ pub struct Replay {
     pub restarts: Vec<u64>,
 }
 
-/// Replays CSV text from `input` through a fresh detector with `cfg`.
-/// `path` only names the input in errors.
+/// Replays CSV text from `input` through a fresh detector as `config` sets it
+/// up (its detector settings on its wheel). `path` only names the input in
+/// errors.
 ///
 /// # Errors
 /// [`CliError::File`] naming `path`, the line and the problem.
-pub fn replay(path: &Path, input: impl Read, cfg: DetectorConfig) -> Result<Replay, CliError> {
-    let cfg_rate_hz = cfg.sample_rate_hz;
-    let mut det = Detector::new(cfg).map_err(|e| CliError::Usage(format!("detector: {e}")))?;
+pub fn replay(path: &Path, input: impl Read, config: &Config) -> Result<Replay, CliError> {
+    let cfg_rate_hz = config.detector.sample_rate_hz;
+    let mut det = config
+        .detector()
+        .map_err(|e| CliError::Usage(format!("detector: {e}")))?;
     let mut reader = csv::ReaderBuilder::new()
         .has_headers(true)
         .flexible(true)
@@ -255,11 +259,7 @@ pub fn table(r: &Replay) -> String {
 /// Runs `wobblog detect`.
 pub fn run(args: &Args) -> Result<(), CliError> {
     let file = std::fs::File::open(&args.csv).map_err(|e| CliError::file(&args.csv, e))?;
-    let r = replay(
-        &args.csv,
-        io::BufReader::new(file),
-        DetectorConfig::default(),
-    )?;
+    let r = replay(&args.csv, io::BufReader::new(file), &Config::default())?;
     for line in &r.restarts {
         eprintln!(
             "wobblog: {}: line {line}: time gap; detector restarted",
@@ -284,11 +284,7 @@ mod tests {
     use super::*;
 
     fn run_text(text: &str) -> Result<Replay, CliError> {
-        replay(
-            Path::new("x.csv"),
-            text.as_bytes(),
-            DetectorConfig::default(),
-        )
+        replay(Path::new("x.csv"), text.as_bytes(), &Config::default())
     }
 
     fn message(e: CliError) -> String {

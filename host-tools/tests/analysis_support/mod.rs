@@ -32,7 +32,7 @@ pub fn stdout_of(cmd: &mut Command) -> String {
     String::from_utf8(out.stdout).unwrap()
 }
 
-/// The recorded-signal corpus: `hil-tests/fixtures/corpus`, or the
+/// The synthetic corpus: `hil-tests/fixtures/corpus`, or the
 /// directory `CORPUS_DIR` names (e.g. a freshly generated one).
 #[must_use]
 pub fn corpus_dir() -> std::path::PathBuf {

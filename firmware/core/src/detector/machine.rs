@@ -115,6 +115,7 @@ impl History {
 #[derive(Clone, Debug)]
 pub struct Detector {
     cfg: DetectorConfig,
+    wheel_circumference_m: f32,
     p: Params,
     hpf: HighPass4,
     canceller: Option<HarmonicCanceller>,
@@ -175,16 +176,24 @@ const RIPPLE_CEILING: f32 = 2.0;
 const INPUT_LIMIT_DEG: f32 = 1000.0;
 
 impl Detector {
-    /// A detector with configuration `cfg`.
+    /// A detector with configuration `cfg` on a wheel of rolling
+    /// circumference `wheel_circumference_m`, which places the wheel-rotation
+    /// harmonics. Pass the wheel-speed estimator's own
+    /// ([`crate::wheel::WheelConfig::circumference_m`]; [`crate::config::Config::detector`]
+    /// does): a second value would put every harmonic where the wheel is not.
     ///
     /// # Errors
-    /// When `cfg` is out of range (see [`ConfigError`]).
-    pub fn new(cfg: DetectorConfig) -> Result<Self, ConfigError> {
+    /// When `cfg` or the circumference is out of range (see [`ConfigError`]).
+    pub fn new(cfg: DetectorConfig, wheel_circumference_m: f32) -> Result<Self, ConfigError> {
         let p = Params::new(&cfg)?;
+        if !(wheel_circumference_m.is_finite() && wheel_circumference_m > 0.0) {
+            return Err(ConfigError::Circumference);
+        }
         let (window, amp_scale) = hann(p.window_len);
         let (freq_window, freq_amp_scale) = hann(p.freq_window_len);
         Ok(Self {
             cfg,
+            wheel_circumference_m,
             p,
             hpf: HighPass4::new(cfg.highpass_hz, cfg.sample_rate_hz),
             canceller: (cfg.harmonic_tau_s > 0.0).then(|| {
@@ -192,7 +201,7 @@ impl Detector {
                     cfg.bin_lo_hz - 1.0,
                     cfg.bin_hi_hz + 1.0,
                     cfg.harmonic_tau_s,
-                    cfg.wheel_circumference_m,
+                    wheel_circumference_m,
                     cfg.min_speed_mps,
                     cfg.sample_rate_hz,
                 )
@@ -231,10 +240,16 @@ impl Detector {
         &self.cfg
     }
 
+    /// The wheel circumference the harmonics are placed with, metres.
+    #[must_use]
+    pub fn wheel_circumference_m(&self) -> f32 {
+        self.wheel_circumference_m
+    }
+
     /// Forgets everything (as after power-up), keeping the configuration.
     pub fn reset(&mut self) {
-        // `new` cannot fail: `self.cfg` was validated when `self` was built.
-        if let Ok(fresh) = Self::new(self.cfg) {
+        // `new` cannot fail: both values were validated when `self` was built.
+        if let Ok(fresh) = Self::new(self.cfg, self.wheel_circumference_m) {
             *self = fresh;
         }
     }
@@ -404,7 +419,7 @@ impl Detector {
             self.holdoff_left > 0 && amp_deg < self.cfg.impulse_catchup * self.impulse_peak_deg;
 
         let at_wheel_harmonic = speed_mps.is_some_and(|v| {
-            let f_wheel = v / self.cfg.wheel_circumference_m;
+            let f_wheel = v / self.wheel_circumference_m;
             if f_wheel <= 0.0 {
                 return false;
             }
@@ -491,7 +506,11 @@ mod tests {
     const TAU: f32 = core::f32::consts::TAU;
 
     fn detector() -> Detector {
-        Detector::new(DetectorConfig::default()).unwrap()
+        Detector::new(
+            DetectorConfig::default(),
+            crate::wheel::WheelConfig::DEFAULT.circumference_m,
+        )
+        .unwrap()
     }
 
     #[test]

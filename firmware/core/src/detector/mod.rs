@@ -110,8 +110,6 @@ pub struct DetectorConfig {
     pub freq_window_s: f32,
     /// Below this wheel speed (when speed is known) the alert stays off.
     pub min_speed_mps: f32,
-    /// Wheel rolling circumference, to place the wheel-rotation harmonics.
-    pub wheel_circumference_m: f32,
     /// A dominant frequency this close to a wheel harmonic counts as one.
     pub harmonic_tol_hz: f32,
     /// At a wheel harmonic (speed known) and below twice `amp_on_deg`, the
@@ -152,7 +150,6 @@ impl DetectorConfig {
         max_growth_ratio: 2.7,
         freq_window_s: 0.64,
         min_speed_mps: 1.5,
-        wheel_circumference_m: 2.13,
         harmonic_tol_hz: 0.20,
         harmonic_growth_ratio: 1.05,
         harmonic_tau_s: 3.0,
@@ -287,6 +284,9 @@ pub enum ConfigError {
     History,
     /// A value is NaN or infinite.
     NotFinite,
+    /// The wheel circumference (which places the wheel-rotation harmonics)
+    /// is not a positive finite number.
+    Circumference,
 }
 
 impl core::fmt::Display for ConfigError {
@@ -299,6 +299,7 @@ impl core::fmt::Display for ConfigError {
             Self::Thresholds => "amp_off_deg must be below amp_on_deg, thresholds non-negative",
             Self::History => "look-back and impulse spans must be 1 to 32 hops",
             Self::NotFinite => "a value is NaN or infinite",
+            Self::Circumference => "wheel circumference must be a positive number of metres",
         })
     }
 }
@@ -357,7 +358,6 @@ impl Params {
             c.max_growth_ratio,
             c.freq_window_s,
             c.min_speed_mps,
-            c.wheel_circumference_m,
             c.harmonic_tol_hz,
             c.harmonic_growth_ratio,
             c.harmonic_tau_s,
@@ -408,9 +408,6 @@ impl Params {
             c.harmonic_tau_s,
         ];
         if c.amp_off_deg >= c.amp_on_deg || non_negative.iter().any(|&v| v < 0.0) {
-            return Err(ConfigError::Thresholds);
-        }
-        if c.wheel_circumference_m <= 0.0 {
             return Err(ConfigError::Thresholds);
         }
         let hop_s = hop as f32 / fs;
