@@ -43,6 +43,8 @@ enum Command {
     /// The linear bicycle models: eigenvalues against speed, plots, parameter studies, fits.
     #[command(subcommand)]
     Model(cmd::model::Command),
+    /// Print the logger's field self-test report (SELFTEST.TXT from the card).
+    Selftest(cmd::selftest::Args),
     /// Print a shell completion script (bash, zsh, fish, ...).
     Completions(cmd::completions::Args),
     /// Print the man page (roff) of wobblog.
@@ -67,6 +69,7 @@ pub fn main() -> ExitCode {
         Command::Gpx(args) => cmd::gpx::run(&args),
         Command::Summary(args) => cmd::summary::run(&args),
         Command::Model(command) => cmd::model::run(&command),
+        Command::Selftest(args) => cmd::selftest::run(&args),
         Command::Completions(args) => cmd::completions::run(&args),
         Command::Man => cmd::completions::man(),
     };

@@ -12,5 +12,6 @@ pub mod logs;
 pub mod model;
 pub mod nmea;
 pub mod plot;
+pub mod selftest;
 pub mod summary;
 pub mod wobble;
