@@ -6,6 +6,7 @@ pub mod decode;
 pub mod detect;
 pub mod encode;
 pub mod events;
+pub mod export;
 pub mod gpx;
 pub mod info;
 pub mod logs;
