@@ -10,11 +10,7 @@
 #![no_std]
 #![no_main]
 
-mod adapters;
-mod clocks;
-mod pins;
-mod startup;
-mod watchdog;
+use wobble_stm32f405::{adapters, clocks, pins, startup, watchdog};
 
 use cortex_m_rt::entry;
 use embassy_executor::{Executor, InterruptExecutor};
@@ -47,13 +43,13 @@ use wobble_core::steering::Steering;
 use wobble_core::wheel::WheelSpeed;
 use {defmt_rtt as _, panic_probe as _};
 
-use adapters::card::SdCard;
-use adapters::gps::GpsAdapter;
-use adapters::imu::ImuAdapter;
-use adapters::rider::{AlertPins, MarkerButton, StatusLight};
-use adapters::steering::{SteeringAdapter, DMA_SAMPLES};
-use adapters::wheel::WheelAdapter;
-use pins::{Board, Irqs};
+use wobble_stm32f405::adapters::card::SdCard;
+use wobble_stm32f405::adapters::gps::GpsAdapter;
+use wobble_stm32f405::adapters::imu::ImuAdapter;
+use wobble_stm32f405::adapters::rider::{AlertPins, MarkerButton, StatusLight};
+use wobble_stm32f405::adapters::steering::{SteeringAdapter, DMA_SAMPLES};
+use wobble_stm32f405::adapters::wheel::WheelAdapter;
+use wobble_stm32f405::pins::{Board, Irqs};
 
 /// Records from the sampler and the GPS task to the SD writer.
 static QUEUE: RecordQueue = RecordQueue::new();
@@ -130,8 +126,29 @@ fn main() -> ! {
         startup::blink_code(&mut led, code);
     }
 
+    let selftest = marker_held(&mut board);
     let (card, loaded) = card_and_config(board.card);
     let config = loaded.config;
+    if selftest {
+        let _wheel_timer = adapters::wheel::start(board.wheel);
+        let (_, ports) = sampler_parts(board.imu, board.steering, board.rider, &config);
+        let (gps_tx, gps_rx) = gps_uart(board.gps);
+        let parts = wobble_stm32f405::selftest::Parts {
+            imu: ports.imu,
+            steering: ports.steering,
+            wheel: ports.wheel,
+            gps: GpsAdapter::new(gps_tx, gps_rx),
+            card,
+            buzzer: ports.alert.buzzer,
+            alert_led: ports.alert.led,
+            status_led: ports.status_led.led,
+            crystal,
+            reset,
+        };
+        EXECUTOR_THREAD.init(Executor::new()).run(move |thread| {
+            thread.spawn(defmt::unwrap!(selftest_task(parts)));
+        })
+    }
     let t_us = Instant::now().as_micros();
     for fault in loaded.faults.records(t_us) {
         QUEUE.push(Record::Fault(fault));
@@ -160,6 +177,15 @@ fn main() -> ! {
         thread.spawn(defmt::unwrap!(writer_task(logger)));
         thread.spawn(defmt::unwrap!(watchdog_task(watchdog)));
     })
+}
+
+/// Whether the marker button is held at power-on: the rider asks for the
+/// field self-test instead of a ride.
+fn marker_held(board: &mut Board) -> bool {
+    let button = Input::new(board.rider.marker.reborrow(), Pull::Up);
+    // Let the pull-up charge the line before reading it.
+    embassy_time::block_for(embassy_time::Duration::from_millis(20));
+    button.is_low()
 }
 
 /// Opens the card and reads `CONFIG.TXT` (defaults without a card).
@@ -316,6 +342,11 @@ async fn gps_task(tx: UartTx<'static, Async>, rx: RingBufferedUartRx<'static>) {
     }
     let mut receiver = GpsReceiver::new(GpsConfig::default());
     gps::run(&mut port, &mut receiver, &QUEUE, &SHARED).await;
+}
+
+#[embassy_executor::task]
+async fn selftest_task(parts: wobble_stm32f405::selftest::Parts) {
+    wobble_stm32f405::selftest::run(parts).await
 }
 
 #[embassy_executor::task]
