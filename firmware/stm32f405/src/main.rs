@@ -18,11 +18,9 @@ use embassy_stm32::adc::{Adc, AdcChannel, Exten, RingBufferedAdc, SampleTime, CO
 use embassy_stm32::gpio::{Input, Level, Output, Pull, Speed};
 use embassy_stm32::interrupt;
 use embassy_stm32::interrupt::{InterruptExt, Priority};
-use embassy_stm32::mode::Async;
 use embassy_stm32::peripherals::{ADC1, IWDG};
 use embassy_stm32::spi::Spi;
 use embassy_stm32::time::Hertz;
-use embassy_stm32::usart::{self, RingBufferedUartRx, Uart, UartTx};
 use embassy_stm32::Peri;
 use embassy_time::{Delay, Instant};
 use embedded_hal_bus::spi::ExclusiveDevice;
@@ -132,12 +130,11 @@ fn main() -> ! {
     if selftest {
         let _wheel_timer = adapters::wheel::start(board.wheel);
         let (_, ports) = sampler_parts(board.imu, board.steering, board.rider, &config);
-        let (gps_tx, gps_rx) = gps_uart(board.gps);
         let parts = wobble_stm32f405::selftest::Parts {
             imu: ports.imu,
             steering: ports.steering,
             wheel: ports.wheel,
-            gps: GpsAdapter::new(gps_tx, gps_rx),
+            gps: GpsAdapter::new(board.gps, GPS_RING.init([0; adapters::gps::RING_BYTES])),
             card,
             buzzer: ports.alert.buzzer,
             alert_led: ports.alert.led,
@@ -162,7 +159,7 @@ fn main() -> ! {
 
     let _wheel_timer = adapters::wheel::start(board.wheel);
     let (sampler, ports) = sampler_parts(board.imu, board.steering, board.rider, &config);
-    let (gps_tx, gps_rx) = gps_uart(board.gps);
+    let gps_port = GpsAdapter::new(board.gps, GPS_RING.init([0; adapters::gps::RING_BYTES]));
 
     interrupt::UART4.set_priority(Priority::P6);
     let high = EXECUTOR_HIGH.start(interrupt::UART4);
@@ -170,7 +167,7 @@ fn main() -> ! {
 
     interrupt::UART5.set_priority(Priority::P7);
     let medium = EXECUTOR_MEDIUM.start(interrupt::UART5);
-    medium.spawn(defmt::unwrap!(gps_task(gps_tx, gps_rx)));
+    medium.spawn(defmt::unwrap!(gps_task(gps_port)));
 
     let watchdog = board.watchdog;
     EXECUTOR_THREAD.init(Executor::new()).run(move |thread| {
@@ -290,27 +287,6 @@ fn steering_adc(
     )
 }
 
-/// USART2 at the receivers' usual power-up rate; the GPS task finds theirs.
-fn gps_uart(pins: pins::GpsPins) -> (UartTx<'static, Async>, RingBufferedUartRx<'static>) {
-    let mut config = usart::Config::default();
-    config.baudrate = wobble_core::drivers::gnss_bringup::PROBE_BAUDS[0];
-    let uart = defmt::unwrap!(Uart::new(
-        pins.uart,
-        pins.rx,
-        pins.tx,
-        pins.tx_dma,
-        pins.rx_dma,
-        Irqs,
-        config
-    )
-    .ok());
-    let (tx, rx) = uart.split();
-    (
-        tx,
-        rx.into_ring_buffered(GPS_RING.init([0; adapters::gps::RING_BYTES])),
-    )
-}
-
 #[embassy_executor::task]
 async fn sampler_task(mut sampler: Sampler, mut ports: Ports) {
     sampler::run(
@@ -327,8 +303,7 @@ async fn sampler_task(mut sampler: Sampler, mut ports: Ports) {
 }
 
 #[embassy_executor::task]
-async fn gps_task(tx: UartTx<'static, Async>, rx: RingBufferedUartRx<'static>) {
-    let mut port = GpsAdapter::new(tx, rx);
+async fn gps_task(mut port: GpsAdapter) {
     let outcome = gps_setup::run(&mut port, &mut |step| defmt::info!("GPS set-up: {}", step)).await;
     defmt::info!("GPS: {}", outcome);
     if let Some(code) = outcome.fault() {
