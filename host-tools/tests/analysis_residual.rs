@@ -25,10 +25,10 @@ fn run(x: impl Fn(f64) -> f64) -> Run {
 
 /// Grows at 1.5/s from 0.02 deg at 8 s to 2 deg, holds, gone at 16 s.
 fn envelope(t: f64) -> f64 {
-    if t < 8.0 || t > 16.0 {
-        0.0
-    } else {
+    if (8.0..=16.0).contains(&t) {
         (0.02 * (1.5 * (t - 8.0)).exp()).min(2.0)
+    } else {
+        0.0
     }
 }
 
