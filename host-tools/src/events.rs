@@ -153,7 +153,7 @@ impl EventKind {
     }
 }
 
-/// Collects [`LogEvent`]s from decoder events.
+/// Turns decoder events into [`LogEvent`]s, and collects them.
 #[derive(Default)]
 pub struct EventCollector {
     events: Vec<LogEvent>,
@@ -167,16 +167,20 @@ impl EventCollector {
         Self::default()
     }
 
-    /// Takes one decoder event.
+    /// Takes one decoder event and keeps it if it is a [`LogEvent`].
     pub fn observe(&mut self, event: &Event<'_>) {
+        if let Some(e) = self.convert(event) {
+            self.events.push(e);
+        }
+    }
+
+    /// The [`LogEvent`] of a decoder event, if it is one (not kept).
+    pub fn convert(&mut self, event: &Event<'_>) -> Option<LogEvent> {
         let (t_s, kind) = match event {
             Event::Record(record) => {
                 let t_s = record.t_us() as f64 / 1e6;
                 self.last_t_s = t_s;
-                let Some(kind) = record_event(record) else {
-                    return;
-                };
-                (t_s, kind)
+                (t_s, record_event(record)?)
             }
             Event::Gap(gap) => {
                 let lost = LostBlocks::from(gap);
@@ -219,7 +223,7 @@ impl EventCollector {
                 },
             ),
         };
-        self.events.push(LogEvent { t_s, kind });
+        Some(LogEvent { t_s, kind })
     }
 
     /// The events in time order (file order among equal times).

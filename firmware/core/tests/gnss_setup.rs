@@ -1,7 +1,9 @@
 //! The receiver set-up commands carry the checksums the receivers check:
 //! compared with sentences and frames published in the vendors' manuals.
 
-use wobble_core::drivers::gnss_setup::{baud_commands, nmea, rate_commands, ubx};
+use wobble_core::drivers::gnss_setup::{
+    baud_commands, nmea, rate_commands, ubx, valset_command, MAX_COMMAND_LEN,
+};
 
 #[test]
 fn nmea_checksums_match_published_pmtk_sentences() {
@@ -47,4 +49,46 @@ fn boot_commands_ask_for_115200_baud_and_20hz_rmc_gga() {
         }
         assert_eq!(cmd[cmd.len() - 2..], [a, b]);
     }
+}
+
+#[test]
+fn valset_sets_rate_sentences_and_baud_in_ram() {
+    let cmd = valset_command();
+    assert!(cmd.len() <= MAX_COMMAND_LEN);
+    // UBX-CFG-VALSET, version 0, RAM layer.
+    assert_eq!(cmd[2..4], [0x06, 0x8A]);
+    let len = usize::from(u16::from_le_bytes([cmd[4], cmd[5]]));
+    assert_eq!(cmd.len(), len + 8);
+    let payload = &cmd[6..6 + len];
+    assert_eq!(payload[..4], [0, 1, 0, 0]);
+    // Key-value pairs; the value size is the key's bits 30:28 (1: 1 bit
+    // stored as a byte, 2: 1 byte, 3: 2 bytes, 4: 4 bytes).
+    let mut items = Vec::new();
+    let mut rest = &payload[4..];
+    while !rest.is_empty() {
+        let key = u32::from_le_bytes(rest[..4].try_into().unwrap());
+        let size = match (key >> 28) & 0x7 {
+            1 | 2 => 1,
+            3 => 2,
+            4 => 4,
+            other => panic!("size code {other}"),
+        };
+        let mut value = [0u8; 4];
+        value[..size].copy_from_slice(&rest[4..4 + size]);
+        items.push((key, u32::from_le_bytes(value)));
+        rest = &rest[4 + size..];
+    }
+    assert_eq!(
+        items,
+        [
+            (0x3021_0001, 50),
+            (0x2091_00AC, 1),
+            (0x2091_00BB, 1),
+            (0x2091_00CA, 0),
+            (0x2091_00C0, 0),
+            (0x2091_00C5, 0),
+            (0x2091_00B1, 0),
+            (0x4052_0001, 115_200),
+        ]
+    );
 }

@@ -33,12 +33,12 @@ use embedded_hal_bus::spi::ExclusiveDevice;
 use embedded_sdmmc::VolumeManager;
 use static_cell::StaticCell;
 use wobble_core::app::sampler::{Sampler, SamplerPorts};
-use wobble_core::app::{gps, sampler, writer};
+use wobble_core::app::{gps, gps_setup, sampler, writer};
 use wobble_core::boot;
 use wobble_core::channels::{RecordQueue, SharedStatus};
 use wobble_core::config::{self, Config, Loaded, KEY_COUNT, MAX_TEXT_LEN};
 use wobble_core::drivers::icm42688::{self, Icm42688};
-use wobble_core::format::Record;
+use wobble_core::format::{Fault, FaultSource, Record};
 use wobble_core::frame_assembly::FrameConfig;
 use wobble_core::gps::{GpsConfig, GpsReceiver};
 use wobble_core::imu::Imu;
@@ -264,10 +264,10 @@ fn steering_adc(
     )
 }
 
-/// USART2 at the receivers' power-up rate; the GPS task raises it.
+/// USART2 at the receivers' usual power-up rate; the GPS task finds theirs.
 fn gps_uart(pins: pins::GpsPins) -> (UartTx<'static, Async>, RingBufferedUartRx<'static>) {
     let mut config = usart::Config::default();
-    config.baudrate = wobble_core::drivers::gnss_setup::BOOT_BAUDS[0];
+    config.baudrate = wobble_core::drivers::gnss_bringup::PROBE_BAUDS[0];
     let uart = defmt::unwrap!(Uart::new(
         pins.uart,
         pins.rx,
@@ -301,9 +301,19 @@ async fn sampler_task(mut sampler: Sampler, mut ports: Ports) {
 }
 
 #[embassy_executor::task]
-async fn gps_task(mut tx: UartTx<'static, Async>, rx: RingBufferedUartRx<'static>) {
-    adapters::gps::configure_receiver(&mut tx).await;
-    let mut port = GpsAdapter::new(rx);
+async fn gps_task(tx: UartTx<'static, Async>, rx: RingBufferedUartRx<'static>) {
+    let mut port = GpsAdapter::new(tx, rx);
+    let outcome = gps_setup::run(&mut port, &mut |step| defmt::info!("GPS set-up: {}", step)).await;
+    defmt::info!("GPS: {}", outcome);
+    if let Some(code) = outcome.fault() {
+        let t_us = Instant::now().as_micros();
+        QUEUE.push(Record::Fault(Fault {
+            t_us,
+            source: FaultSource::Gps,
+            code,
+            count: 1,
+        }));
+    }
     let mut receiver = GpsReceiver::new(GpsConfig::default());
     gps::run(&mut port, &mut receiver, &QUEUE, &SHARED).await;
 }

@@ -3,14 +3,16 @@
 use std::io::{IsTerminal, Write};
 use std::path::{Path, PathBuf};
 
+use crate::events::{EventCollector, LogEvent};
 use crate::export::columns::{self, Column};
 use crate::export::{Format, LogMetadata, RowWriter};
 use crate::losses::Losses;
 use crate::output::Output;
 use crate::reader::read_log;
-use crate::rows::RowAssembler;
-use crate::time::{TimeWindow, WindowArgs};
+use crate::rows::{Row, RowAssembler};
+use crate::time::{utc_ms_at, SyncPair, TimeWindow, WindowArgs};
 use crate::CliError;
+use wobble_core::format::{Event, GpsFix, Record};
 
 /// Arguments of `wobblog decode`.
 #[derive(clap::Args)]
@@ -64,11 +66,17 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         columns: columns::select(args.columns.as_deref()).map_err(CliError::Usage)?,
         window: args.window.window(),
     };
-    if export.format == Format::Parquet && args.output.is_none() && std::io::stdout().is_terminal()
-    {
+    if args.columns.is_some() && export.format == Format::Mcap {
         return Err(CliError::Usage(
-            "parquet output is binary: give -o FILE or redirect standard output".into(),
+            "--columns does not apply to MCAP, whose channels are the sensor groups".into(),
         ));
+    }
+    let binary = matches!(export.format, Format::Parquet | Format::Mcap);
+    if binary && args.output.is_none() && std::io::stdout().is_terminal() {
+        return Err(CliError::Usage(format!(
+            "{} output is binary: give -o FILE or redirect standard output",
+            export.format.name()
+        )));
     }
     let mut out = Output::create_or_stdout(args.output.as_deref(), &[&args.log])?;
     let name = out.name().to_path_buf();
@@ -90,31 +98,83 @@ pub fn decode_to(
     out: impl Write + Send,
     out_name: &Path,
 ) -> Result<Losses, CliError> {
-    let write_err = |e: &dyn std::fmt::Display| CliError::file(out_name, e);
-    let mut writer = RowWriter::new(export.format, export.columns.clone(), out);
+    let mut sink = WindowedSink {
+        writer: RowWriter::new(export.format, export.columns.clone(), out),
+        window: export.window,
+        failure: None,
+        sync: Vec::new(),
+    };
     let mut rows = RowAssembler::new();
     let mut losses = Losses::default();
     let mut meta = LogMetadata::default();
-    let mut failure: Option<std::io::Error> = None;
-    let window = export.window;
-    let mut emit = |row: &crate::rows::Row| {
-        let inside = window.is_all() || window.contains(row.t_s, row.utc_us.map(|u| u / 1000));
-        if failure.is_none() && inside {
-            failure = writer.write(row).err();
-        }
-    };
+    // Fixes and events have messages of their own only in MCAP.
+    let mut events = (export.format == Format::Mcap).then(EventCollector::new);
     read_log(log, |event| {
         losses.observe(&event);
         meta.observe(&event);
-        if let wobble_core::format::Event::Record(record) = event {
-            rows.push(&record, &mut emit);
+        if let Some(e) = events.as_mut().and_then(|c| c.convert(&event)) {
+            sink.event(&e);
+        }
+        if let Event::Record(record) = event {
+            match (&events, &record) {
+                (Some(_), Record::Gps(fix)) => sink.gps(fix),
+                (Some(_), Record::UtcSync(pair)) => {
+                    if let Ok(ms) = i64::try_from(pair.unix_ms) {
+                        sink.sync = vec![(pair.t_us as f64 / 1e6, ms)];
+                    }
+                }
+                _ => {}
+            }
+            rows.push(&record, &mut |row: &Row| sink.row(row));
         }
     })?;
-    rows.finish(&mut emit);
+    rows.finish(&mut |row: &Row| sink.row(row));
+    let WindowedSink {
+        mut writer,
+        failure,
+        ..
+    } = sink;
     match failure.map_or_else(|| writer.finish(&meta), Err) {
         // The reader went away (`wobblog decode LOG | head`): not a failure.
         Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(losses),
-        Err(e) => Err(write_err(&e)),
+        Err(e) => Err(CliError::file(out_name, e)),
         Ok(()) => Ok(losses),
+    }
+}
+
+/// A writer that keeps what falls in the window and remembers the first
+/// write failure (the decoder's callbacks cannot return one).
+struct WindowedSink<W: Write + Send> {
+    writer: RowWriter<W>,
+    window: TimeWindow,
+    failure: Option<std::io::Error>,
+    /// The latest sync pair, which places events in UTC.
+    sync: Vec<SyncPair>,
+}
+
+impl<W: Write + Send> WindowedSink<W> {
+    fn keep(&mut self, inside: bool, write: impl FnOnce(&mut RowWriter<W>) -> std::io::Result<()>) {
+        if inside && self.failure.is_none() {
+            self.failure = write(&mut self.writer).err();
+        }
+    }
+
+    fn row(&mut self, row: &Row) {
+        let inside =
+            self.window.is_all() || self.window.contains(row.t_s, row.utc_us.map(|u| u / 1000));
+        self.keep(inside, |w| w.write(row));
+    }
+
+    fn gps(&mut self, fix: &GpsFix) {
+        let utc_ms = fix.utc.and_then(|u| i64::try_from(u.unix_ms()).ok());
+        let inside = self.window.contains(fix.t_us as f64 / 1e6, utc_ms);
+        self.keep(inside, |w| w.gps(fix));
+    }
+
+    fn event(&mut self, event: &LogEvent) {
+        let inside = self
+            .window
+            .contains(event.t_s, utc_ms_at(&self.sync, event.t_s));
+        self.keep(inside, |w| w.event(event));
     }
 }

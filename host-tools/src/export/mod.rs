@@ -2,6 +2,7 @@
 //! [`columns::COLUMNS`] (or a selection of them).
 
 pub mod columns;
+pub mod mcap;
 pub mod metadata;
 pub mod parquet;
 
@@ -11,8 +12,10 @@ use std::path::Path;
 use columns::{Column, Value};
 pub use metadata::LogMetadata;
 
+use crate::events::LogEvent;
 use crate::rows::Row;
 use crate::CliError;
+use wobble_core::format::GpsFix;
 
 /// The CSV columns `wobblog encode` reads: the documented ones, units in
 /// the names (the first columns of [`columns::COLUMNS`]).
@@ -41,6 +44,9 @@ pub enum Format {
     Jsonl,
     /// Apache Parquet (binary; typed columns, GPS columns nullable).
     Parquet,
+    /// MCAP for Foxglove (binary; a JSON channel per sensor group, GPS as
+    /// foxglove.LocationFix, events on their own channel).
+    Mcap,
 }
 
 impl Format {
@@ -52,6 +58,7 @@ impl Format {
             "csv" => Some(Self::Csv),
             "jsonl" | "ndjson" => Some(Self::Jsonl),
             "parquet" => Some(Self::Parquet),
+            "mcap" => Some(Self::Mcap),
             _ => None,
         }
     }
@@ -82,6 +89,7 @@ impl Format {
             Self::Csv => "csv",
             Self::Jsonl => "jsonl",
             Self::Parquet => "parquet",
+            Self::Mcap => "mcap",
         }
     }
 }
@@ -99,6 +107,8 @@ enum Sink<W: Write + Send> {
     Csv(csv::Writer<W>, bool),
     Jsonl(W),
     Parquet(parquet::ParquetWriter<W>),
+    /// Built on the first row: creating it writes the file's header.
+    Mcap(Option<Box<mcap::McapWriter<W>>>, Option<W>),
 }
 
 impl<W: Write + Send> RowWriter<W> {
@@ -109,6 +119,7 @@ impl<W: Write + Send> RowWriter<W> {
             Format::Csv => Sink::Csv(csv::Writer::from_writer(out), false),
             Format::Jsonl => Sink::Jsonl(out),
             Format::Parquet => Sink::Parquet(parquet::ParquetWriter::new(out, &columns)),
+            Format::Mcap => Sink::Mcap(None, Some(out)),
         };
         Self { columns, sink }
     }
@@ -128,7 +139,37 @@ impl<W: Write + Send> RowWriter<W> {
             Sink::Csv(w, _) => write_csv(w, &self.columns, row).map_err(csv_io_error),
             Sink::Jsonl(w) => write_json(w, &self.columns, row),
             Sink::Parquet(w) => w.write(row).map_err(std::io::Error::other),
+            Sink::Mcap(..) => self.mcap()?.row(row).map_err(mcap_io_error),
         }
+    }
+
+    /// Writes a GPS fix (MCAP only: the table formats carry the fix in
+    /// force on every row).
+    pub fn gps(&mut self, fix: &GpsFix) -> std::io::Result<()> {
+        match self.sink {
+            Sink::Mcap(..) => self.mcap()?.gps(fix).map_err(mcap_io_error),
+            _ => Ok(()),
+        }
+    }
+
+    /// Writes an event (MCAP only).
+    pub fn event(&mut self, event: &LogEvent) -> std::io::Result<()> {
+        match self.sink {
+            Sink::Mcap(..) => self.mcap()?.event(event).map_err(mcap_io_error),
+            _ => Ok(()),
+        }
+    }
+
+    fn mcap(&mut self) -> std::io::Result<&mut mcap::McapWriter<W>> {
+        let Sink::Mcap(writer, out) = &mut self.sink else {
+            return Err(std::io::Error::other("not an MCAP output"));
+        };
+        if let Some(out) = out.take() {
+            *writer = Some(Box::new(mcap::McapWriter::new(out).map_err(mcap_io_error)?));
+        }
+        writer
+            .as_deref_mut()
+            .ok_or_else(|| std::io::Error::other("the MCAP file could not be started"))
     }
 
     /// Writes the CSV header if no row came, or the Parquet footer with
@@ -139,6 +180,7 @@ impl<W: Write + Send> RowWriter<W> {
             Sink::Csv(w, _) => w.flush(),
             Sink::Jsonl(w) => w.flush(),
             Sink::Parquet(w) => w.finish(meta).map_err(std::io::Error::other),
+            Sink::Mcap(..) => self.mcap()?.finish(meta).map_err(mcap_io_error),
         }
     }
 }
@@ -185,6 +227,14 @@ fn write_json<W: Write>(w: &mut W, columns: &[Column], row: &Row) -> std::io::Re
 /// UTC in ISO 8601 to the millisecond (rounded down).
 fn utc_text(us: i64) -> String {
     crate::time::iso8601_unix_ms(us.div_euclid(1000)).unwrap_or_default()
+}
+
+/// Keeps the kind of an I/O error wrapped by `mcap`.
+fn mcap_io_error(err: ::mcap::McapError) -> std::io::Error {
+    match err {
+        ::mcap::McapError::Io(e) => e,
+        other => std::io::Error::other(other.to_string()),
+    }
 }
 
 /// Keeps the kind of an I/O error wrapped by `csv` (its own conversion

@@ -8,6 +8,7 @@
 //! ```
 
 pub mod gps;
+pub mod gps_setup;
 pub mod ports;
 pub mod sampler;
 pub mod writer;

@@ -1,13 +1,16 @@
 //! Boot-time commands that ask common GNSS receivers for what the logger
 //! wants: 115 200 baud, 20 Hz fixes, only RMC and GGA sentences.
 //!
-//! Two dialects cover most receivers on small boards: MediaTek's `PMTK`
-//! NMEA sentences and u-blox's binary UBX protocol. The board sends both;
-//! each receiver ignores the other's. A receiver that cannot do 20 Hz
+//! Three dialects cover most receivers on small boards: MediaTek's `PMTK`
+//! NMEA sentences, u-blox's legacy UBX CFG-PRT/RATE/MSG messages (up to
+//! M8), and UBX-CFG-VALSET for the M9/M10 generation, which dropped the
+//! legacy ones. The legacy set carries both the MTK and the UBX commands
+//! (each receiver ignores the other's): [`baud_commands`] at the baud the
+//! receiver talks at, then [`rate_commands`] at 115 200; [`valset_command`]
+//! is one message at the receiver's baud. A receiver that cannot do 20 Hz
 //! rejects the rate and keeps its own: the GPS path copes with any rate.
-//! Receivers power up at 9600 baud, so [`baud_commands`] goes out at 9600
-//! (and again at 115 200, harmless for one that is already there), then
-//! [`rate_commands`] at 115 200.
+//! Which set to send, and whether it worked, is decided by
+//! [`super::gnss_bringup`].
 
 use heapless::Vec;
 
@@ -20,8 +23,6 @@ pub type Command = Vec<u8, MAX_COMMAND_LEN>;
 pub const TARGET_BAUD: u32 = 115_200;
 /// Fix interval asked for: 50 ms, 20 Hz.
 pub const FIX_INTERVAL_MS: u16 = 50;
-/// Baud rates receivers start at (9600 for nearly all) and the target.
-pub const BOOT_BAUDS: [u32; 2] = [9_600, TARGET_BAUD];
 
 /// UBX message class CFG.
 const UBX_CFG: u8 = 0x06;
@@ -31,6 +32,24 @@ const UBX_CFG_PRT: u8 = 0x00;
 const UBX_CFG_MSG: u8 = 0x01;
 /// UBX-CFG-RATE: navigation rate.
 const UBX_CFG_RATE: u8 = 0x08;
+/// UBX-CFG-VALSET: set configuration items (M9/M10).
+const UBX_CFG_VALSET: u8 = 0x8A;
+/// CFG-VALSET layer bit: RAM only (the setting is lost at power-off, so a
+/// receiver shared with other equipment is left as it was).
+const VALSET_LAYER_RAM: u8 = 0x01;
+/// Configuration keys (u-blox M10 interface description): baud rate of
+/// UART1 (U4), measurement period in ms (U2), and the UART1 output rate of
+/// each NMEA sentence (U1, per epoch).
+const KEY_UART1_BAUDRATE: u32 = 0x4052_0001;
+const KEY_RATE_MEAS: u32 = 0x3021_0001;
+const KEY_MSGOUT_NMEA_UART1: [(u32, bool); 6] = [
+    (0x2091_00AC, true),  // RMC
+    (0x2091_00BB, true),  // GGA
+    (0x2091_00CA, false), // GLL
+    (0x2091_00C0, false), // GSA
+    (0x2091_00C5, false), // GSV
+    (0x2091_00B1, false), // VTG
+];
 /// UBX class of the standard NMEA sentences, and their ids.
 const NMEA_CLASS: u8 = 0xF0;
 const NMEA_GGA: u8 = 0x00;
@@ -113,4 +132,22 @@ pub fn rate_commands() -> [Command; 9] {
         msg(NMEA_GSV, false),
         msg(NMEA_VTG, false),
     ]
+}
+
+/// One UBX-CFG-VALSET (RAM layer) with everything at once: 20 Hz, RMC and
+/// GGA only, then 115 200 baud (applied after the message).
+#[must_use]
+pub fn valset_command() -> Command {
+    let mut payload: Vec<u8, 56> = Vec::new();
+    // version 0, layers, 2 reserved bytes.
+    let _ = payload.extend_from_slice(&[0, VALSET_LAYER_RAM, 0, 0]);
+    let _ = payload.extend_from_slice(&KEY_RATE_MEAS.to_le_bytes());
+    let _ = payload.extend_from_slice(&FIX_INTERVAL_MS.to_le_bytes());
+    for (key, on) in KEY_MSGOUT_NMEA_UART1 {
+        let _ = payload.extend_from_slice(&key.to_le_bytes());
+        let _ = payload.push(u8::from(on));
+    }
+    let _ = payload.extend_from_slice(&KEY_UART1_BAUDRATE.to_le_bytes());
+    let _ = payload.extend_from_slice(&TARGET_BAUD.to_le_bytes());
+    ubx(UBX_CFG, UBX_CFG_VALSET, &payload)
 }
