@@ -13,3 +13,16 @@ if ((${#missing[@]})); then
     $SUDO apt-get update
     DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y "${missing[@]}"
 fi
+# DuckDB's Python wheel: the dataset test queries `wobblog export` output
+# with a real engine (the duckdb crate's bundled C++ build would cost CI
+# minutes). A user install; Debian's Python refuses pip without the flag.
+if ! python3 -c 'import duckdb' 2>/dev/null; then
+    python3 -m pip --version >/dev/null 2>&1 || {
+        SUDO=""
+        [ "$(id -u)" -eq 0 ] || SUDO=sudo
+        $SUDO apt-get update
+        DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y python3-pip
+    }
+    python3 -m pip install --user --quiet duckdb 2>/dev/null ||
+        python3 -m pip install --user --quiet --break-system-packages duckdb
+fi

@@ -32,6 +32,10 @@ cargo clippy -p wobble-stm32f405 --target "$TARGET" -- -D warnings
 # Fails when flash > 192 KiB or static RAM > 64 KiB (firmware/docs/board.md).
 cargo run -q -p wobble-size-budget -- "${CARGO_TARGET_DIR:-target}/$TARGET/release/wobble-stm32f405"
 
+step "on-target tests (hil-tests/on-target): build and clippy; they run on a board with a probe"
+cargo build -p wobble-on-target --tests --target "$TARGET"
+cargo clippy -p wobble-on-target --tests --target "$TARGET" -- -D warnings
+
 step "QEMU image (netduinoplus2): clippy and release build, run by the tests"
 cargo clippy -p wobble-qemu-image --target "$TARGET" -- -D warnings
 (cd hil-tests/qemu-image && cargo build --release)

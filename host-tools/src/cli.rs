@@ -26,6 +26,8 @@ enum Command {
     Events(cmd::events::Args),
     /// Print the CONFIG.TXT a log was recorded with, ready to copy to a card.
     Config(cmd::config::Args),
+    /// Write every log of a card or folder of cards as one Parquet dataset.
+    Export(cmd::export::Args),
     /// Build a log from a CSV through the firmware's encoder (tests and demos).
     Encode(cmd::encode::Args),
     /// Replay a steering CSV through the on-board wobble detector; print each alert change.
@@ -43,6 +45,8 @@ enum Command {
     /// The linear bicycle models: eigenvalues against speed, plots, parameter studies, fits.
     #[command(subcommand)]
     Model(cmd::model::Command),
+    /// Print the logger's field self-test report (SELFTEST.TXT from the card).
+    Selftest(cmd::selftest::Args),
     /// Print a shell completion script (bash, zsh, fish, ...).
     Completions(cmd::completions::Args),
     /// Print the man page (roff) of wobblog.
@@ -59,6 +63,7 @@ pub fn main() -> ExitCode {
         Command::Decode(args) => cmd::decode::run(&args),
         Command::Events(args) => cmd::events::run(&args),
         Command::Config(args) => cmd::config::run(&args),
+        Command::Export(args) => cmd::export::run(&args),
         Command::Encode(args) => cmd::encode::run(&args),
         Command::Detect(args) => cmd::detect::run(&args),
         Command::Nmea(args) => cmd::nmea::run(&args),
@@ -67,6 +72,7 @@ pub fn main() -> ExitCode {
         Command::Gpx(args) => cmd::gpx::run(&args),
         Command::Summary(args) => cmd::summary::run(&args),
         Command::Model(command) => cmd::model::run(&command),
+        Command::Selftest(args) => cmd::selftest::run(&args),
         Command::Completions(args) => cmd::completions::run(&args),
         Command::Man => cmd::completions::man(),
     };

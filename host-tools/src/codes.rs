@@ -15,6 +15,9 @@ use wobble_core::config::{
     FAULT_BAD_VALUE, FAULT_OBSOLETE_KEY, FAULT_REJECTED, FAULT_SYNTAX, FAULT_UNKNOWN_KEY,
     FAULT_UNREADABLE,
 };
+use wobble_core::drivers::gnss_bringup::{
+    FAULT_SETUP_SILENT, FAULT_SETUP_SLOW, FAULT_SETUP_UNCONFIRMED,
+};
 use wobble_core::format::{DropoutReason, FaultSource};
 use wobble_core::gps::{
     FAULT_CHECKSUM, FAULT_FRAMING, FAULT_NO_CHECKSUM, FAULT_OVERLONG, FAULT_UNPARSEABLE,
@@ -22,7 +25,7 @@ use wobble_core::gps::{
 use wobble_core::logger::{FAULT_CARD_ABSENT, FAULT_CARD_FULL, FAULT_CARD_WRITE};
 
 /// Every fault code the firmware records: (source, code, meaning).
-pub const FAULT_MEANINGS: [(FaultSource, u8, &str); 29] = [
+pub const FAULT_MEANINGS: [(FaultSource, u8, &str); 32] = [
     (
         FaultSource::Imu,
         FAULT_IMU_NO_RESPONSE,
@@ -64,6 +67,9 @@ pub const FAULT_MEANINGS: [(FaultSource, u8, &str); 29] = [
         FAULT_UNPARSEABLE,
         "RMC/GGA/GLL/VTG/GSA/ZDA sentence the parser rejected",
     ),
+    (FaultSource::Gps, FAULT_SETUP_SILENT, "set-up: no valid NMEA at any baud rate (logging at 9600)"),
+    (FaultSource::Gps, FAULT_SETUP_UNCONFIRMED, "set-up: no command set confirmed (logging at the receiver's own baud and rate)"),
+    (FaultSource::Gps, FAULT_SETUP_SLOW, "set-up: configured, but fixes come slower than 15 Hz"),
     (
         FaultSource::Card,
         FAULT_CARD_ABSENT,

@@ -7,6 +7,7 @@ pub mod cli;
 pub mod cmd;
 pub mod codes;
 pub mod csv_input;
+pub mod dataset;
 pub mod error;
 pub mod events;
 pub mod export;

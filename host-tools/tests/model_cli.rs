@@ -99,3 +99,119 @@ fn usage_errors_exit_2() {
         .unwrap();
     assert_eq!(out.status.code(), Some(2));
 }
+
+fn corpus_log(dir: &Path, name: &str) -> PathBuf {
+    let csv = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../hil-tests/fixtures/corpus")
+        .join(format!("{name}.csv"));
+    let log = dir.join(format!("{name}.WBL"));
+    wobblog()
+        .args(["encode", "--csv"])
+        .arg(&csv)
+        .arg("-o")
+        .arg(&log)
+        .assert()
+        .success();
+    log
+}
+
+#[test]
+fn plot_and_sweep_draw_figures_and_print_critical_speeds() {
+    let dir = tempfile::tempdir().unwrap();
+    let fig = dir.path().join("fig4.png");
+    wobblog()
+        .args(["model", "plot"])
+        .arg(params("test-bicycle.toml"))
+        .args(["--both", "--speeds", "0:8:0.25", "-o"])
+        .arg(&fig)
+        .assert()
+        .success();
+    assert!(std::fs::read(&fig).unwrap().starts_with(b"\x89PNG"));
+    let out = wobblog()
+        .args(["model", "sweep"])
+        .arg(params("test-bicycle.toml"))
+        .args([
+            "--param",
+            "front_tyre.cornering_stiffness",
+            "--factors",
+            "0.5,1,2",
+            "--speeds",
+            "0:8:0.25",
+        ])
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert_eq!(
+        text.matches("front_tyre.cornering_stiffness x").count(),
+        3,
+        "{text}"
+    );
+    assert!(
+        text.contains("x 1 (11.5 1/rad):\n  wobble speed 3.80"),
+        "{text}"
+    );
+    let out = wobblog()
+        .args(["model", "sweep"])
+        .arg(params("test-bicycle.toml"))
+        .args(["--param", "front_tyre.no_such", "--speeds", "0:1:1"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8(out.stderr)
+        .unwrap()
+        .contains("front_tyre.no_such: no such parameter"));
+}
+
+#[test]
+fn compare_prints_residuals_and_fit_writes_the_fitted_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let log = corpus_log(dir.path(), "wobble_fig6");
+    let out = wobblog()
+        .args(["model", "compare"])
+        .arg(params("test-bicycle.toml"))
+        .arg(&log)
+        .arg("-o")
+        .arg(dir.path().join("fig8.svg"))
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8(out.stdout).unwrap();
+    let row = text
+        .lines()
+        .find(|l| l.starts_with("wobble_fig6.WBL"))
+        .expect(&text);
+    let cols: Vec<f64> = row
+        .split_whitespace()
+        .skip(1)
+        .take(8)
+        .map(|c| c.parse().unwrap())
+        .collect();
+    // measured minus model, as printed
+    assert!((cols[2] - cols[3] - cols[4]).abs() < 0.011, "{row}");
+    assert!(text.contains("rms residuals over 1 episodes"));
+    let fitted = dir.path().join("fitted.toml");
+    let out = wobblog()
+        .args(["model", "fit"])
+        .arg(params("test-bicycle.toml"))
+        .arg(&log)
+        .args(["--param", "steer_head.damping", "-o"])
+        .arg(&fitted)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let written = wobble_model::ParamSet::load(&fitted).unwrap();
+    let q = written.quantity("steer_head.damping").unwrap();
+    assert_eq!(q.source, "fitted to measured wobble episodes");
+    assert!(String::from_utf8(out.stdout)
+        .unwrap()
+        .contains(&format!("steer_head.damping = {:.6}", q.value)));
+}

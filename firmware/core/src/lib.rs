@@ -20,6 +20,7 @@ pub mod frame_assembly;
 pub mod gps;
 pub mod imu;
 pub mod logger;
+pub mod selftest;
 pub mod stall;
 pub mod steering;
 pub mod watchdog;

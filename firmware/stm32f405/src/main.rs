@@ -10,11 +10,7 @@
 #![no_std]
 #![no_main]
 
-mod adapters;
-mod clocks;
-mod pins;
-mod startup;
-mod watchdog;
+use wobble_stm32f405::{adapters, clocks, pins, startup, watchdog};
 
 use cortex_m_rt::entry;
 use embassy_executor::{Executor, InterruptExecutor};
@@ -47,13 +43,13 @@ use wobble_core::steering::Steering;
 use wobble_core::wheel::WheelSpeed;
 use {defmt_rtt as _, panic_probe as _};
 
-use adapters::card::SdCard;
-use adapters::gps::GpsAdapter;
-use adapters::imu::ImuAdapter;
-use adapters::rider::{AlertPins, MarkerButton, StatusLight};
-use adapters::steering::{SteeringAdapter, DMA_SAMPLES};
-use adapters::wheel::WheelAdapter;
-use pins::{Board, Irqs};
+use wobble_stm32f405::adapters::card::SdCard;
+use wobble_stm32f405::adapters::gps::GpsAdapter;
+use wobble_stm32f405::adapters::imu::ImuAdapter;
+use wobble_stm32f405::adapters::rider::{AlertPins, MarkerButton, StatusLight};
+use wobble_stm32f405::adapters::steering::{SteeringAdapter, DMA_SAMPLES};
+use wobble_stm32f405::adapters::wheel::WheelAdapter;
+use wobble_stm32f405::pins::{Board, Irqs};
 
 /// Records from the sampler and the GPS task to the SD writer.
 static QUEUE: RecordQueue = RecordQueue::new();

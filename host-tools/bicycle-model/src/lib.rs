@@ -7,6 +7,7 @@
 
 pub mod critical;
 pub mod eig;
+pub mod fit;
 pub mod model;
 pub mod multibody;
 pub mod params;
@@ -16,5 +17,6 @@ pub mod wobble;
 
 pub use critical::{critical_speeds, CriticalSpeed};
 pub use model::{Model, StateRole};
+pub use nalgebra::Complex;
 pub use params::{ModelKind, ParamError, ParamSet, Problem, Quantity, Unit};
 pub use sweep::{Branch, Mode, Sweep, SweepError};

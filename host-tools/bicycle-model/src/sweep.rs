@@ -321,3 +321,34 @@ fn pick<S>(seen: &[S], keep: impl Fn(&S) -> bool, score: impl Fn(&S) -> f64) -> 
         .max_by(|a, b| score(a.1).total_cmp(&score(b.1)))
         .map(|(i, _)| i)
 }
+
+/// Grid step for following a mode up to given speeds, m/s.
+const FOLLOW_STEP_MPS: f64 = 0.25;
+
+/// The `mode` eigenvalue (upper member) of `model` at each of `speeds_mps`
+/// (any order), followed along a grid from 0 m/s so that it is the same
+/// branch at every speed; `None` if the model has no such mode.
+pub fn mode_at(
+    model: &Model,
+    mode: Mode,
+    speeds_mps: &[f64],
+) -> Result<Option<Vec<Complex<f64>>>, SweepError> {
+    let top = speeds_mps.iter().copied().fold(0.0, f64::max);
+    let mut grid: Vec<f64> = (0..)
+        .map(|i| f64::from(i) * FOLLOW_STEP_MPS)
+        .take_while(|&u| u <= top + FOLLOW_STEP_MPS)
+        .chain(speeds_mps.iter().copied())
+        .collect();
+    grid.sort_by(f64::total_cmp);
+    grid.dedup();
+    let sweep = Sweep::run(model, &grid, |_| {})?;
+    Ok(sweep.upper(mode).map(|b| {
+        speeds_mps
+            .iter()
+            .map(|u| {
+                let k = grid.partition_point(|g| g < u);
+                b.values[k.min(b.values.len() - 1)]
+            })
+            .collect()
+    }))
+}

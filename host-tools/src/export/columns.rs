@@ -1,5 +1,6 @@
 //! The columns of a decoded row: one table giving every export format the
-//! same names, order and types, and `--columns` its choices.
+//! same names, order and types, and `--columns` its choices. The same
+//! column type describes the tables of a dataset (runs, episodes).
 
 use crate::rows::Row;
 
@@ -14,10 +15,14 @@ pub enum Kind {
     Label,
     /// A UTC time, absent before the first GPS sync pair.
     Utc,
+    /// A whole number, absent in some rows.
+    Integer,
+    /// Free text (a file name).
+    Text,
 }
 
 /// One cell.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub enum Value {
     /// A number, or none.
     Number(Option<f64>),
@@ -25,18 +30,30 @@ pub enum Value {
     Label(Option<&'static str>),
     /// µs since 1970, or none.
     Utc(Option<i64>),
+    /// A whole number, or none.
+    Integer(Option<i64>),
+    /// Text, or none.
+    Text(Option<String>),
 }
 
-/// A column: its name (unit in the name), type and value in a row.
-#[derive(Clone, Copy)]
-pub struct Column {
+/// A column of a table of `R`s: its name (unit in the name), type and
+/// value in a row.
+pub struct Column<R = Row> {
     /// Header name, as in the CSV.
     pub name: &'static str,
     /// Type of its values.
     pub kind: Kind,
     /// Its value in a row.
-    pub value: fn(&Row) -> Value,
+    pub value: fn(&R) -> Value,
 }
+
+// By hand: derived impls would require `R: Clone`.
+impl<R> Clone for Column<R> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+impl<R> Copy for Column<R> {}
 
 /// A column of numbers present in every row.
 macro_rules! number {

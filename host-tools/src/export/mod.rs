@@ -192,7 +192,13 @@ fn write_csv<W: Write>(w: &mut csv::Writer<W>, columns: &[Column], row: &Row) ->
             Value::Number(Some(v)) => w.write_field(num.format(v))?,
             Value::Label(Some(s)) => w.write_field(s)?,
             Value::Utc(Some(us)) => w.write_field(utc_text(us))?,
-            Value::Number(None) | Value::Label(None) | Value::Utc(None) => w.write_field("")?,
+            Value::Integer(Some(n)) => w.write_field(n.to_string())?,
+            Value::Text(Some(s)) => w.write_field(s)?,
+            Value::Number(None)
+            | Value::Label(None)
+            | Value::Utc(None)
+            | Value::Integer(None)
+            | Value::Text(None) => w.write_field("")?,
         }
     }
     w.write_record(None::<&[u8]>)
@@ -210,7 +216,13 @@ fn write_json<W: Write>(w: &mut W, columns: &[Column], row: &Row) -> std::io::Re
             Value::Number(Some(v)) => num.format(v).to_string(),
             Value::Label(Some(s)) => format!("\"{s}\""),
             Value::Utc(Some(us)) => format!("\"{}\"", utc_text(us)),
-            Value::Number(None) | Value::Label(None) | Value::Utc(None) => continue,
+            Value::Integer(Some(n)) => n.to_string(),
+            Value::Text(Some(s)) => serde_json::to_string(&s).map_err(std::io::Error::other)?,
+            Value::Number(None)
+            | Value::Label(None)
+            | Value::Utc(None)
+            | Value::Integer(None)
+            | Value::Text(None) => continue,
         };
         if line.len() > 1 {
             line.push(',');

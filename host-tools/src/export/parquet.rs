@@ -27,9 +27,9 @@ const ROW_GROUP_ROWS: usize = 65_536;
 
 /// Writes rows into a Parquet file on any writer (the format is written
 /// front to back; only readers need to seek).
-pub struct ParquetWriter<W: Write + Send> {
+pub struct ParquetWriter<W: Write + Send, R = Row> {
     state: State<W>,
-    columns: Vec<Column>,
+    columns: Vec<Column<R>>,
     buffers: Vec<Buffer>,
     rows: usize,
 }
@@ -40,6 +40,8 @@ enum Buffer {
     Number(Vec<f64>, Option<Vec<i16>>),
     Label(Vec<ByteArray>, Vec<i16>),
     Utc(Vec<i64>, Vec<i16>),
+    Integer(Vec<i64>, Vec<i16>),
+    Text(Vec<ByteArray>, Vec<i16>),
 }
 
 enum State<W: Write + Send> {
@@ -49,9 +51,9 @@ enum State<W: Write + Send> {
     Closed,
 }
 
-impl<W: Write + Send> ParquetWriter<W> {
+impl<W: Write + Send, R> ParquetWriter<W, R> {
     /// A writer of `columns` on `out`.
-    pub fn new(out: W, columns: &[Column]) -> Self {
+    pub fn new(out: W, columns: &[Column<R>]) -> Self {
         let buffers = columns
             .iter()
             .map(|c| match c.kind {
@@ -59,6 +61,8 @@ impl<W: Write + Send> ParquetWriter<W> {
                 Kind::OptNumber => Buffer::Number(Vec::new(), Some(Vec::new())),
                 Kind::Label => Buffer::Label(Vec::new(), Vec::new()),
                 Kind::Utc => Buffer::Utc(Vec::new(), Vec::new()),
+                Kind::Integer => Buffer::Integer(Vec::new(), Vec::new()),
+                Kind::Text => Buffer::Text(Vec::new(), Vec::new()),
             })
             .collect();
         Self {
@@ -76,11 +80,11 @@ impl<W: Write + Send> ParquetWriter<W> {
             let field = match c.kind {
                 Kind::Number => "REQUIRED DOUBLE",
                 Kind::OptNumber => "OPTIONAL DOUBLE",
-                Kind::Label => "OPTIONAL BYTE_ARRAY",
-                Kind::Utc => "OPTIONAL INT64",
+                Kind::Label | Kind::Text => "OPTIONAL BYTE_ARRAY",
+                Kind::Utc | Kind::Integer => "OPTIONAL INT64",
             };
             let annotation = match c.kind {
-                Kind::Label => " (UTF8)",
+                Kind::Label | Kind::Text => " (UTF8)",
                 Kind::Utc => " (TIMESTAMP(MICROS,true))",
                 _ => "",
             };
@@ -99,7 +103,11 @@ impl<W: Write + Send> ParquetWriter<W> {
                 // Numbers are nearly all distinct: a dictionary would be
                 // built and thrown away for every page.
                 .set_dictionary_enabled(false);
-            for c in self.columns.iter().filter(|c| c.kind == Kind::Label) {
+            for c in self
+                .columns
+                .iter()
+                .filter(|c| matches!(c.kind, Kind::Label | Kind::Text))
+            {
                 props = props.set_column_dictionary_enabled(ColumnPath::from(c.name), true);
             }
             self.state = match std::mem::replace(&mut self.state, State::Closed) {
@@ -120,7 +128,7 @@ impl<W: Write + Send> ParquetWriter<W> {
     }
 
     /// Adds one row.
-    pub fn write(&mut self, row: &Row) -> Result<(), ParquetError> {
+    pub fn write(&mut self, row: &R) -> Result<(), ParquetError> {
         for (column, buffer) in self.columns.iter().zip(&mut self.buffers) {
             match (buffer, (column.value)(row)) {
                 (Buffer::Number(values, levels), Value::Number(v)) => {
@@ -140,9 +148,14 @@ impl<W: Write + Send> ParquetWriter<W> {
                     levels.push(i16::from(v.is_some()));
                     values.extend(v.map(|s| ByteArray::from(s.as_bytes().to_vec())));
                 }
-                (Buffer::Utc(values, levels), Value::Utc(v)) => {
+                (Buffer::Utc(values, levels), Value::Utc(v))
+                | (Buffer::Integer(values, levels), Value::Integer(v)) => {
                     levels.push(i16::from(v.is_some()));
                     values.extend(v);
+                }
+                (Buffer::Text(values, levels), Value::Text(v)) => {
+                    levels.push(i16::from(v.is_some()));
+                    values.extend(v.map(|s| ByteArray::from(s.into_bytes())));
                 }
                 _ => {
                     return Err(ParquetError::General(format!(
@@ -170,6 +183,8 @@ impl<W: Write + Send> ParquetWriter<W> {
                 }
                 Buffer::Label(v, l) => Buffer::Label(std::mem::take(v), std::mem::take(l)),
                 Buffer::Utc(v, l) => Buffer::Utc(std::mem::take(v), std::mem::take(l)),
+                Buffer::Integer(v, l) => Buffer::Integer(std::mem::take(v), std::mem::take(l)),
+                Buffer::Text(v, l) => Buffer::Text(std::mem::take(v), std::mem::take(l)),
             })
             .collect();
         let file = self.file()?;
@@ -185,12 +200,12 @@ impl<W: Write + Send> ParquetWriter<W> {
                         .typed::<DoubleType>()
                         .write_batch(values, levels.as_deref(), None)?;
                 }
-                Buffer::Label(values, levels) => {
+                Buffer::Label(values, levels) | Buffer::Text(values, levels) => {
                     column
                         .typed::<ByteArrayType>()
                         .write_batch(values, Some(levels), None)?;
                 }
-                Buffer::Utc(values, levels) => {
+                Buffer::Utc(values, levels) | Buffer::Integer(values, levels) => {
                     column
                         .typed::<Int64Type>()
                         .write_batch(values, Some(levels), None)?;
@@ -202,19 +217,30 @@ impl<W: Write + Send> ParquetWriter<W> {
         Ok(())
     }
 
-    /// Writes the rows still buffered and the file footer with `meta` as
+    /// Writes the rows still buffered and the file footer with `pairs` as
     /// key-value metadata; the file is complete after this (also with no
     /// rows at all).
-    pub fn finish(&mut self, meta: &LogMetadata) -> Result<(), ParquetError> {
+    pub fn finish_with(&mut self, pairs: Vec<(String, String)>) -> Result<(), ParquetError> {
         self.write_group()?;
         if let State::Open(mut file) = std::mem::replace(&mut self.state, State::Closed) {
-            for (key, value) in meta.pairs(&self.columns) {
+            for (key, value) in pairs {
                 file.append_key_value_metadata(KeyValue::new(key, value));
             }
             file.finish()?;
             file.inner_mut().flush()?;
         }
         Ok(())
+    }
+}
+
+impl<W: Write + Send> ParquetWriter<W, Row> {
+    /// [`Self::finish_with`] the log's metadata and the columns' units.
+    ///
+    /// # Errors
+    /// When the output fails.
+    pub fn finish(&mut self, meta: &LogMetadata) -> Result<(), ParquetError> {
+        let pairs = meta.pairs(&self.columns);
+        self.finish_with(pairs)
     }
 }
 

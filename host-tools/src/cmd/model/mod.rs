@@ -1,7 +1,13 @@
 //! `wobblog model`: the linear bicycle models of the `wobble-model` crate
 //! (Whipple benchmark, extended wobble model) against speed.
 
+pub mod compare;
 pub mod eig;
+pub mod episodes;
+pub mod figure;
+pub mod fit;
+pub mod plot;
+pub mod sweep;
 
 use std::path::Path;
 use std::str::FromStr;
@@ -16,12 +22,24 @@ use crate::CliError;
 pub enum Command {
     /// Eigenvalues against speed, per mode, and the critical speeds.
     Eig(eig::Args),
+    /// Eigenvalues against speed as a figure (the seed paper's Figure 4).
+    Plot(plot::Args),
+    /// Scale one parameter by several factors: critical speeds and a figure.
+    Sweep(sweep::Args),
+    /// The model's wobble mode with measured episodes over it (Figure 8), residuals printed.
+    Compare(compare::Args),
+    /// Fit parameters to measured wobble episodes; confidence intervals and the fitted file.
+    Fit(fit::Args),
 }
 
 /// Runs a `model` subcommand.
 pub fn run(command: &Command) -> Result<(), CliError> {
     match command {
         Command::Eig(args) => eig::run(args),
+        Command::Plot(args) => plot::run(args),
+        Command::Sweep(args) => sweep::run(args),
+        Command::Compare(args) => compare::run(args),
+        Command::Fit(args) => fit::run(args),
     }
 }
 

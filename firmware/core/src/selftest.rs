@@ -1,0 +1,363 @@
+//! The field self-test: what the board measured about each part, whether
+//! that is good enough to ride, and the `SELFTEST.TXT` report.
+//!
+//! The board runs the test when the marker button is held at power-on (or
+//! `selftest=1` is in `CONFIG.TXT`): the rider holds the bike still, then
+//! turns the handlebar and spins the front wheel by hand during
+//! [`TEST_WINDOW_US`]. The board only gathers [`Measurements`]; the
+//! verdicts and the report are here, so they are tested on the host and
+//! `wobblog selftest` reads the same format back.
+//!
+//! Report format, one check per line after a header line:
+//!
+//! ```text
+//! wobble self-test 1
+//! imu PASS who_am_i=0x47 accel_g=1.01
+//! steering FAIL counts=2011..2013 (turn the handlebar)
+//! ```
+
+use core::fmt::{self, Write};
+
+use crate::boot::ResetCause;
+use crate::drivers::icm42688::reg::WHO_AM_I_VALUE;
+
+/// How long the rider turns the bar and spins the wheel, µs.
+pub const TEST_WINDOW_US: u64 = 10_000_000;
+/// First line of every report (the number is the format's version).
+pub const HEADER: &str = "wobble self-test 1";
+
+/// At rest the accelerometer reads 1 g; more than 10 % off is a wrong
+/// scale, a broken axis or a bike being moved.
+const ONE_G_TOLERANCE: f32 = 0.10;
+/// ADC counts (12 bits): the wiper must stay off both rails (a rail means
+/// an open end or a short) and move by at least this much when the bar is
+/// turned (about 15 degrees with the default calibration).
+const ADC_RAIL_MARGIN: u16 = 40;
+const ADC_FULL_SCALE: u16 = 4095;
+const MIN_STEER_SWING_COUNTS: u16 = 200;
+/// Edges while the wheel is spun by hand: one revolution of the disc.
+const MIN_WHEEL_EDGES: u32 = 50;
+/// The log needs about 3 KiB/s; a card must write far faster to absorb
+/// its own stalls, and read fast enough for the logger's FAT work.
+const MIN_CARD_KIB_S: u32 = 100;
+/// An hour of logging is about 11 MB.
+const MIN_FREE_MIB: u32 = 64;
+
+/// What the board measured.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Measurements {
+    /// The IMU's `WHO_AM_I`, if it answered.
+    pub imu_id: Option<u8>,
+    /// Mean acceleration magnitude at rest, g, if it delivered samples.
+    pub accel_g: Option<f32>,
+    /// Lowest and highest steering ADC count during the window.
+    pub steer_counts: Option<(u16, u16)>,
+    /// Wheel edges during the window.
+    pub wheel_edges: u32,
+    /// The baud rate the GPS receiver was found at, if it was.
+    pub gps_baud: Option<u32>,
+    /// Its fix rate after set-up, Hz.
+    pub gps_rate_hz: u32,
+    /// Card write and read speed, KiB/s, if the card worked.
+    pub card_kib_s: Option<(u32, u32)>,
+    /// Free space on the card, MiB.
+    pub card_free_mib: u32,
+    /// Whether the crystal runs (else the HSI).
+    pub crystal: bool,
+    /// Why the MCU last reset.
+    pub reset: Option<ResetCause>,
+}
+
+/// One check's result.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Verdict {
+    /// Good to ride.
+    Pass,
+    /// Fix before riding.
+    Fail,
+}
+
+/// The checks, in report order (the LED code of a failure is its index
+/// plus one).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Check {
+    /// IMU identity and 1 g at rest.
+    Imu,
+    /// Steering ADC in range and moving.
+    Steering,
+    /// Wheel edges while spun.
+    Wheel,
+    /// GPS sentences found at some baud.
+    Gps,
+    /// Card speed and free space.
+    Card,
+    /// Crystal running.
+    Clock,
+    /// The last reset was a normal one.
+    Reset,
+}
+
+/// Every check, in order.
+pub const CHECKS: [Check; 7] = [
+    Check::Imu,
+    Check::Steering,
+    Check::Wheel,
+    Check::Gps,
+    Check::Card,
+    Check::Clock,
+    Check::Reset,
+];
+
+impl Check {
+    /// Its name in the report.
+    #[must_use]
+    pub const fn name(self) -> &'static str {
+        match self {
+            Self::Imu => "imu",
+            Self::Steering => "steering",
+            Self::Wheel => "wheel",
+            Self::Gps => "gps",
+            Self::Card => "card",
+            Self::Clock => "clock",
+            Self::Reset => "reset",
+        }
+    }
+
+    /// The verdict on `m`.
+    #[must_use]
+    pub fn verdict(self, m: &Measurements) -> Verdict {
+        let pass = match self {
+            Self::Imu => {
+                m.imu_id == Some(WHO_AM_I_VALUE)
+                    && m.accel_g
+                        .is_some_and(|g| (g - 1.0).abs() <= ONE_G_TOLERANCE)
+            }
+            Self::Steering => m.steer_counts.is_some_and(|(lo, hi)| {
+                lo >= ADC_RAIL_MARGIN
+                    && hi <= ADC_FULL_SCALE - ADC_RAIL_MARGIN
+                    && hi.saturating_sub(lo) >= MIN_STEER_SWING_COUNTS
+            }),
+            Self::Wheel => m.wheel_edges >= MIN_WHEEL_EDGES,
+            Self::Gps => m.gps_baud.is_some() && m.gps_rate_hz >= 1,
+            Self::Card => {
+                m.card_kib_s
+                    .is_some_and(|(w, r)| w >= MIN_CARD_KIB_S && r >= MIN_CARD_KIB_S)
+                    && m.card_free_mib >= MIN_FREE_MIB
+            }
+            Self::Clock => m.crystal,
+            Self::Reset => m.reset.is_some_and(|r| !r.is_abnormal()),
+        };
+        if pass {
+            Verdict::Pass
+        } else {
+            Verdict::Fail
+        }
+    }
+
+    /// What was measured, for the report.
+    fn detail(self, m: &Measurements, out: &mut impl Write) -> fmt::Result {
+        match self {
+            Self::Imu => match (m.imu_id, m.accel_g) {
+                (None, _) => out.write_str("no answer"),
+                (Some(id), None) => write!(out, "who_am_i=0x{id:02x} no samples"),
+                (Some(id), Some(g)) => write!(out, "who_am_i=0x{id:02x} accel_g={g:.2}"),
+            },
+            Self::Steering => match m.steer_counts {
+                None => out.write_str("no conversions"),
+                Some((lo, hi)) => write!(out, "counts={lo}..{hi} (turn the handlebar)"),
+            },
+            Self::Wheel => write!(out, "edges={} (spin the wheel)", m.wheel_edges),
+            Self::Gps => match m.gps_baud {
+                None => out.write_str("no NMEA at any baud"),
+                Some(b) => write!(out, "found_baud={b} rate_hz={}", m.gps_rate_hz),
+            },
+            Self::Card => match m.card_kib_s {
+                None => out.write_str("not readable"),
+                Some((w, r)) => write!(
+                    out,
+                    "write_kib_s={w} read_kib_s={r} free_mib={}",
+                    m.card_free_mib
+                ),
+            },
+            Self::Clock => out.write_str(if m.crystal { "crystal" } else { "internal RC" }),
+            Self::Reset => match m.reset {
+                None => out.write_str("unknown"),
+                Some(r) => write!(out, "cause={r:?}"),
+            },
+        }
+    }
+}
+
+/// The first failing check's LED code (its position, from 1), or 0 when
+/// every check passed.
+#[must_use]
+pub fn failure_code(m: &Measurements) -> u8 {
+    CHECKS
+        .iter()
+        .position(|c| c.verdict(m) == Verdict::Fail)
+        .map_or(0, |i| i as u8 + 1)
+}
+
+/// Writes the report (see the module docs).
+///
+/// # Errors
+/// `out`'s error (a full buffer).
+pub fn write_report(m: &Measurements, out: &mut impl Write) -> fmt::Result {
+    writeln!(out, "{HEADER}")?;
+    for check in CHECKS {
+        let verdict = match check.verdict(m) {
+            Verdict::Pass => "PASS",
+            Verdict::Fail => "FAIL",
+        };
+        write!(out, "{} {verdict} ", check.name())?;
+        check.detail(m, out)?;
+        writeln!(out)?;
+    }
+    Ok(())
+}
+
+/// One line of a report read back.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ReportLine<'a> {
+    /// The check's name.
+    pub check: &'a str,
+    /// Its verdict.
+    pub verdict: Verdict,
+    /// What was measured.
+    pub detail: &'a str,
+}
+
+/// Why a report could not be read.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ReportError {
+    /// The first line is not [`HEADER`].
+    NotAReport,
+    /// This line (from 1) is not `name PASS|FAIL detail`.
+    BadLine(usize),
+}
+
+impl fmt::Display for ReportError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::NotAReport => write!(f, "not a self-test report (no \"{HEADER}\" line)"),
+            Self::BadLine(n) => write!(f, "line {n} is not `check PASS|FAIL detail`"),
+        }
+    }
+}
+
+/// Reads a report back, calling `line` for each check line.
+///
+/// # Errors
+/// [`ReportError`] for anything but a report as [`write_report`] makes.
+pub fn read_report<'a>(
+    text: &'a str,
+    line: &mut impl FnMut(ReportLine<'a>),
+) -> Result<(), ReportError> {
+    let mut lines = text.lines();
+    if lines.next().map(str::trim_end) != Some(HEADER) {
+        return Err(ReportError::NotAReport);
+    }
+    for (i, l) in lines.enumerate().filter(|(_, l)| !l.trim().is_empty()) {
+        let mut parts = l.splitn(3, ' ');
+        let (Some(check), Some(verdict)) = (parts.next(), parts.next()) else {
+            return Err(ReportError::BadLine(i + 2));
+        };
+        let verdict = match verdict {
+            "PASS" => Verdict::Pass,
+            "FAIL" => Verdict::Fail,
+            _ => return Err(ReportError::BadLine(i + 2)),
+        };
+        line(ReportLine {
+            check,
+            verdict,
+            detail: parts.next().unwrap_or("").trim_end(),
+        });
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn good() -> Measurements {
+        Measurements {
+            imu_id: Some(0x47),
+            accel_g: Some(1.01),
+            steer_counts: Some((1700, 2300)),
+            wheel_edges: 180,
+            gps_baud: Some(9_600),
+            gps_rate_hz: 20,
+            card_kib_s: Some((900, 1800)),
+            card_free_mib: 30_000,
+            crystal: true,
+            reset: Some(ResetCause::PowerOn),
+        }
+    }
+
+    #[test]
+    fn a_good_board_passes_everything() {
+        let m = good();
+        assert!(CHECKS.iter().all(|c| c.verdict(&m) == Verdict::Pass));
+        assert_eq!(failure_code(&m), 0);
+    }
+
+    #[test]
+    fn each_fault_fails_its_own_check_and_gives_its_code() {
+        let cases: [(Check, fn(&mut Measurements)); 12] = [
+            (Check::Imu, |m| m.imu_id = Some(0x00)),
+            (Check::Imu, |m| m.accel_g = Some(0.5)),
+            (Check::Imu, |m| m.accel_g = None),
+            (Check::Steering, |m| m.steer_counts = Some((2000, 2010))),
+            (Check::Steering, |m| m.steer_counts = Some((0, 900))),
+            (Check::Steering, |m| m.steer_counts = Some((3000, 4095))),
+            (Check::Wheel, |m| m.wheel_edges = 49),
+            (Check::Gps, |m| m.gps_baud = None),
+            (Check::Card, |m| m.card_kib_s = Some((50, 1800))),
+            (Check::Card, |m| m.card_free_mib = 10),
+            (Check::Clock, |m| m.crystal = false),
+            (Check::Reset, |m| m.reset = Some(ResetCause::Watchdog)),
+        ];
+        for (check, spoil) in cases {
+            let mut m = good();
+            spoil(&mut m);
+            let failed: Vec<Check> = CHECKS
+                .into_iter()
+                .filter(|c| c.verdict(&m) == Verdict::Fail)
+                .collect();
+            assert_eq!(failed, [check], "{m:?}");
+            let code = CHECKS.iter().position(|&c| c == check).unwrap() as u8 + 1;
+            assert_eq!(failure_code(&m), code);
+        }
+    }
+
+    #[test]
+    fn the_report_reads_back_line_for_line() {
+        let mut m = good();
+        m.wheel_edges = 3;
+        let mut text = String::new();
+        write_report(&m, &mut text).unwrap();
+        assert!(text.starts_with("wobble self-test 1\nimu PASS who_am_i=0x47 accel_g=1.01\n"));
+        let mut lines = Vec::new();
+        read_report(&text, &mut |l| lines.push(l)).unwrap();
+        assert_eq!(lines.len(), CHECKS.len());
+        assert_eq!(
+            lines[2],
+            ReportLine {
+                check: "wheel",
+                verdict: Verdict::Fail,
+                detail: "edges=3 (spin the wheel)"
+            }
+        );
+        assert_eq!(
+            read_report("hello\n", &mut |_| {}),
+            Err(ReportError::NotAReport)
+        );
+        assert_eq!(
+            read_report("wobble self-test 1\nimu MAYBE x\n", &mut |_| {}),
+            Err(ReportError::BadLine(2))
+        );
+    }
+}

@@ -1,0 +1,71 @@
+//! Measured wobble episodes of card logs, from the `wobblog wobble`
+//! analysis, as points to compare with and fit the model to.
+
+use std::path::{Path, PathBuf};
+
+use wobble_model::fit::Observation;
+
+use super::figure::Measured;
+use crate::analysis::{find_episodes, Episode, Run};
+use crate::cmd::logs::{for_each_log, warn_losses};
+use crate::CliError;
+
+/// One episode with the log it came from.
+pub struct LoggedEpisode {
+    /// The log's file name.
+    pub log: String,
+    /// The episode.
+    pub episode: Episode,
+}
+
+impl LoggedEpisode {
+    /// Whether the episode may not be fitted. The analysis does not mark
+    /// censored episodes (cut by a gap or the end of the log) yet, so
+    /// every episode counts until it does.
+    #[must_use]
+    pub fn censored(&self) -> bool {
+        false
+    }
+
+    /// The point drawn for it.
+    #[must_use]
+    pub fn measured(&self) -> Measured {
+        Measured {
+            speed_mps: self.episode.speed_at_onset_mps,
+            sigma_per_s: self.episode.sigma_per_s,
+            freq_hz: self.episode.freq_hz,
+            censored: self.censored(),
+        }
+    }
+
+    /// The observation a fit uses.
+    #[must_use]
+    pub fn observation(&self) -> Observation {
+        Observation {
+            speed_mps: self.episode.speed_at_onset_mps,
+            freq_hz: self.episode.freq_hz,
+            sigma_per_s: self.episode.sigma_per_s,
+        }
+    }
+}
+
+/// Every episode of `logs`. A log that cannot be read is reported and
+/// skipped; the error then says so after the others were used.
+pub fn load(logs: &[PathBuf]) -> (Vec<LoggedEpisode>, Result<(), CliError>) {
+    let mut out = Vec::new();
+    let result = for_each_log(logs, "analysing", |log: &Path| {
+        let run = Run::load(log)?;
+        warn_losses(&run);
+        let name = run.name();
+        out.extend(
+            find_episodes(&run)
+                .into_iter()
+                .map(|episode| LoggedEpisode {
+                    log: name.clone(),
+                    episode,
+                }),
+        );
+        Ok(())
+    });
+    (out, result)
+}

@@ -1,0 +1,236 @@
+//! Eigenvalues against speed in the seed paper's Figure 4 layout: the real
+//! part (1/s) above, the imaginary part as a frequency (Hz) below, one
+//! colour per mode. Several sweeps can share the figure, told apart by line
+//! style (standard thick, half thin, double dotted as in Figures 7, 9-11),
+//! and measured points can be laid over it (Figure 8).
+
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use wobble_model::sweep::REAL_TOL;
+use wobble_model::{Mode, Sweep};
+
+use crate::plot::{padded_range, Figure, FONT};
+
+/// How a sweep's lines are drawn.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Line {
+    /// The standard: solid, thick.
+    Thick,
+    /// Solid, thin.
+    Thin,
+    /// Dotted.
+    Dotted,
+    /// Dashed (a second model).
+    Dashed,
+}
+
+/// One sweep on the figure.
+pub struct Layer {
+    /// Legend text.
+    pub label: String,
+    /// Its eigenvalues.
+    pub sweep: Sweep,
+    /// Its line style.
+    pub line: Line,
+}
+
+/// A measured point: speed, real part, frequency, and whether it may be
+/// fitted (censored points are drawn open).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Measured {
+    /// Speed at onset, m/s.
+    pub speed_mps: f64,
+    /// Growth rate sigma, 1/s.
+    pub sigma_per_s: f64,
+    /// Frequency, Hz.
+    pub freq_hz: f64,
+    /// Censored: drawn open, never fitted.
+    pub censored: bool,
+}
+
+/// The figure.
+pub struct EigenFigure {
+    /// Title.
+    pub title: String,
+    /// Sweeps, drawn in order.
+    pub layers: Vec<Layer>,
+    /// Modes drawn (others left out).
+    pub modes: Vec<Mode>,
+    /// Measured points.
+    pub measured: Vec<Measured>,
+}
+
+fn colour(mode: Mode) -> RGBColor {
+    match mode {
+        Mode::Wobble => RGBColor(0xd6, 0x27, 0x28),
+        Mode::Weave => RGBColor(0x1f, 0x4e, 0x9a),
+        Mode::Capsize => RGBColor(0x2c, 0xa0, 0x2c),
+        Mode::Castering => RGBColor(0xff, 0x7f, 0x0e),
+        Mode::Lean => RGBColor(0x94, 0x67, 0xbd),
+        Mode::Twist => RGBColor(0x8c, 0x56, 0x4b),
+        Mode::Other => RGBColor(0x9f, 0x9f, 0x9f),
+    }
+}
+
+/// Points of one panel for a branch, split where the value is missing.
+fn runs(speeds: &[f64], values: impl Iterator<Item = Option<f64>>) -> Vec<Vec<(f64, f64)>> {
+    let mut out: Vec<Vec<(f64, f64)>> = vec![Vec::new()];
+    for (&u, v) in speeds.iter().zip(values) {
+        match v {
+            Some(v) if v.is_finite() => out.last_mut().into_iter().for_each(|r| r.push((u, v))),
+            _ => out.push(Vec::new()),
+        }
+    }
+    out.retain(|r| r.len() > 1);
+    out
+}
+
+impl EigenFigure {
+    fn branches(&self) -> impl Iterator<Item = (&Layer, &wobble_model::Branch)> {
+        self.layers.iter().flat_map(move |l| {
+            l.sweep
+                .branches
+                .iter()
+                .filter(|b| self.modes.contains(&b.mode))
+                .map(move |b| (l, b))
+        })
+    }
+
+    fn panel<DB: DrawingBackend>(
+        &self,
+        area: &DrawingArea<DB, Shift>,
+        frequency: bool,
+    ) -> Result<(), String> {
+        let err = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
+        let pick = |v: wobble_model::Complex<f64>| {
+            if frequency {
+                (v.im > REAL_TOL).then_some(v.im / std::f64::consts::TAU)
+            } else {
+                Some(v.re)
+            }
+        };
+        let speeds = self
+            .layers
+            .iter()
+            .flat_map(|l| l.sweep.speeds_mps.iter().copied());
+        let x = padded_range(speeds, 1.0);
+        let x = x.start.max(0.0)..x.end;
+        let ys = self
+            .branches()
+            .flat_map(|(_, b)| b.values.iter().filter_map(|v| pick(*v)))
+            .chain(
+                self.measured
+                    .iter()
+                    .map(|m| if frequency { m.freq_hz } else { m.sigma_per_s }),
+            )
+            // The zero line of the real part is what the figure is about.
+            .chain((!frequency).then_some(0.0));
+        let y = padded_range(ys, 1.0);
+        let (caption, y_desc) = if frequency {
+            ("", "frequency (Hz)")
+        } else {
+            (self.title.as_str(), "real part (1/s)")
+        };
+        let mut chart = ChartBuilder::on(area)
+            .caption(caption, (FONT, 20))
+            .margin(12)
+            .x_label_area_size(36)
+            .y_label_area_size(56)
+            .build_cartesian_2d(x.clone(), y)
+            .map_err(err)?;
+        chart
+            .configure_mesh()
+            .x_desc("forward speed (m/s)")
+            .y_desc(y_desc)
+            .label_style((FONT, 13))
+            .axis_desc_style((FONT, 15))
+            .draw()
+            .map_err(err)?;
+        if !frequency {
+            chart
+                .draw_series(std::iter::once(PathElement::new(
+                    vec![(x.start, 0.0), (x.end, 0.0)],
+                    BLACK.stroke_width(1),
+                )))
+                .map_err(err)?;
+        }
+        let mut labelled: Vec<(Mode, String)> = Vec::new();
+        for (layer, branch) in self.branches() {
+            let c = colour(branch.mode);
+            for run in runs(
+                &layer.sweep.speeds_mps,
+                branch.values.iter().map(|v| pick(*v)),
+            ) {
+                let series = match layer.line {
+                    Line::Thick => chart.draw_series(LineSeries::new(run, c.stroke_width(3))),
+                    Line::Thin => chart.draw_series(LineSeries::new(run, c.stroke_width(1))),
+                    Line::Dotted => {
+                        chart.draw_series(DashedLineSeries::new(run, 2, 4, c.stroke_width(2)))
+                    }
+                    Line::Dashed => {
+                        chart.draw_series(DashedLineSeries::new(run, 8, 6, c.stroke_width(2)))
+                    }
+                }
+                .map_err(err)?;
+                let key = (branch.mode, layer.label.clone());
+                if !frequency && !labelled.contains(&key) {
+                    let name = if self.layers.len() > 1 {
+                        format!("{} ({})", branch.mode, layer.label)
+                    } else {
+                        branch.mode.to_string()
+                    };
+                    let width = if layer.line == Line::Thin { 1 } else { 3 };
+                    series.label(name).legend(move |(px, py)| {
+                        PathElement::new(vec![(px, py), (px + 18, py)], c.stroke_width(width))
+                    });
+                    labelled.push(key);
+                }
+            }
+        }
+        let dot = |m: &Measured| {
+            let at = (
+                m.speed_mps,
+                if frequency { m.freq_hz } else { m.sigma_per_s },
+            );
+            let style = if m.censored {
+                BLACK.stroke_width(2)
+            } else {
+                BLACK.filled()
+            };
+            Circle::new(at, 4, style)
+        };
+        if !self.measured.is_empty() {
+            let s = chart
+                .draw_series(self.measured.iter().map(dot))
+                .map_err(err)?;
+            if !frequency {
+                s.label("measured (open: censored)")
+                    .legend(|(px, py)| Circle::new((px + 8, py), 4, BLACK.filled()));
+            }
+        }
+        if !frequency {
+            chart
+                .configure_series_labels()
+                .label_font((FONT, 13))
+                .background_style(WHITE.mix(0.85))
+                .border_style(BLACK)
+                .position(SeriesLabelPosition::LowerLeft)
+                .draw()
+                .map_err(err)?;
+        }
+        Ok(())
+    }
+}
+
+impl Figure for EigenFigure {
+    fn size_px(&self) -> (u32, u32) {
+        (1000, 900)
+    }
+
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String> {
+        root.fill(&WHITE).map_err(|e| e.to_string())?;
+        let (top, bottom) = root.split_vertically(480);
+        self.panel(&top, false)?;
+        self.panel(&bottom, true)
+    }
+}

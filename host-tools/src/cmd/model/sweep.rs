@@ -1,0 +1,112 @@
+//! `wobblog model sweep`: one parameter scaled by several factors, the
+//! critical speeds of each variant, and the seed paper's Figures 7, 9-11
+//! (standard thick, smaller factors thin, larger dotted).
+
+use std::fmt::Write as _;
+use std::io::Write as _;
+use std::path::PathBuf;
+
+use wobble_model::{critical_speeds, Mode, Model, ParamSet};
+
+use super::eig::describe;
+use super::figure::{EigenFigure, Layer, Line};
+use super::{param_error, sweep, Speeds};
+use crate::output::Output;
+use crate::plot::{render, ImageKind};
+use crate::CliError;
+
+/// Arguments of `wobblog model sweep`.
+#[derive(clap::Args)]
+pub struct Args {
+    /// Parameter file (TOML or BicycleParameters `*Benchmark.txt`).
+    pub params: PathBuf,
+    /// The parameter to vary, as named in the file (`section.key`).
+    #[arg(long)]
+    pub param: String,
+    /// Factors to scale it by, comma-separated.
+    #[arg(long, value_delimiter = ',', default_value = "0.5,1,2")]
+    pub factors: Vec<f64>,
+    /// Speeds FROM:TO:STEP, m/s.
+    #[arg(long, default_value = "0:10:0.05")]
+    pub speeds: Speeds,
+    /// Also draw the figure into this `.png` or `.svg` file.
+    #[arg(short, long)]
+    pub output: Option<PathBuf>,
+}
+
+/// One variant of the parameter set.
+pub fn variant(set: &ParamSet, key: &str, factor: f64) -> Result<ParamSet, CliError> {
+    let mut v = set.clone();
+    let value = v.value(key).map_err(|e| param_error(&e))?;
+    v.set_value(key, value * factor, &format!("{factor} x the file's value"))
+        .map_err(|e| param_error(&e))?;
+    Ok(v)
+}
+
+/// Runs `wobblog model sweep`.
+pub fn run(args: &Args) -> Result<(), CliError> {
+    if let Some(o) = &args.output {
+        ImageKind::of(o)?;
+    }
+    if args.factors.iter().any(|f| !f.is_finite() || *f <= 0.0) {
+        return Err(CliError::Usage("--factors must be positive numbers".into()));
+    }
+    let set = ParamSet::load(&args.params).map_err(|e| param_error(&e))?;
+    let out = args
+        .output
+        .as_deref()
+        .map(|o| Output::create(o, &[&args.params]))
+        .transpose()?;
+    let mut text = String::new();
+    let mut layers = Vec::new();
+    for &factor in &args.factors {
+        let model =
+            Model::from_set(&variant(&set, &args.param, factor)?).map_err(|e| param_error(&e))?;
+        let s = sweep(&model, &args.speeds.0, &args.params)?;
+        let _ = writeln!(
+            text,
+            "{} x {factor} ({}):",
+            args.param,
+            value_text(&set, &args.param, factor)
+        );
+        let critical = critical_speeds(&model, &s);
+        if critical.is_empty() {
+            text.push_str("  no critical speed in this speed range\n");
+        }
+        for c in &critical {
+            let _ = writeln!(text, "  {}", describe(c));
+        }
+        let line = if (factor - 1.0).abs() < 1e-12 {
+            Line::Thick
+        } else if factor < 1.0 {
+            Line::Thin
+        } else {
+            Line::Dotted
+        };
+        layers.push(Layer {
+            label: format!("x {factor}"),
+            sweep: s,
+            line,
+        });
+    }
+    let mut stdout = Output::stdout();
+    stdout
+        .write_all(text.as_bytes())
+        .map_err(|e| stdout.error(e))?;
+    stdout.commit()?;
+    if let Some(out) = out {
+        let figure = EigenFigure {
+            title: format!("{}: {} x {:?}", set.name, args.param, args.factors),
+            layers,
+            modes: vec![Mode::Wobble, Mode::Weave],
+            measured: Vec::new(),
+        };
+        render(&figure, out)?;
+    }
+    Ok(())
+}
+
+fn value_text(set: &ParamSet, key: &str, factor: f64) -> String {
+    set.quantity(key)
+        .map_or_else(String::new, |q| format!("{} {}", q.value * factor, q.unit))
+}

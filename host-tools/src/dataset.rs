@@ -1,0 +1,312 @@
+//! A campaign as one Hive-partitioned Parquet dataset: the frames of every
+//! run under `run=NNNNN/part-0.parquet` (under `card=NAME/` as well for a
+//! folder of cards), beside `runs.parquet` (one row per run, as `wobblog
+//! summary`) and `episodes.parquet` (one row per wobble episode, as
+//! `wobblog wobble`), so DuckDB or Polars query a season at once.
+
+use std::path::{Path, PathBuf};
+
+use crate::analysis::{find_episodes, Episode, Run, Stability};
+use crate::cmd::summary::{logs_in, RunRow};
+use crate::export::columns::{Column, Kind, Value};
+use crate::export::parquet::ParquetWriter;
+use crate::output::Output;
+use crate::CliError;
+
+/// One log of the campaign and where it goes.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct LogEntry {
+    /// The card's directory name, for a folder of cards.
+    pub card: Option<String>,
+    /// Run number: from the file name `RUNnnnnn.WBL`.
+    pub run: u32,
+    /// The log file.
+    pub path: PathBuf,
+}
+
+impl LogEntry {
+    /// The partition directory, relative to the dataset.
+    #[must_use]
+    pub fn partition(&self) -> PathBuf {
+        let run = PathBuf::from(format!("run={:05}", self.run));
+        match &self.card {
+            Some(card) => Path::new(&format!("card={card}")).join(run),
+            None => run,
+        }
+    }
+}
+
+/// The run number in a log's file name (`RUN00003.WBL` is 3).
+fn run_number(path: &Path) -> Option<u32> {
+    let stem = path.file_stem()?.to_string_lossy().to_ascii_uppercase();
+    stem.strip_prefix("RUN")?.parse().ok()
+}
+
+/// The logs of `dir`: a card (logs at its top) or a folder of cards (one
+/// level of subdirectories holding logs), in name order.
+///
+/// # Errors
+/// An unreadable directory, no logs, a log whose name carries no run
+/// number, or two logs of one card with the same run number.
+pub fn campaign_logs(dir: &Path) -> Result<Vec<LogEntry>, CliError> {
+    let mut cards: Vec<(Option<String>, Vec<PathBuf>)> = Vec::new();
+    let top = logs_in(dir)?;
+    if top.is_empty() {
+        let mut subdirs: Vec<PathBuf> = std::fs::read_dir(dir)
+            .map_err(|e| CliError::file(dir, e))?
+            .filter_map(|e| e.ok().map(|e| e.path()))
+            .filter(|p| p.is_dir())
+            .collect();
+        subdirs.sort();
+        for sub in subdirs {
+            let logs = logs_in(&sub)?;
+            if !logs.is_empty() {
+                let name = sub.file_name().map(|n| n.to_string_lossy().into_owned());
+                cards.push((name, logs));
+            }
+        }
+    } else {
+        cards.push((None, top));
+    }
+    let mut entries: Vec<LogEntry> = Vec::new();
+    for (card, logs) in cards {
+        for path in logs {
+            let run = run_number(&path).ok_or_else(|| {
+                CliError::file(&path, "no run number in the name (expected RUNnnnnn.WBL)")
+            })?;
+            let entry = LogEntry {
+                card: card.clone(),
+                run,
+                path,
+            };
+            if let Some(twin) = entries.iter().find(|e| e.partition() == entry.partition()) {
+                return Err(CliError::file(
+                    &entry.path,
+                    format!("the same run number as {}", twin.path.display()),
+                ));
+            }
+            entries.push(entry);
+        }
+    }
+    if entries.is_empty() {
+        return Err(CliError::file(
+            dir,
+            "no *.WBL logs here or in its subdirectories",
+        ));
+    }
+    Ok(entries)
+}
+
+/// One run's row of `runs.parquet`.
+pub struct RunsRow {
+    entry: LogEntry,
+    row: RunRow,
+    first_utc_us: Option<i64>,
+    firmware: Option<String>,
+}
+
+/// One episode's row of `episodes.parquet`.
+pub struct EpisodesRow {
+    entry: LogEntry,
+    episode: Episode,
+}
+
+/// The identifying columns every table starts with.
+macro_rules! identity {
+    ($t:ty) => {
+        [
+            Column::<$t> {
+                name: "card",
+                kind: Kind::Text,
+                value: |r| Value::Text(r.entry.card.clone()),
+            },
+            Column::<$t> {
+                name: "run",
+                kind: Kind::Integer,
+                value: |r| Value::Integer(Some(i64::from(r.entry.run))),
+            },
+            Column::<$t> {
+                name: "log",
+                kind: Kind::Text,
+                value: |r| {
+                    Value::Text(
+                        r.entry
+                            .path
+                            .file_name()
+                            .map(|n| n.to_string_lossy().into_owned()),
+                    )
+                },
+            },
+        ]
+    };
+}
+
+/// A column of numbers of a table row type.
+macro_rules! number {
+    ($t:ty, $name:literal, $r:ident => $value:expr) => {
+        Column::<$t> {
+            name: $name,
+            kind: Kind::OptNumber,
+            value: |$r| Value::Number($value),
+        }
+    };
+}
+
+/// A column of counts of a table row type.
+macro_rules! count {
+    ($t:ty, $name:literal, $r:ident => $value:expr) => {
+        Column::<$t> {
+            name: $name,
+            kind: Kind::Integer,
+            value: |$r| Value::Integer(i64::try_from($value).ok()),
+        }
+    };
+}
+
+/// The columns of `runs.parquet`: `wobblog summary`'s, with the run's
+/// identity and first UTC.
+fn runs_columns() -> Vec<Column<RunsRow>> {
+    let mut columns = identity!(RunsRow).to_vec();
+    columns.extend([
+        number!(RunsRow, "duration_s", r => Some(r.row.duration_s)),
+        number!(RunsRow, "distance_m", r => Some(r.row.distance_m)),
+        number!(RunsRow, "max_speed_mps", r => Some(r.row.max_speed_mps)),
+        count!(RunsRow, "episodes", r => r.row.episodes),
+        count!(RunsRow, "unstable_episodes", r => r.row.unstable_episodes),
+        number!(RunsRow, "wobble_speed_mps", r => r.row.wobble_speed_mps),
+        count!(RunsRow, "frames_lost", r => r.row.frames_lost),
+        count!(RunsRow, "lost_blocks", r => r.row.lost_blocks),
+        Column {
+            name: "first_utc",
+            kind: Kind::Utc,
+            value: |r| Value::Utc(r.first_utc_us),
+        },
+        Column {
+            name: "firmware",
+            kind: Kind::Text,
+            value: |r| Value::Text(r.firmware.clone()),
+        },
+    ]);
+    columns
+}
+
+/// The columns of `episodes.parquet`: `wobblog wobble`'s fields.
+fn episodes_columns() -> Vec<Column<EpisodesRow>> {
+    let mut columns = identity!(EpisodesRow).to_vec();
+    columns.extend([
+        number!(EpisodesRow, "onset_s", r => Some(r.episode.onset_s)),
+        number!(EpisodesRow, "end_s", r => Some(r.episode.end_s)),
+        number!(EpisodesRow, "peak_s", r => Some(r.episode.peak_s)),
+        number!(EpisodesRow, "freq_hz", r => Some(r.episode.freq_hz)),
+        number!(EpisodesRow, "sigma_per_s", r => Some(r.episode.sigma_per_s)),
+        number!(EpisodesRow, "peak_amp_deg", r => Some(r.episode.peak_amp_deg)),
+        number!(EpisodesRow, "speed_at_onset_mps", r => Some(r.episode.speed_at_onset_mps)),
+        Column {
+            name: "stability",
+            kind: Kind::Label,
+            value: |r| {
+                Value::Label(Some(match r.episode.stability {
+                    Stability::Stable => "stable",
+                    Stability::Unstable => "unstable",
+                }))
+            },
+        },
+    ]);
+    columns
+}
+
+/// Writes `rows` as the Parquet file `path`.
+fn write_table<R>(path: &Path, columns: &[Column<R>], rows: &[R]) -> Result<(), CliError> {
+    let mut out = Output::create(path, &[])?;
+    let mut writer = ParquetWriter::new(&mut out, columns);
+    let pairs = vec![(
+        "wobblog.version".to_string(),
+        env!("CARGO_PKG_VERSION").to_string(),
+    )];
+    rows.iter()
+        .try_for_each(|r| writer.write(r))
+        .and_then(|()| writer.finish_with(pairs))
+        .map_err(|e| CliError::file(path, e))?;
+    drop(writer);
+    out.commit()
+}
+
+/// Writes the dataset of `entries` into `dir` (which must exist and be
+/// empty); `progress` is called after each log.
+///
+/// # Errors
+/// The first log that cannot be read, or an output that cannot be written.
+pub fn write_dataset(
+    entries: &[LogEntry],
+    dir: &Path,
+    mut progress: impl FnMut(&LogEntry, &Run),
+) -> Result<(), CliError> {
+    let mut runs = Vec::new();
+    let mut episodes = Vec::new();
+    for entry in entries {
+        let partition = dir.join(entry.partition());
+        std::fs::create_dir_all(&partition).map_err(|e| CliError::file(&partition, e))?;
+        let part = partition.join("part-0.parquet");
+        let mut out = Output::create(&part, &[&entry.path])?;
+        let export = crate::cmd::decode::Export::all(crate::export::Format::Parquet);
+        crate::cmd::decode::decode_to(&entry.path, &export, &mut out, &part)?;
+        out.commit()?;
+        let run = Run::load(&entry.path)?;
+        progress(entry, &run);
+        episodes.extend(find_episodes(&run).into_iter().map(|episode| EpisodesRow {
+            entry: entry.clone(),
+            episode,
+        }));
+        runs.push(RunsRow {
+            entry: entry.clone(),
+            row: RunRow::of(&run),
+            first_utc_us: run.summary.utc_syncs.first().map(|p| p.1 * 1000),
+            firmware: run.summary.firmware.clone(),
+        });
+    }
+    write_table(&dir.join("runs.parquet"), &runs_columns(), &runs)?;
+    write_table(
+        &dir.join("episodes.parquet"),
+        &episodes_columns(),
+        &episodes,
+    )
+}
+
+/// Builds the dataset of `entries` at `target` whole or not at all: in a
+/// temporary directory beside it, renamed to `target` once complete.
+///
+/// # Errors
+/// `target` exists already (a dataset is never merged into or replaced), or
+/// any failure of [`write_dataset`]; nothing is left behind then.
+pub fn build(
+    entries: &[LogEntry],
+    target: &Path,
+    progress: impl FnMut(&LogEntry, &Run),
+) -> Result<(), CliError> {
+    if target.exists() {
+        return Err(CliError::file(
+            target,
+            "exists already; a dataset is written whole into a new directory",
+        ));
+    }
+    let parent = match target.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    let name = target
+        .file_name()
+        .map_or_else(String::new, |n| n.to_string_lossy().into_owned());
+    let temp = tempfile::Builder::new()
+        .prefix(&format!(".{name}."))
+        .suffix(".tmp")
+        .tempdir_in(parent)
+        .map_err(|e| CliError::file(target, format!("cannot create the dataset: {e}")))?;
+    write_dataset(entries, temp.path(), progress)?;
+    // A non-empty directory that appeared at `target` meanwhile makes the
+    // rename fail rather than be replaced.
+    std::fs::rename(temp.path(), target)
+        .map_err(|e| CliError::file(target, format!("cannot move the dataset in place: {e}")))?;
+    // The directory moved; there is nothing left to clean up.
+    let _ = temp.keep();
+    Ok(())
+}

@@ -1,0 +1,75 @@
+//! `wobblog selftest`: a report the firmware's own writer made is printed
+//! check by check with the failures named; anything else is a clear error.
+
+use std::path::Path;
+
+use assert_cmd::Command;
+use wobble_core::boot::ResetCause;
+use wobble_core::selftest::{write_report, Measurements};
+
+fn run(path: &Path) -> (Option<i32>, String, String) {
+    let out = Command::cargo_bin("wobblog")
+        .unwrap()
+        .arg("selftest")
+        .arg(path)
+        .output()
+        .unwrap();
+    (
+        out.status.code(),
+        String::from_utf8(out.stdout).unwrap(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+#[test]
+fn a_report_is_printed_with_its_failures_named() {
+    let m = Measurements {
+        imu_id: Some(0x47),
+        accel_g: Some(0.99),
+        steer_counts: Some((1500, 2500)),
+        wheel_edges: 0,
+        gps_baud: Some(38_400),
+        gps_rate_hz: 20,
+        card_kib_s: Some((700, 1500)),
+        card_free_mib: 7_000,
+        crystal: true,
+        reset: Some(ResetCause::Watchdog),
+    };
+    let mut text = String::new();
+    write_report(&m, &mut text).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("SELFTEST.TXT");
+    std::fs::write(&path, &text).unwrap();
+    let (code, stdout, stderr) = run(&path);
+    assert_eq!(code, Some(0), "{stderr}");
+    let lines: Vec<&str> = stdout.lines().collect();
+    assert_eq!(lines.len(), 8, "{stdout}");
+    assert!(
+        lines[0].starts_with("imu       pass  who_am_i=0x47"),
+        "{stdout}"
+    );
+    assert!(lines[2].starts_with("wheel     FAIL  edges=0"), "{stdout}");
+    assert_eq!(
+        lines[7],
+        "failed: wheel, reset (see firmware/docs/board.md, bring-up)"
+    );
+    // The input is never touched.
+    assert_eq!(std::fs::read_to_string(&path).unwrap(), text);
+}
+
+#[test]
+fn a_file_that_is_no_report_is_an_error_naming_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("CONFIG.TXT");
+    std::fs::write(&path, "wheel.circumference_m=2.1\n").unwrap();
+    let (code, stdout, stderr) = run(&path);
+    assert_eq!(code, Some(1));
+    assert!(stdout.is_empty());
+    assert!(
+        stderr.contains("CONFIG.TXT: not a self-test report"),
+        "{stderr}"
+    );
+    let (code, _, stderr) = run(&dir.path().join("missing.txt"));
+    assert_eq!(code, Some(1));
+    assert!(stderr.contains("missing.txt"), "{stderr}");
+}
