@@ -23,12 +23,19 @@
 //!    [`ONSET_AMP_DEG`]: the wobble's start "from nothing", independent of
 //!    where the noise floor happens to be. A stable episode starts where it
 //!    was struck.
+//! 5. Each stretch between gaps is analysed alone, so no fit reaches across
+//!    a gap. An episode that reaches a lost block, a dropout, a time jump or
+//!    an end of the data is **censored** (see [`super::censor`]): its onset
+//!    is not placed before the cut, its peak and end are only what was seen,
+//!    and one that starts at a cut is never called stable (its strike was
+//!    not seen: a ring-down from a gap's edge would be a mode made up).
 
 use std::f64::consts::TAU;
 use std::ops::Range;
 
 use serde::Serialize;
 
+use super::censor::{span_cuts, Cut};
 use super::filter::{contiguous_spans, wobble_band, Biquad, Pass};
 use super::run::Run;
 use super::sinefit::{fit_mode, SineFit};
@@ -104,9 +111,27 @@ pub struct Episode {
     pub stability: Stability,
     /// The stretch the envelope fit used, s since boot.
     pub fit_s: [f64; 2],
+    /// Whether the data do not show the whole episode: it reaches a cut
+    /// (below). Its onset, peak or end are then bounds only.
+    pub censored: bool,
+    /// What cuts it at its start, if the data do not show it starting.
+    pub cut_at_start: Option<Cut>,
+    /// What cuts it at its end, if the data do not show it ending.
+    pub cut_at_end: Option<Cut>,
 }
 
 impl Episode {
+    /// What cuts the episode, in words (`start: lost_blocks, end:
+    /// data_end`); empty when the data show it whole.
+    #[must_use]
+    pub fn cuts_text(&self) -> String {
+        let parts: Vec<String> = [("start", self.cut_at_start), ("end", self.cut_at_end)]
+            .into_iter()
+            .filter_map(|(edge, cut)| cut.map(|c| format!("{edge}: {}", c.as_str())))
+            .collect();
+        parts.join(", ")
+    }
+
     /// Imaginary part of the mode, `2 pi f`, rad/s.
     #[must_use]
     pub fn omega_rad_s(&self) -> f64 {
@@ -114,12 +139,13 @@ impl Episode {
     }
 }
 
-/// The wobble speed: the lowest speed at onset of an unstable episode, m/s.
+/// The wobble speed: the lowest speed at onset of an unstable episode
+/// whose onset the data show (not cut at its start), m/s.
 #[must_use]
 pub fn wobble_speed_mps(episodes: &[Episode]) -> Option<f64> {
     episodes
         .iter()
-        .filter(|e| e.stability == Stability::Unstable)
+        .filter(|e| e.stability == Stability::Unstable && e.cut_at_start.is_none())
         .map(|e| e.speed_at_onset_mps)
         .min_by(f64::total_cmp)
 }
@@ -131,7 +157,10 @@ pub fn find_episodes(run: &Run) -> Vec<Episode> {
     contiguous_spans(&run.t_s, 1.0 / fs_hz)
         .into_iter()
         .filter(|span| span.len() as f64 >= MIN_SPAN_S * fs_hz)
-        .flat_map(|span| Span::new(run, span).episodes())
+        .flat_map(|span| {
+            let cuts = span_cuts(run, &span);
+            Span::new(run, span, cuts).episodes()
+        })
         .collect()
 }
 
@@ -142,10 +171,12 @@ struct Span<'a> {
     band: Vec<f64>,
     energy: Vec<f64>,
     fs_hz: f64,
+    /// What cuts the stretch at its start and end.
+    cuts: (Cut, Cut),
 }
 
 impl<'a> Span<'a> {
-    fn new(run: &'a Run, span: Range<usize>) -> Self {
+    fn new(run: &'a Run, span: Range<usize>, cuts: (Cut, Cut)) -> Self {
         let fs_hz = run.sample_rate_hz();
         let band = wobble_band(&run.steer_deg[span.clone()], fs_hz);
         let mut energy: Vec<f64> = band.iter().map(|v| 2.0 * v * v).collect();
@@ -157,6 +188,7 @@ impl<'a> Span<'a> {
             band,
             energy,
             fs_hz,
+            cuts,
         }
     }
 
@@ -249,9 +281,12 @@ impl<'a> Span<'a> {
             let ok = (mode.sigma_per_s > 0.0) == growing && mode.residual_rel <= MAX_RESIDUAL_REL;
             ok.then_some((fitted, mode))
         };
+        // Quiet before it within the stretch, or it reaches the cut.
+        let starts_at_cut = region.start == 0;
         let (stability, range, mode) =
             match growth_range(&clean, local.clone(), floor, ceiling).and_then(|r| fit(r, true)) {
                 Some((r, mode)) => (Stability::Unstable, r, mode),
+                None if starts_at_cut => return None,
                 None => {
                     let (r, mode) = fit(decay_range(&clean, band, local.clone(), floor)?, false)?;
                     (Stability::Stable, r, mode)
@@ -261,10 +296,15 @@ impl<'a> Span<'a> {
         let onset_s = match stability {
             Stability::Unstable => {
                 let level = mode.log_amp - self.level_bias(t, top, &mode, range.clone());
-                (mode.t0_s + (ONSET_AMP_DEG.ln() - level) / mode.sigma_per_s).max(self.t_s[0])
+                mode.t0_s + (ONSET_AMP_DEG.ln() - level) / mode.sigma_per_s
             }
             Stability::Stable => self.t_s[region.start],
         };
+        // An onset before the stretch began would be extrapolated across
+        // the cut: the first frame after it is all the data say.
+        let cut_at_start = (starts_at_cut || onset_s < self.t_s[0]).then_some(self.cuts.0);
+        let onset_s = onset_s.max(self.t_s[0]);
+        let cut_at_end = (region.end >= self.t_s.len()).then_some(self.cuts.1);
         let end = region.end.min(self.t_s.len() - 1);
         Some(Episode {
             onset_s,
@@ -276,6 +316,9 @@ impl<'a> Span<'a> {
             speed_at_onset_mps: self.run.speed_around(onset_s, SPEED_HALF_WIDTH_S),
             stability,
             fit_s: [t[range.start], t[range.end - 1]],
+            censored: cut_at_start.is_some() || cut_at_end.is_some(),
+            cut_at_start,
+            cut_at_end,
         })
     }
 

@@ -1,12 +1,14 @@
 //! Offline analysis of a whole run: roll angle from the IMU, and wobble
 //! episodes measured as the seed paper does (frequency, growth rate, speed).
 
+pub mod censor;
 pub mod episodes;
 pub mod filter;
 pub mod roll;
 pub mod run;
 pub mod sinefit;
 
+pub use censor::Cut;
 pub use episodes::{find_episodes, wobble_speed_mps, Episode, Stability};
 pub use roll::estimate_roll_deg;
 pub use run::Run;

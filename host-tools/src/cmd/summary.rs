@@ -45,6 +45,9 @@ pub struct RunRow {
     pub episodes: usize,
     /// Of which unstable.
     pub unstable_episodes: usize,
+    /// Episodes the data do not show whole (cut by a gap or an end of the
+    /// data; counted in `episodes` too).
+    pub censored_episodes: usize,
     /// Lowest speed at onset of an unstable episode, m/s.
     pub wobble_speed_mps: Option<f64>,
     /// Frames lost: dropped by the logger plus held by blocks missing from
@@ -83,6 +86,7 @@ impl RunRow {
                 .iter()
                 .filter(|e| e.stability == Stability::Unstable)
                 .count(),
+            censored_episodes: episodes.iter().filter(|e| e.censored).count(),
             wobble_speed_mps: wobble_speed_mps(&episodes),
             frames_lost: s.frames_dropped + s.frames_lost,
             lost_blocks: s.lost_blocks,
@@ -128,7 +132,7 @@ fn opt(v: Option<f64>) -> String {
     v.map_or(String::new(), |v| format!("{v:.2}"))
 }
 
-fn cells(r: &RunRow) -> [String; 9] {
+fn cells(r: &RunRow) -> [String; 10] {
     [
         r.log.clone(),
         format!("{:.2}", r.duration_s),
@@ -136,19 +140,21 @@ fn cells(r: &RunRow) -> [String; 9] {
         format!("{:.2}", r.max_speed_mps),
         r.episodes.to_string(),
         r.unstable_episodes.to_string(),
+        r.censored_episodes.to_string(),
         opt(r.wobble_speed_mps),
         r.frames_lost.to_string(),
         r.lost_blocks.to_string(),
     ]
 }
 
-const HEADER: [&str; 9] = [
+const HEADER: [&str; 10] = [
     "log",
     "duration_s",
     "distance_m",
     "max_speed_mps",
     "episodes",
     "unstable_episodes",
+    "censored_episodes",
     "wobble_speed_mps",
     "frames_lost",
     "lost_blocks",
@@ -174,7 +180,7 @@ pub fn render(rows: &[RunRow], format: SummaryFormat) -> String {
             }
         }
         SummaryFormat::Table => {
-            let table: Vec<[String; 9]> = std::iter::once(HEADER.map(String::from))
+            let table: Vec<[String; 10]> = std::iter::once(HEADER.map(String::from))
                 .chain(rows.iter().map(cells))
                 .collect();
             let widths: Vec<usize> = (0..HEADER.len())

@@ -113,7 +113,7 @@ fn render_text(r: &RunEpisodes) -> String {
     if !r.episodes.is_empty() {
         let _ = writeln!(
             o,
-            "  onset_s    end_s  freq_hz  sigma_per_s  peak_amp_deg  speed_at_onset_mps  stability"
+            "  onset_s    end_s  freq_hz  sigma_per_s  peak_amp_deg  speed_at_onset_mps  stability  censored"
         );
     }
     for e in &r.episodes {
@@ -121,11 +121,17 @@ fn render_text(r: &RunEpisodes) -> String {
             Stability::Stable => "stable",
             Stability::Unstable => "unstable",
         };
-        let _ = writeln!(
-            o,
-            "  {:7.2}  {:7.2}  {:7.2}  {:11.2}  {:12.2}  {:18.2}  {stability}",
-            e.onset_s, e.end_s, e.freq_hz, e.sigma_per_s, e.peak_amp_deg, e.speed_at_onset_mps,
+        let line = format!(
+            "  {:7.2}  {:7.2}  {:7.2}  {:11.2}  {:12.2}  {:18.2}  {stability:<9}  {}",
+            e.onset_s,
+            e.end_s,
+            e.freq_hz,
+            e.sigma_per_s,
+            e.peak_amp_deg,
+            e.speed_at_onset_mps,
+            e.cuts_text(),
         );
+        let _ = writeln!(o, "{}", line.trim_end());
     }
     o
 }

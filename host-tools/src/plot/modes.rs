@@ -15,6 +15,10 @@ pub const Y_LABEL: &str = "imaginary part 2 pi f (rad/s)";
 /// Radius of an episode's dot, px.
 pub const DOT_PX: i32 = 5;
 
+/// Colour of censored episodes (cut by a gap or an end of the data), drawn
+/// hollow whatever their run.
+pub const CENSORED_COLOUR: RGBColor = RGBColor(0xa0, 0xa0, 0xa0);
+
 /// One colour per run, in turn: dark enough on white to tell apart.
 const RUN_COLOURS: [RGBColor; 8] = [
     RGBColor(0x1f, 0x4e, 0x9a),
@@ -56,7 +60,10 @@ impl Figure for ModePlot {
         let x = padded_range(self.all().map(|e| e.sigma_per_s).chain([0.0]), 2.0);
         let y = padded_range(self.all().map(Episode::omega_rad_s), 10.0);
         let mut chart = ChartBuilder::on(root)
-            .caption("Wobble modes (filled: unstable, open: stable)", (FONT, 20))
+            .caption(
+                "Wobble modes (filled: unstable, open: stable, grey: cut by a gap)",
+                (FONT, 20),
+            )
             .margin(16)
             .x_label_area_size(40)
             .y_label_area_size(60)
@@ -80,9 +87,11 @@ impl Figure for ModePlot {
             let colour = RUN_COLOURS[k % RUN_COLOURS.len()];
             chart
                 .draw_series(episodes.iter().map(|e| {
-                    let style = match e.stability {
-                        Stability::Unstable => colour.filled(),
-                        Stability::Stable => colour.stroke_width(2),
+                    let style = match (e.censored, e.stability) {
+                        // Only part of it was seen: hollow and grey.
+                        (true, _) => CENSORED_COLOUR.stroke_width(2),
+                        (false, Stability::Unstable) => colour.filled(),
+                        (false, Stability::Stable) => colour.stroke_width(2),
                     };
                     Circle::new((e.sigma_per_s, e.omega_rad_s()), DOT_PX, style)
                 }))

@@ -1,5 +1,6 @@
 //! The seed paper's Figure 6: steering angle, roll angle, yaw rate and speed
-//! stacked on one time axis, alert periods shaded, rider markers drawn.
+//! stacked on one time axis, alert periods shaded, rider markers drawn, and
+//! where the data are missing (lost blocks, forward time jumps) shaded too.
 
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -24,6 +25,8 @@ pub const ALERT_COLOUR: RGBColor = RGBColor(0xe0, 0x30, 0x30);
 pub const MARKER_COLOUR: RGBColor = RGBColor(0x20, 0x90, 0x30);
 /// Colour of stretches lost from the file (drawn with transparency).
 pub const LOST_COLOUR: RGBColor = RGBColor(0x70, 0x70, 0x70);
+/// Colour of forward jumps of the logger's clock (drawn with transparency).
+pub const JUMP_COLOUR: RGBColor = RGBColor(0xe0, 0x90, 0x10);
 /// Width of the y tick labels and axis title, px: room for `-1000.0`
 /// beside a two-line-free title in 14 px text.
 const Y_LABEL_AREA_PX: u32 = 84;
@@ -38,6 +41,9 @@ pub struct TimePlot {
     markers_s: Vec<f64>,
     /// Stretches lost from the file (missing blocks), s.
     lost_s: Vec<(f64, f64)>,
+    /// Forward jumps of the frame times, s: no data, and no time passed
+    /// that the logger saw.
+    jumps_s: Vec<(f64, f64)>,
     /// Sync pairs, when the time axis is labelled in UTC.
     utc: Option<Vec<SyncPair>>,
 }
@@ -106,6 +112,15 @@ impl TimePlot {
             .filter(|&(a, b)| overlaps(a, b))
             .map(|(a, b)| (a.max(window_s.start), b.min(window_s.end)))
             .collect();
+        let jumps_s = run
+            .summary
+            .losses
+            .time_jumps
+            .iter()
+            .copied()
+            .filter(|&(a, b)| a < b && overlaps(a, b))
+            .map(|(a, b)| (a.max(window_s.start), b.min(window_s.end)))
+            .collect();
         Some(Self {
             title: format!(
                 "{}: {:.1} to {:.1} s",
@@ -118,6 +133,7 @@ impl TimePlot {
             alerts_s,
             markers_s,
             lost_s,
+            jumps_s,
             utc: None,
         })
     }
@@ -154,6 +170,12 @@ impl TimePlot {
                 .map_or(String::new(), |iso| iso[11..19].to_string()),
             None => tick_label(t_s),
         }
+    }
+
+    /// Forward time jumps drawn, s.
+    #[must_use]
+    pub fn jumps_s(&self) -> &[(f64, f64)] {
+        &self.jumps_s
     }
 
     /// Alert periods drawn, s.
@@ -238,6 +260,14 @@ impl Figure for TimePlot {
                     )
                 });
             }
+            let jumps = chart
+                .draw_series(self.jumps_s.iter().map(|s| span(s, JUMP_COLOUR.mix(0.3))))
+                .map_err(err)?;
+            if k == 0 && !self.jumps_s.is_empty() {
+                jumps.label("time jump (logger clock)").legend(|(x, y)| {
+                    Rectangle::new([(x, y - 6), (x + 16, y + 6)], JUMP_COLOUR.mix(0.3).filled())
+                });
+            }
             let markers = chart
                 .draw_series(self.markers_s.iter().map(|&t| {
                     PathElement::new(
@@ -259,8 +289,10 @@ impl Figure for TimePlot {
                     .draw_series(LineSeries::new(points.iter().copied(), LINE_COLOUR))
                     .map_err(err)?;
             }
-            let keyed =
-                !(self.alerts_s.is_empty() && self.lost_s.is_empty() && self.markers_s.is_empty());
+            let keyed = !(self.alerts_s.is_empty()
+                && self.lost_s.is_empty()
+                && self.jumps_s.is_empty()
+                && self.markers_s.is_empty());
             if k == 0 && keyed {
                 chart
                     .configure_series_labels()
