@@ -349,7 +349,8 @@ mod tests {
 
     #[test]
     fn each_fault_fails_its_own_check_and_gives_its_code() {
-        let cases: [(Check, fn(&mut Measurements)); 12] = [
+        type Spoil = fn(&mut Measurements);
+        let cases: [(Check, Spoil); 12] = [
             (Check::Imu, |m| m.imu_id = Some(0x00)),
             (Check::Imu, |m| m.accel_g = Some(0.5)),
             (Check::Imu, |m| m.accel_g = None),
