@@ -215,3 +215,25 @@ fn compare_prints_residuals_and_fit_writes_the_fitted_file() {
         .unwrap()
         .contains(&format!("steer_head.damping = {:.6}", q.value)));
 }
+
+#[test]
+fn eig_whipple_gives_the_four_states_of_the_lumped_bicycle() {
+    let out = wobblog()
+        .args(["model", "eig"])
+        .arg(params("test-bicycle.toml"))
+        .args(["--whipple", "--speeds", "5:5:1", "--format", "csv"])
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    let text = String::from_utf8(out.stdout).unwrap();
+    let modes: Vec<&str> = text
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').nth(1).unwrap())
+        .collect();
+    assert_eq!(modes.len(), 4, "{text}");
+    assert!(
+        modes.contains(&"weave") && modes.contains(&"castering"),
+        "{text}"
+    );
+}

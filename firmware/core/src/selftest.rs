@@ -18,6 +18,8 @@
 
 use core::fmt::{self, Write};
 
+use embedded_sdmmc::{Block, BlockDevice, BlockIdx};
+
 use crate::boot::ResetCause;
 use crate::drivers::icm42688::reg::WHO_AM_I_VALUE;
 
@@ -162,7 +164,17 @@ impl Check {
             Self::Imu => match (m.imu_id, m.accel_g) {
                 (None, _) => out.write_str("no answer"),
                 (Some(id), None) => write!(out, "who_am_i=0x{id:02x} no samples"),
-                (Some(id), Some(g)) => write!(out, "who_am_i=0x{id:02x} accel_g={g:.2}"),
+                (Some(id), Some(g)) => {
+                    // Hundredths by integer arithmetic: no float formatting
+                    // code in the firmware for one figure (a magnitude, >= 0).
+                    let cg = (g * 100.0 + 0.5) as u32;
+                    write!(
+                        out,
+                        "who_am_i=0x{id:02x} accel_g={}.{:02}",
+                        cg / 100,
+                        cg % 100
+                    )
+                }
             },
             Self::Steering => match m.steer_counts {
                 None => out.write_str("no conversions"),
@@ -278,6 +290,37 @@ pub fn read_report<'a>(
     Ok(())
 }
 
+/// Free space of the card's first partition, MiB, from its FAT32 FSInfo
+/// sector: the free-cluster count the file system last recorded (kept by
+/// every FAT driver; embedded-sdmmc has no free-space query of its own).
+/// `None` for anything but a FAT32 volume with a known count.
+pub fn fat32_free_mib<D: BlockDevice>(card: &D) -> Option<u32> {
+    let mut block = [Block::new()];
+    let mut read = |idx: u32| -> Option<[u8; 512]> {
+        card.read(&mut block, BlockIdx(idx)).ok()?;
+        Some(block[0].contents)
+    };
+    let u16_at = |b: &[u8; 512], at: usize| u16::from_le_bytes([b[at], b[at + 1]]);
+    let u32_at =
+        |b: &[u8; 512], at: usize| u32::from_le_bytes([b[at], b[at + 1], b[at + 2], b[at + 3]]);
+    // MBR: partition entry 0 at 446, its first block at +8.
+    let mbr = read(0)?;
+    let start = u32_at(&mbr, 446 + 8);
+    let boot = read(start)?;
+    if u16_at(&boot, 11) != 512 || boot[13] == 0 {
+        return None;
+    }
+    let sectors_per_cluster = u32::from(boot[13]);
+    let fsinfo = read(start.checked_add(u32::from(u16_at(&boot, 48)))?)?;
+    let signed = u32_at(&fsinfo, 0) == 0x4161_5252 && u32_at(&fsinfo, 484) == 0x6141_7272;
+    let free_clusters = u32_at(&fsinfo, 488);
+    if !signed || free_clusters == u32::MAX {
+        return None;
+    }
+    let free_bytes = u64::from(free_clusters) * u64::from(sectors_per_cluster) * 512;
+    u32::try_from(free_bytes >> 20).ok()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -306,7 +349,8 @@ mod tests {
 
     #[test]
     fn each_fault_fails_its_own_check_and_gives_its_code() {
-        let cases: [(Check, fn(&mut Measurements)); 12] = [
+        type Spoil = fn(&mut Measurements);
+        let cases: [(Check, Spoil); 12] = [
             (Check::Imu, |m| m.imu_id = Some(0x00)),
             (Check::Imu, |m| m.accel_g = Some(0.5)),
             (Check::Imu, |m| m.accel_g = None),

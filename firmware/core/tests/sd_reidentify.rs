@@ -53,6 +53,17 @@ pub const HOOKS: CardHooks<Mock<u8>> = CardHooks {
     after_operation: count_operation,
 };
 
+/// The card under test on (clones of) the mocks.
+fn card(spi: &Mock<u8>, cs: &PinMock) -> Card<Mock<u8>, PinMock, NoopDelay> {
+    Card::new(
+        spi.clone(),
+        cs.clone(),
+        NoopDelay::new(),
+        HOOKS,
+        DATA_CLOCK_HZ,
+    )
+}
+
 fn csd_read() -> Spi {
     [command(9, 0, R1_READY), data_block(&csd())].concat()
 }
@@ -87,13 +98,7 @@ fn missing_then_inserted_then_pulled() {
     ]
     .concat();
     let mut chip_select = PinMock::new(&cs(&pins));
-    let card = Card::new(
-        spi.clone(),
-        chip_select.clone(),
-        NoopDelay::new(),
-        HOOKS,
-        DATA_CLOCK_HZ,
-    );
+    let card = card(&spi, &chip_select);
 
     assert!(matches!(card.num_blocks(), Err(SdCardError::CardNotFound)));
     assert_eq!(take_clocks(), [IDENTIFICATION_CLOCK_HZ]);
@@ -140,13 +145,7 @@ fn repeated_crc_errors_halve_the_data_clock() {
     pins.extend([&IDENTIFY_CS[..], &OPERATION_CS].concat());
     let mut spi = Mock::new(&expectations);
     let mut chip_select = PinMock::new(&cs(&pins));
-    let card = Card::new(
-        spi.clone(),
-        chip_select.clone(),
-        NoopDelay::new(),
-        HOOKS,
-        DATA_CLOCK_HZ,
-    );
+    let card = card(&spi, &chip_select);
     let mut blocks = [Block::new()];
     for _ in 0..CRC_ERRORS_BEFORE_SLOWING {
         let read = card.read(&mut blocks, BlockIdx(9));

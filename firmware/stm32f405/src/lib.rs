@@ -8,5 +8,6 @@
 pub mod adapters;
 pub mod clocks;
 pub mod pins;
+pub mod selftest;
 pub mod startup;
 pub mod watchdog;

@@ -18,11 +18,9 @@ use embassy_stm32::adc::{Adc, AdcChannel, Exten, RingBufferedAdc, SampleTime, CO
 use embassy_stm32::gpio::{Input, Level, Output, Pull, Speed};
 use embassy_stm32::interrupt;
 use embassy_stm32::interrupt::{InterruptExt, Priority};
-use embassy_stm32::mode::Async;
 use embassy_stm32::peripherals::{ADC1, IWDG};
 use embassy_stm32::spi::Spi;
 use embassy_stm32::time::Hertz;
-use embassy_stm32::usart::{self, RingBufferedUartRx, Uart, UartTx};
 use embassy_stm32::Peri;
 use embassy_time::{Delay, Instant};
 use embedded_hal_bus::spi::ExclusiveDevice;
@@ -126,8 +124,28 @@ fn main() -> ! {
         startup::blink_code(&mut led, code);
     }
 
+    let selftest = marker_held(&mut board);
     let (card, loaded) = card_and_config(board.card);
     let config = loaded.config;
+    if selftest {
+        let _wheel_timer = adapters::wheel::start(board.wheel);
+        let (_, ports) = sampler_parts(board.imu, board.steering, board.rider, &config);
+        let parts = wobble_stm32f405::selftest::Parts {
+            imu: ports.imu,
+            steering: ports.steering,
+            wheel: ports.wheel,
+            gps: GpsAdapter::new(board.gps, GPS_RING.init([0; adapters::gps::RING_BYTES])),
+            card,
+            buzzer: ports.alert.buzzer,
+            alert_led: ports.alert.led,
+            status_led: ports.status_led.led,
+            crystal,
+            reset,
+        };
+        EXECUTOR_THREAD.init(Executor::new()).run(move |thread| {
+            thread.spawn(defmt::unwrap!(selftest_task(parts)));
+        })
+    }
     let t_us = Instant::now().as_micros();
     for fault in loaded.faults.records(t_us) {
         QUEUE.push(Record::Fault(fault));
@@ -141,7 +159,7 @@ fn main() -> ! {
 
     let _wheel_timer = adapters::wheel::start(board.wheel);
     let (sampler, ports) = sampler_parts(board.imu, board.steering, board.rider, &config);
-    let (gps_tx, gps_rx) = gps_uart(board.gps);
+    let gps_port = GpsAdapter::new(board.gps, GPS_RING.init([0; adapters::gps::RING_BYTES]));
 
     interrupt::UART4.set_priority(Priority::P6);
     let high = EXECUTOR_HIGH.start(interrupt::UART4);
@@ -149,13 +167,22 @@ fn main() -> ! {
 
     interrupt::UART5.set_priority(Priority::P7);
     let medium = EXECUTOR_MEDIUM.start(interrupt::UART5);
-    medium.spawn(defmt::unwrap!(gps_task(gps_tx, gps_rx)));
+    medium.spawn(defmt::unwrap!(gps_task(gps_port)));
 
     let watchdog = board.watchdog;
     EXECUTOR_THREAD.init(Executor::new()).run(move |thread| {
         thread.spawn(defmt::unwrap!(writer_task(logger)));
         thread.spawn(defmt::unwrap!(watchdog_task(watchdog)));
     })
+}
+
+/// Whether the marker button is held at power-on: the rider asks for the
+/// field self-test instead of a ride.
+fn marker_held(board: &mut Board) -> bool {
+    let button = Input::new(board.rider.marker.reborrow(), Pull::Up);
+    // Let the pull-up charge the line before reading it.
+    embassy_time::block_for(embassy_time::Duration::from_millis(20));
+    button.is_low()
 }
 
 /// Opens the card and reads `CONFIG.TXT` (defaults without a card).
@@ -260,27 +287,6 @@ fn steering_adc(
     )
 }
 
-/// USART2 at the receivers' usual power-up rate; the GPS task finds theirs.
-fn gps_uart(pins: pins::GpsPins) -> (UartTx<'static, Async>, RingBufferedUartRx<'static>) {
-    let mut config = usart::Config::default();
-    config.baudrate = wobble_core::drivers::gnss_bringup::PROBE_BAUDS[0];
-    let uart = defmt::unwrap!(Uart::new(
-        pins.uart,
-        pins.rx,
-        pins.tx,
-        pins.tx_dma,
-        pins.rx_dma,
-        Irqs,
-        config
-    )
-    .ok());
-    let (tx, rx) = uart.split();
-    (
-        tx,
-        rx.into_ring_buffered(GPS_RING.init([0; adapters::gps::RING_BYTES])),
-    )
-}
-
 #[embassy_executor::task]
 async fn sampler_task(mut sampler: Sampler, mut ports: Ports) {
     sampler::run(
@@ -297,8 +303,7 @@ async fn sampler_task(mut sampler: Sampler, mut ports: Ports) {
 }
 
 #[embassy_executor::task]
-async fn gps_task(tx: UartTx<'static, Async>, rx: RingBufferedUartRx<'static>) {
-    let mut port = GpsAdapter::new(tx, rx);
+async fn gps_task(mut port: GpsAdapter) {
     let outcome = gps_setup::run(&mut port, &mut |step| defmt::info!("GPS set-up: {}", step)).await;
     defmt::info!("GPS: {}", outcome);
     if let Some(code) = outcome.fault() {
@@ -312,6 +317,11 @@ async fn gps_task(tx: UartTx<'static, Async>, rx: RingBufferedUartRx<'static>) {
     }
     let mut receiver = GpsReceiver::new(GpsConfig::default());
     gps::run(&mut port, &mut receiver, &QUEUE, &SHARED).await;
+}
+
+#[embassy_executor::task]
+async fn selftest_task(parts: wobble_stm32f405::selftest::Parts) {
+    wobble_stm32f405::selftest::run(parts).await
 }
 
 #[embassy_executor::task]

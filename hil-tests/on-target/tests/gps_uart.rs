@@ -9,14 +9,12 @@ use defmt_rtt as _;
 #[cfg(test)]
 #[embedded_test::tests]
 mod tests {
-    use embassy_stm32::usart::{self, Uart};
     use embassy_time::{Duration, Instant};
     use static_cell::StaticCell;
     use wobble_core::app::gps_setup::GpsLink;
     use wobble_core::app::ports::GpsPort;
     use wobble_core::drivers::gnss_bringup::SentenceCounter;
     use wobble_stm32f405::adapters::gps::{GpsAdapter, RING_BYTES};
-    use wobble_stm32f405::pins::Irqs;
 
     static RING: StaticCell<[u8; RING_BYTES]> = StaticCell::new();
 
@@ -25,19 +23,7 @@ mod tests {
 
     fn port() -> GpsAdapter {
         let (board, _) = wobble_on_target::board();
-        let pins = board.gps;
-        let uart = defmt::unwrap!(Uart::new(
-            pins.uart,
-            pins.rx,
-            pins.tx,
-            pins.tx_dma,
-            pins.rx_dma,
-            Irqs,
-            usart::Config::default(),
-        )
-        .ok());
-        let (tx, rx) = uart.split();
-        GpsAdapter::new(tx, rx.into_ring_buffered(RING.init([0; RING_BYTES])))
+        GpsAdapter::new(board.gps, RING.init([0; RING_BYTES]))
     }
 
     /// Sends `epochs` epochs at `hz`, reading back as it goes.

@@ -335,32 +335,42 @@ fn contact(chains: &Chains, frame: Frame, point: Vector3<f64>) -> Contact {
 /// `(phi, delta)`, comparable with the benchmark's closed forms.
 #[must_use]
 pub fn constrained_whipple(lin: &Linearised) -> [DMatrix<f64>; 4] {
-    let ind_w = [2 + PHI, 2 + DELTA];
-    let ind_q = [PHI, DELTA];
+    constrained(lin, &[PHI, DELTA])
+}
+
+/// The description with both contacts rolling without lateral slip and
+/// only the coordinates `keep` free (the others locked): `(M, C1, K0 g, K2)`
+/// of `M q'' + u C1 q' + (g K0 + u^2 K2) q = 0` in the kept coordinates.
+/// The lateral velocity and yaw rate follow from the two rolling
+/// constraints, `w = T q' + u E q`, and Kane's equations are projected on
+/// `T`.
+#[must_use]
+pub fn constrained(lin: &Linearised, keep: &[usize]) -> [DMatrix<f64>; 4] {
+    let n = keep.len();
     let mut a2 = DMatrix::zeros(2, 2);
-    let mut bw = DMatrix::zeros(2, 2);
-    let mut bq = DMatrix::zeros(2, 2);
+    let mut bw = DMatrix::zeros(2, n);
+    let mut bq = DMatrix::zeros(2, n);
     for (row, c) in lin.tyres.iter().enumerate() {
         a2[(row, 0)] = c.slip_w[(0, V)];
         a2[(row, 1)] = c.slip_w[(0, R)];
-        for (col, (&iw, &iq)) in ind_w.iter().zip(&ind_q).enumerate() {
-            bw[(row, col)] = c.slip_w[(0, iw)];
-            bq[(row, col)] = c.slip_q[(0, iq)];
+        for (col, &k) in keep.iter().enumerate() {
+            bw[(row, col)] = c.slip_w[(0, 2 + k)];
+            bq[(row, col)] = c.slip_q[(0, k)];
         }
     }
     let inv = a2.try_inverse().unwrap_or_else(|| DMatrix::zeros(2, 2));
     let dep_w = -&inv * bw;
     let dep_q = -&inv * bq;
-    let mut t = DMatrix::zeros(N_SPEEDS, 2);
-    let mut e = DMatrix::zeros(N_SPEEDS, 2);
-    for col in 0..2 {
+    let mut t = DMatrix::zeros(N_SPEEDS, n);
+    let mut e = DMatrix::zeros(N_SPEEDS, n);
+    for (col, &k) in keep.iter().enumerate() {
         t[(V, col)] = dep_w[(0, col)];
         t[(R, col)] = dep_w[(1, col)];
         e[(V, col)] = dep_q[(0, col)];
         e[(R, col)] = dep_q[(1, col)];
-        t[(ind_w[col], col)] = 1.0;
+        t[(2 + k, col)] = 1.0;
     }
-    let k_sub = lin.k.select_columns(&ind_q);
+    let k_sub = lin.k.select_columns(keep);
     let tt = t.transpose();
     [
         &tt * &lin.m * &t,
@@ -369,7 +379,6 @@ pub fn constrained_whipple(lin: &Linearised) -> [DMatrix<f64>; 4] {
         &tt * &lin.g * &e,
     ]
 }
-
 /// The tensor of a body in the plane of symmetry.
 #[must_use]
 pub fn planar_inertia(xx: f64, xz: f64, yy: f64, zz: f64) -> Matrix3<f64> {

@@ -1,17 +1,22 @@
-//! `wobblog detect`: replay a steering-angle CSV through the on-board wobble
-//! detector (the firmware's code and defaults) and print every alert change.
+//! `wobblog detect`: replay a card log (with the settings it was recorded
+//! with) or a steering-angle CSV (with the defaults) through the on-board
+//! wobble detector, the firmware's own code, and print every alert change.
 
 use std::io::{self, Read};
 use std::path::{Path, PathBuf};
 
 use wobble_core::config::Config;
-use wobble_core::detector::AlertEvent;
+use wobble_core::detector::{AlertEvent, Detector};
+use wobble_core::format::{Event, FaultSource};
 
 use crate::csv_input::{number_in, Cell, Step, TimeSteps};
+use crate::reader::read_log;
+use crate::rows::{Row, RowAssembler};
 use crate::CliError;
 
 const AFTER_HELP: &str = "\
-Input: a CSV with a header naming at least `t_s` (seconds) and `steer_deg`
+Input: a card log, replayed with the detector settings of its header (what
+`wobblog config LOG` prints), re-tuned with --set; or a CSV with a header naming at least `t_s` (seconds) and `steer_deg`
 (degrees), optionally `speed_mps` (m/s; empty cells mean unknown), sampled at
 100 Hz. Other columns are ignored, so `wobblog decode` output works as is.
 With the speed, the detector cancels the wheel-rotation harmonics as the
@@ -35,10 +40,19 @@ names the file, the line and what is wrong), 2 usage error.";
 /// Arguments of `wobblog detect`.
 #[derive(clap::Args)]
 #[command(after_help = AFTER_HELP)]
+#[command(group = clap::ArgGroup::new("input").required(true).args(["log", "csv"]))]
 pub struct Args {
-    /// The CSV to replay (`t_s,steer_deg[,speed_mps]` at 100 Hz).
+    /// A card log (`RUNnnnnn.WBL`) to replay with the detector settings in
+    /// its header.
+    pub log: Option<PathBuf>,
+    /// The CSV to replay (`t_s,steer_deg[,speed_mps]` at 100 Hz), with the
+    /// firmware's default settings.
     #[arg(long, value_name = "IN")]
-    pub csv: PathBuf,
+    pub csv: Option<PathBuf>,
+    /// Re-tune a setting for this replay (`detector.amp_on_deg=0.6`); the
+    /// keys of `CONFIG.TXT`, applied after the log's own. Repeatable.
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    pub set: Vec<String>,
     /// One JSON object per line for each alert change, nothing else.
     #[arg(long)]
     pub json: bool,
@@ -143,25 +157,116 @@ pub fn replay(path: &Path, input: impl Read, config: &Config) -> Result<Replay, 
             };
             cell.error(path, e)
         })?;
-        if let (Step::Gap(_), Some((t_prev, _))) = (step, last) {
+        let restart = matches!(step, Step::Gap(_)) && last.is_some();
+        out.push(&mut det, restart, line, t_s, steer, speed);
+        last = Some((t_s, line));
+    }
+    Ok(out)
+}
+
+impl Replay {
+    /// Feeds one sample to `det`, restarting it first if `restart` (a gap
+    /// before the sample at `place`, a line or frame number): an alert
+    /// still on is reported off at the previous sample.
+    fn push(
+        &mut self,
+        det: &mut Detector,
+        restart: bool,
+        place: u64,
+        t_s: f64,
+        steer_deg: f64,
+        speed_mps: Option<f64>,
+    ) {
+        if let (true, Some((_, t_prev))) = (restart, self.span_s) {
             if det.alert_active() {
-                out.changes.push(Change {
+                self.changes.push(Change {
                     t_s: t_prev,
                     event: AlertEvent::Off,
                 });
             }
             det.reset();
-            out.restarts.push(line);
+            self.restarts.push(place);
         }
-        last = Some((t_s, line));
-        out.samples += 1;
-        out.span_s = Some((out.span_s.map_or(t_s, |s| s.0), t_s));
+        self.samples += 1;
+        self.span_s = Some((self.span_s.map_or(t_s, |s| s.0), t_s));
         #[allow(clippy::cast_possible_truncation)] // degrees and m/s fit f32
-        if let Some(event) = det.push(steer as f32, speed.map(|v| v as f32)) {
-            out.changes.push(Change { t_s, event });
+        if let Some(event) = det.push(steer_deg as f32, speed_mps.map(|v| v as f32)) {
+            self.changes.push(Change { t_s, event });
         }
     }
+}
+
+/// Replays the frames of the card log at `path` through a fresh detector as
+/// `config` sets it up. A gap of more than 1.5 frame periods (lost blocks,
+/// dropouts) or a time jump restarts the detector; `restarts` holds the
+/// frame numbers (from 0) where it did.
+///
+/// # Errors
+/// The log cannot be read, or `config` does not make a detector.
+pub fn replay_log(path: &Path, config: &Config) -> Result<Replay, CliError> {
+    let mut det = config
+        .detector()
+        .map_err(|e| CliError::Usage(format!("detector: {e}")))?;
+    let period_s = 1.0 / f64::from(config.detector.sample_rate_hz).max(1.0);
+    let mut out = Replay {
+        has_speed: true,
+        ..Replay::default()
+    };
+    let mut rows = RowAssembler::new();
+    let mut feed = |row: &Row| {
+        let restart = out
+            .span_s
+            .is_some_and(|(_, last)| !(0.0..=1.5 * period_s).contains(&(row.t_s - last)));
+        let place = out.samples;
+        out.push(
+            &mut det,
+            restart,
+            place,
+            row.t_s,
+            row.steer_deg,
+            Some(row.speed_mps),
+        );
+    };
+    read_log(path, |event| {
+        if let Event::Record(record) = event {
+            rows.push(&record, &mut feed);
+        }
+    })?;
+    rows.finish(&mut feed);
     Ok(out)
+}
+
+/// The configuration a log was recorded with (its header's `CONFIG.TXT`
+/// lines, the defaults where it has none), re-tuned by `set` lines
+/// (`key=value`, applied after the header's).
+///
+/// # Errors
+/// A `set` line the configuration does not accept, as a usage error.
+pub fn log_config(header_lines: &[String], set: &[String]) -> Result<Config, CliError> {
+    let text: String = header_lines
+        .iter()
+        .chain(set)
+        .map(|l| format!("{l}\n"))
+        .collect();
+    let loaded = Config::parse(text.as_bytes());
+    let first_set_line = header_lines.len() + 1;
+    let bad: Vec<String> = loaded
+        .faults
+        .first()
+        .iter()
+        .filter(|f| usize::from(f.line) >= first_set_line || f.line == 0)
+        .map(|f| {
+            let what = crate::codes::fault_meaning(FaultSource::Config, f.code);
+            match set.get(usize::from(f.line).wrapping_sub(first_set_line)) {
+                Some(line) => format!("--set {line}: {what}"),
+                None => format!("--set: {what}"),
+            }
+        })
+        .collect();
+    if !bad.is_empty() {
+        return Err(CliError::Usage(bad.join("; ")));
+    }
+    Ok(loaded.config)
 }
 
 fn csv_error(path: &Path, e: &csv::Error) -> CliError {
@@ -258,12 +363,29 @@ pub fn table(r: &Replay) -> String {
 
 /// Runs `wobblog detect`.
 pub fn run(args: &Args) -> Result<(), CliError> {
-    let file = std::fs::File::open(&args.csv).map_err(|e| CliError::file(&args.csv, e))?;
-    let r = replay(&args.csv, io::BufReader::new(file), &Config::default())?;
-    for line in &r.restarts {
+    let (r, input, place) = match (&args.log, &args.csv) {
+        (Some(log), _) => {
+            let header = crate::cmd::config::read_header(log)?;
+            if header.config.is_empty() {
+                eprintln!(
+                    "wobblog: {}: note: no configuration in the header; the defaults are used",
+                    log.display()
+                );
+            }
+            let config = log_config(&header.config, &args.set)?;
+            (replay_log(log, &config)?, log, "frame")
+        }
+        (None, Some(csv)) => {
+            let config = log_config(&[], &args.set)?;
+            let file = std::fs::File::open(csv).map_err(|e| CliError::file(csv, e))?;
+            (replay(csv, io::BufReader::new(file), &config)?, csv, "line")
+        }
+        (None, None) => return Err(CliError::Usage("give a LOG or --csv IN".into())),
+    };
+    for at in &r.restarts {
         eprintln!(
-            "wobblog: {}: line {line}: time gap; detector restarted",
-            args.csv.display()
+            "wobblog: {}: {place} {at}: time gap; detector restarted",
+            input.display()
         );
     }
     let text = if args.json {

@@ -4,9 +4,12 @@
 //! the core's `drivers::gnss_bringup`, driven by `app::gps_setup`.
 
 use embassy_stm32::mode::Async;
-use embassy_stm32::usart::{RingBufferedUartRx, UartTx};
+use embassy_stm32::usart::{self, RingBufferedUartRx, Uart, UartTx};
 use wobble_core::app::gps_setup::GpsLink;
 use wobble_core::app::ports::GpsPort;
+use wobble_core::drivers::gnss_bringup::PROBE_BAUDS;
+
+use crate::pins::{GpsPins, Irqs};
 
 /// DMA ring size: 115 200 baud is 11.5 bytes/ms, so 1 KiB holds 89 ms,
 /// far more than the GPS task's executor is ever kept from running.
@@ -19,8 +22,23 @@ pub struct GpsAdapter {
 }
 
 impl GpsAdapter {
-    /// Starts the ring buffer.
-    pub fn new(tx: UartTx<'static, Async>, mut rx: RingBufferedUartRx<'static>) -> Self {
+    /// USART2 at the receivers' usual power-up rate (the bring-up finds
+    /// theirs), receiving into `ring`.
+    pub fn new(pins: GpsPins, ring: &'static mut [u8; RING_BYTES]) -> Self {
+        let mut config = usart::Config::default();
+        config.baudrate = PROBE_BAUDS[0];
+        let uart = defmt::unwrap!(Uart::new(
+            pins.uart,
+            pins.rx,
+            pins.tx,
+            pins.tx_dma,
+            pins.rx_dma,
+            Irqs,
+            config
+        )
+        .ok());
+        let (tx, rx) = uart.split();
+        let mut rx = rx.into_ring_buffered(ring);
         rx.start_uart();
         Self { tx, rx }
     }

@@ -24,6 +24,8 @@ pub struct SteeringAdapter {
     adc: RingBufferedAdc<'static, ADC1>,
     channel: Steering,
     frame: [u16; FRAME_SAMPLES],
+    /// Lowest and highest raw count of the last frame (the self-test's).
+    last_range: Option<(u16, u16)>,
 }
 
 impl SteeringAdapter {
@@ -34,7 +36,13 @@ impl SteeringAdapter {
             adc,
             channel,
             frame: [0; FRAME_SAMPLES],
+            last_range: None,
         }
+    }
+
+    /// Lowest and highest raw ADC count of the last frame read.
+    pub fn last_range(&self) -> Option<(u16, u16)> {
+        self.last_range
     }
 
     /// After an overrun (OVR: a conversion not taken by the DMA in time) the
@@ -56,8 +64,13 @@ impl SteeringPort for SteeringAdapter {
             return Err(SensorError::Overrun);
         }
         let n = self.adc.read_latest(&mut self.frame);
-        self.channel
-            .push_all(self.frame.get(..n).unwrap_or_default());
+        let samples = self.frame.get(..n).unwrap_or_default();
+        self.last_range = samples
+            .iter()
+            .min()
+            .zip(samples.iter().max())
+            .map(|(&lo, &hi)| (lo, hi));
+        self.channel.push_all(samples);
         // No conversion since the last frame: the DMA ring stopped.
         self.channel.take().ok_or(SensorError::Stale)
     }

@@ -3,7 +3,6 @@
 //! residuals (measured minus model) printed.
 
 use std::fmt::Write as _;
-use std::io::Write as _;
 use std::path::{Path, PathBuf};
 
 use wobble_model::sweep::mode_at;
@@ -12,6 +11,7 @@ use wobble_model::Mode;
 use super::episodes::{self, LoggedEpisode};
 use super::figure::{EigenFigure, Layer, Line};
 use super::{load, sweep, Speeds};
+use crate::cmd::logs::print_stdout;
 use crate::output::Output;
 use crate::plot::{render, ImageKind};
 use crate::CliError;
@@ -51,11 +51,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         .map_err(|e| CliError::file(&args.params, e))?
         .ok_or_else(|| CliError::file(&args.params, "the model has no wobble mode"))?;
     let text = residual_table(&found, &wobble);
-    let mut stdout = Output::stdout();
-    stdout
-        .write_all(text.as_bytes())
-        .map_err(|e| stdout.error(e))?;
-    stdout.commit()?;
+    print_stdout(&text)?;
     if let Some(out) = out {
         let figure = EigenFigure {
             title: format!("{}: wobble mode and measured episodes", set.name),

@@ -12,6 +12,7 @@ use wobble_model::ParamSet;
 
 use super::episodes;
 use super::param_error;
+use crate::cmd::logs::print_stdout;
 use crate::output::Output;
 use crate::CliError;
 
@@ -86,10 +87,6 @@ pub fn run(args: &Args) -> Result<(), CliError> {
     out.write_all(to_toml(&fitted).as_bytes())
         .map_err(|e| out.error(e))?;
     out.commit()?;
-    let mut stdout = Output::stdout();
-    stdout
-        .write_all(text.as_bytes())
-        .map_err(|e| stdout.error(e))?;
-    stdout.commit()?;
+    print_stdout(&text)?;
     loaded
 }

@@ -3,7 +3,6 @@
 //! (standard thick, smaller factors thin, larger dotted).
 
 use std::fmt::Write as _;
-use std::io::Write as _;
 use std::path::PathBuf;
 
 use wobble_model::{critical_speeds, Mode, Model, ParamSet};
@@ -11,6 +10,7 @@ use wobble_model::{critical_speeds, Mode, Model, ParamSet};
 use super::eig::describe;
 use super::figure::{EigenFigure, Layer, Line};
 use super::{param_error, sweep, Speeds};
+use crate::cmd::logs::print_stdout;
 use crate::output::Output;
 use crate::plot::{render, ImageKind};
 use crate::CliError;
@@ -89,11 +89,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
             line,
         });
     }
-    let mut stdout = Output::stdout();
-    stdout
-        .write_all(text.as_bytes())
-        .map_err(|e| stdout.error(e))?;
-    stdout.commit()?;
+    print_stdout(&text)?;
     if let Some(out) = out {
         let figure = EigenFigure {
             title: format!("{}: {} x {:?}", set.name, args.param, args.factors),

@@ -1,0 +1,56 @@
+//! The self-test's free-space figure comes from the FAT32 FSInfo sector of
+//! the card's first partition: on a volume formatted by the `fatfs` crate it
+//! agrees with that crate's own count, and anything but FAT32 gives none.
+
+use std::io::Write;
+
+use wobble_core::logger::mock::MockCard;
+use wobble_core::selftest::fat32_free_mib;
+
+const PART_START_BLOCKS: u64 = 2048;
+
+/// A card of `mib` MiB with one FAT32 partition, and `fatfs`'s free count.
+fn card(mib: u64, used_bytes: usize) -> (Vec<u8>, u64) {
+    let bytes = mib << 20;
+    let mut image = vec![0u8; bytes as usize];
+    let start = (PART_START_BLOCKS * 512) as usize;
+    let blocks = (bytes / 512 - PART_START_BLOCKS) as u32;
+    let opts = fatfs::FormatVolumeOptions::new().fat_type(fatfs::FatType::Fat32);
+    fatfs::format_volume(std::io::Cursor::new(&mut image[start..]), opts).expect("format");
+    let free = {
+        let fs = fatfs::FileSystem::new(
+            std::io::Cursor::new(&mut image[start..]),
+            fatfs::FsOptions::new(),
+        )
+        .expect("mount");
+        let mut f = fs.root_dir().create_file("RUN00001.WBL").expect("create");
+        f.write_all(&vec![0xA5; used_bytes]).expect("write");
+        drop(f);
+        let stats = fs.stats().expect("stats");
+        let free = stats.free_clusters() as u64 * stats.cluster_size() as u64;
+        fs.unmount().expect("unmount");
+        free
+    };
+    let entry = &mut image[446..462];
+    entry[4] = 0x0C;
+    entry[8..12].copy_from_slice(&(PART_START_BLOCKS as u32).to_le_bytes());
+    entry[12..16].copy_from_slice(&blocks.to_le_bytes());
+    image[510] = 0x55;
+    image[511] = 0xAA;
+    (image, free)
+}
+
+#[test]
+fn free_space_matches_the_file_systems_own_count() {
+    for used in [0, 5 << 20] {
+        let (image, free_bytes) = card(128, used);
+        let mib = fat32_free_mib(&MockCard::new(image)).expect("FAT32 count");
+        assert_eq!(u64::from(mib), free_bytes >> 20, "used {used}");
+        assert!(mib > 100);
+    }
+}
+
+#[test]
+fn no_fat32_no_figure() {
+    assert_eq!(fat32_free_mib(&MockCard::new(vec![0u8; 1 << 20])), None);
+}

@@ -1,0 +1,228 @@
+//! The field self-test on the board: gathers the core's
+//! `selftest::Measurements` from the adapters, writes `SELFTEST.TXT` and
+//! shows the result. What counts as a pass is the core's.
+//!
+//! Started instead of logging when the marker button is held at power-on.
+//! The status LED blinks fast while the rider turns the handlebar and spins
+//! the wheel (10 s); the GPS bring-up runs meanwhile. Then: all passed,
+//! green LED on and one long beep; a failure, the red LED and the buzzer
+//! repeat the failing check's number (1 IMU, 2 steering, 3 wheel, 4 GPS,
+//! 5 card, 6 clock, 7 reset) until power-off.
+
+use embassy_futures::join::join;
+use embassy_stm32::gpio::Output;
+use embassy_time::{Duration, Instant, Ticker, Timer};
+use embedded_sdmmc::{Mode, VolumeIdx, VolumeManager};
+use wobble_core::app::gps_setup;
+use wobble_core::app::ports::{ImuPort, SteeringPort, WheelPort};
+use wobble_core::boot::ResetCause;
+use wobble_core::drivers::icm42688::reg::WHO_AM_I_VALUE;
+use wobble_core::logger::FixedTime;
+use wobble_core::selftest::{
+    failure_code, fat32_free_mib, write_report, Measurements, TEST_WINDOW_US,
+};
+
+use crate::adapters::card::SdCard;
+use crate::adapters::gps::GpsAdapter;
+use crate::adapters::imu::ImuAdapter;
+use crate::adapters::steering::SteeringAdapter;
+use crate::adapters::wheel::WheelAdapter;
+
+/// Everything the self-test uses.
+pub struct Parts {
+    /// The IMU.
+    pub imu: ImuAdapter,
+    /// The steering ADC.
+    pub steering: SteeringAdapter,
+    /// The wheel capture (its timer already started).
+    pub wheel: WheelAdapter,
+    /// The GPS UART.
+    pub gps: GpsAdapter,
+    /// The card.
+    pub card: SdCard,
+    /// Buzzer, red LED, green LED.
+    pub buzzer: Output<'static>,
+    /// Red LED.
+    pub alert_led: Output<'static>,
+    /// Green LED.
+    pub status_led: Output<'static>,
+    /// Whether the crystal runs.
+    pub crystal: bool,
+    /// Why the MCU reset.
+    pub reset: ResetCause,
+}
+
+/// Blocks written and read for the speed figure (64 KiB).
+const SPEED_BLOCKS: u32 = 128;
+const SCRATCH: &str = "SELFTEST.BIN";
+const REPORT: &str = "SELFTEST.TXT";
+
+/// Mean acceleration magnitude over a second at rest, g.
+async fn imu_at_rest(imu: &mut ImuAdapter) -> Option<f32> {
+    let mut ticker = Ticker::every(Duration::from_millis(10));
+    let (mut sum, mut n) = (0.0f32, 0u32);
+    for _ in 0..100 {
+        ticker.next().await;
+        if let Ok(s) = imu.read().await {
+            let [x, y, z] = s.accel_g;
+            sum += sqrt(x * x + y * y + z * z);
+            n += 1;
+        }
+    }
+    (n > 0).then(|| sum / n as f32)
+}
+
+/// `sqrt` without `std`: Newton's iteration, plenty for a 10 % check.
+fn sqrt(v: f32) -> f32 {
+    let mut r = if v > 1.0 { v } else { 1.0 };
+    for _ in 0..20 {
+        r = 0.5 * (r + v / r);
+    }
+    r
+}
+
+/// Steering range and wheel edges over the test window, status LED
+/// blinking fast.
+async fn sensors(
+    steering: &mut SteeringAdapter,
+    wheel: &mut WheelAdapter,
+    led: &mut Output<'static>,
+    m: &mut Measurements,
+) {
+    let mut ticker = Ticker::every(Duration::from_millis(10));
+    let end = Instant::now() + Duration::from_micros(TEST_WINDOW_US);
+    let mut k = 0u32;
+    while Instant::now() < end {
+        ticker.next().await;
+        k += 1;
+        led.set_level((k / 10).is_multiple_of(2).into());
+        if steering.read().await.is_ok() {
+            if let Some((lo, hi)) = steering.last_range() {
+                let (a, b) = m.steer_counts.unwrap_or((lo, hi));
+                m.steer_counts = Some((a.min(lo), b.max(hi)));
+            }
+        }
+        wheel.drain_edges(&mut |_| m.wheel_edges += 1);
+    }
+    led.set_low();
+}
+
+/// Write and read speed, KiB/s, through a scratch file that is deleted
+/// afterwards (logs are never touched).
+fn card_speed(volumes: &VolumeManager<SdCard, FixedTime>) -> Option<(u32, u32)> {
+    let volume = volumes.open_volume(VolumeIdx(0)).ok()?;
+    let root = volume.open_root_dir().ok()?;
+    let block = [0x5Au8; 512];
+    let kib_s = |start: Instant| {
+        let us = Instant::now().duration_since(start).as_micros().max(1);
+        (u64::from(SPEED_BLOCKS) * 512 * 1_000_000 / 1024 / us) as u32
+    };
+    let start = Instant::now();
+    {
+        let file = root
+            .open_file_in_dir(SCRATCH, Mode::ReadWriteCreateOrTruncate)
+            .ok()?;
+        for _ in 0..SPEED_BLOCKS {
+            file.write(&block).ok()?;
+        }
+        file.close().ok()?;
+    }
+    let write = kib_s(start);
+    let start = Instant::now();
+    {
+        let file = root.open_file_in_dir(SCRATCH, Mode::ReadOnly).ok()?;
+        let mut back = [0u8; 512];
+        for _ in 0..SPEED_BLOCKS {
+            if file.read(&mut back).ok()? != 512 || back != block {
+                return None;
+            }
+        }
+        file.close().ok()?;
+    }
+    let read = kib_s(start);
+    root.delete_entry_in_dir(SCRATCH).ok()?;
+    Some((write, read))
+}
+
+fn write_report_file(volumes: &VolumeManager<SdCard, FixedTime>, text: &str) -> bool {
+    let write = || -> Option<()> {
+        let volume = volumes.open_volume(VolumeIdx(0)).ok()?;
+        let root = volume.open_root_dir().ok()?;
+        let file = root
+            .open_file_in_dir(REPORT, Mode::ReadWriteCreateOrTruncate)
+            .ok()?;
+        file.write(text.as_bytes()).ok()?;
+        file.close().ok()
+    };
+    write().is_some()
+}
+
+/// Beeps and blinks `code` times.
+async fn show(led: &mut Output<'static>, buzzer: &mut Output<'static>, code: u8) {
+    for _ in 0..code {
+        led.set_high();
+        buzzer.set_high();
+        Timer::after_millis(200).await;
+        led.set_low();
+        buzzer.set_low();
+        Timer::after_millis(300).await;
+    }
+    Timer::after_secs(2).await;
+}
+
+/// Runs the self-test, then shows its result until power-off.
+pub async fn run(p: Parts) -> ! {
+    let Parts {
+        mut imu,
+        mut steering,
+        mut wheel,
+        mut gps,
+        card,
+        mut buzzer,
+        mut alert_led,
+        mut status_led,
+        crystal,
+        reset,
+    } = p;
+    defmt::info!("self-test: hold still, then turn the handlebar and spin the wheel");
+    let mut m = Measurements {
+        crystal,
+        reset: Some(reset),
+        ..Measurements::default()
+    };
+    m.accel_g = imu_at_rest(&mut imu).await;
+    // The driver's initialisation checked WHO_AM_I before any sample.
+    m.imu_id = m.accel_g.map(|_| WHO_AM_I_VALUE);
+    let (outcome, ()) = join(
+        gps_setup::run(&mut gps, &mut |step| defmt::info!("GPS set-up: {}", step)),
+        sensors(&mut steering, &mut wheel, &mut status_led, &mut m),
+    )
+    .await;
+    m.gps_baud = outcome.found_baud;
+    m.gps_rate_hz = outcome.rate_hz;
+    let volumes = VolumeManager::new(card, FixedTime::EPOCH);
+    m.card_free_mib = volumes.device(|card| fat32_free_mib(card)).unwrap_or(0);
+    m.card_kib_s = card_speed(&volumes);
+    let mut text = heapless::String::<512>::new();
+    if write_report(&m, &mut text).is_err() {
+        defmt::warn!("self-test report cut short");
+    }
+    defmt::info!("{=str}", text.as_str());
+    if !write_report_file(&volumes, &text) {
+        defmt::error!("{} not written", REPORT);
+    }
+    let code = failure_code(&m);
+    if code == 0 {
+        status_led.set_high();
+        buzzer.set_high();
+        Timer::after_secs(1).await;
+        buzzer.set_low();
+    }
+    loop {
+        if code == 0 {
+            Timer::after_secs(3600).await;
+        } else {
+            show(&mut alert_led, &mut buzzer, code).await;
+        }
+    }
+}
