@@ -237,3 +237,59 @@ fn eig_whipple_gives_the_four_states_of_the_lumped_bicycle() {
         "{text}"
     );
 }
+
+#[test]
+fn censored_episodes_are_compared_but_never_fitted() {
+    let dir = tempfile::tempdir().unwrap();
+    // The Figure 6 ride cut off while its wobble still grows: the episode
+    // meets the end of the data.
+    let csv =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../hil-tests/fixtures/corpus/wobble_fig6.csv");
+    let text = std::fs::read_to_string(csv).unwrap();
+    let mut lines = text.lines();
+    let mut cut = String::from(lines.next().unwrap());
+    cut.push('\n');
+    for line in lines.take_while(|l| l.split(',').next().unwrap().parse::<f64>().unwrap() < 14.6) {
+        cut.push_str(line);
+        cut.push('\n');
+    }
+    let cut_csv = dir.path().join("cut.csv");
+    std::fs::write(&cut_csv, cut).unwrap();
+    let log = dir.path().join("CUT.WBL");
+    wobblog()
+        .args(["encode", "--csv"])
+        .arg(&cut_csv)
+        .arg("-o")
+        .arg(&log)
+        .assert()
+        .success();
+    let out = wobblog()
+        .args(["model", "compare"])
+        .arg(params("test-bicycle.toml"))
+        .arg(&log)
+        .output()
+        .unwrap();
+    let text = String::from_utf8(out.stdout).unwrap();
+    let row = text
+        .lines()
+        .find(|l| l.starts_with("CUT.WBL"))
+        .expect(&text);
+    assert!(row.ends_with("yes"), "{text}");
+    assert!(
+        text.contains("no episodes to compare") || text.contains("over 0 episodes"),
+        "{text}"
+    );
+    let out = wobblog()
+        .args(["model", "fit"])
+        .arg(params("test-bicycle.toml"))
+        .arg(&log)
+        .args(["--param", "steer_head.damping", "-o"])
+        .arg(dir.path().join("fitted.toml"))
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8(out.stderr)
+        .unwrap()
+        .contains("0 episodes cannot determine 1 parameters"));
+    assert!(!dir.path().join("fitted.toml").exists());
+}
