@@ -189,16 +189,44 @@ fn figure_8_has_a_dot_per_episode_and_a_legend_per_run() {
         .sum();
     assert!(episodes >= 2);
     let svg = std::fs::read_to_string(&svg_path).unwrap();
-    assert_eq!(svg.matches("<circle").count(), episodes + 2);
+    // Each episode in the three panels, and a marker per run in the key.
+    assert_eq!(svg.matches("<circle").count(), 3 * episodes + 2);
     let labels = texts(&svg);
     for label in [
         "A.WBL",
         "B.WBL",
         wobblog::plot::modes::X_LABEL,
         wobblog::plot::modes::Y_LABEL,
+        wobblog::plot::modes::SPEED_LABEL,
     ] {
         assert!(labels.contains(&label), "no {label:?} in {labels:?}");
     }
+}
+
+#[test]
+fn figure_8_key_skips_runs_without_episodes() {
+    let dir = tempfile::tempdir().unwrap();
+    let a = dir.path().join("A.WBL");
+    analysis_support::standard_log(&a);
+    let quiet = dir.path().join("QUIET.WBL");
+    let calm = analysis_support::Ride::new(30.0, 5.0, 15.0, 2.0, 0.5);
+    let calm = analysis_support::Ride {
+        steer_deg: calm.roll_deg.iter().map(|r| 2.0 * r.to_radians()).collect(),
+        ..calm
+    };
+    analysis_support::write_log(&quiet, &calm, &analysis_support::Extras::default());
+    let svg_path = dir.path().join("modes.svg");
+    wobblog()
+        .args(["wobble", "--plot"])
+        .arg(&svg_path)
+        .arg(&a)
+        .arg(&quiet)
+        .assert()
+        .success();
+    let svg = std::fs::read_to_string(&svg_path).unwrap();
+    let labels = texts(&svg);
+    assert!(labels.contains(&"A.WBL"), "{labels:?}");
+    assert!(!labels.contains(&"QUIET.WBL"), "{labels:?}");
 }
 
 #[test]

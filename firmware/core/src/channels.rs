@@ -196,7 +196,7 @@ impl SharedStatus {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::format::{Frame, FrameStatus};
+    use crate::format::{Frame, FrameStatus, Marker};
     use proptest::prelude::*;
 
     fn frame(t_us: u64) -> Record<'static> {
@@ -259,6 +259,86 @@ mod tests {
                 prop_assert_eq!(lost, 0);
             }
             prop_assert!(q.high_water() as usize <= QUEUE_LEN);
+        }
+
+        /// Frames from the sampler mixed with other records (GPS fixes,
+        /// alerts, faults: here markers numbered in push order) while the
+        /// writer stalls: a dropped frame is counted in a dropout before the
+        /// next delivered frame, a dropped other record in
+        /// `others_dropped`, never as a lost frame; each kind keeps its
+        /// order.
+        #[test]
+        fn mixed_records_are_accounted_by_kind(
+            bursts in proptest::collection::vec(
+                (proptest::collection::vec(0u8..4, 0..400), prop::bool::ANY), 1..6),
+        ) {
+            let q = RecordQueue::new();
+            let (mut frames, mut others) = (0u64, 0u16);
+            let mut delivered_frames = Vec::new();
+            let mut delivered_others = Vec::new();
+            let mut lost = 0u64;
+            let mut writer = |q: &RecordQueue, lost: &mut u64| {
+                while let Some(r) = q.try_pop() {
+                    match r {
+                        Record::Frame(f) => delivered_frames.push((f.t_us / 10_000, *lost)),
+                        Record::Dropout(d) => *lost += u64::from(d.frames_lost),
+                        Record::Marker(m) => delivered_others.push(m.id),
+                        other => panic!("unexpected {other:?}"),
+                    }
+                }
+            };
+            // Each burst is pushed while the writer stalls (up to three
+            // queues' worth), then the writer drains or stays stalled.
+            for (kinds, drain) in &bursts {
+                for &kind in kinds {
+                    // One frame in four pushes, the rest other records.
+                    if kind == 0 {
+                        q.push(frame(frames * 10_000));
+                        frames += 1;
+                    } else {
+                        q.push(Record::Marker(Marker { t_us: frames * 10_000, id: others }));
+                        others += 1;
+                    }
+                }
+                if *drain {
+                    writer(&q, &mut lost);
+                }
+            }
+            q.push(frame(frames * 10_000));
+            frames += 1;
+            writer(&q, &mut lost);
+            prop_assert_eq!(
+                delivered_frames.len() as u64 + lost + u64::from(q.frames_dropped_pending()),
+                frames
+            );
+            for (i, &(index, lost_before)) in delivered_frames.iter().enumerate() {
+                prop_assert_eq!(index, i as u64 + lost_before);
+            }
+            prop_assert_eq!(
+                delivered_others.len() as u64 + u64::from(q.others_dropped()),
+                u64::from(others)
+            );
+            prop_assert!(delivered_others.windows(2).all(|w| w[0] < w[1]));
+        }
+    }
+
+    /// The case the property must reach: the queue full when both kinds
+    /// arrive.
+    #[test]
+    fn a_dropped_other_record_is_not_a_lost_frame() {
+        let q = RecordQueue::new();
+        for t in 0..QUEUE_LEN as u64 {
+            assert!(q.push(frame(t)));
+        }
+        assert!(!q.push(Record::Marker(Marker { t_us: 1, id: 1 })));
+        assert_eq!((q.others_dropped(), q.frames_dropped_pending()), (1, 0));
+        assert!(!q.push(frame(QUEUE_LEN as u64)));
+        assert_eq!((q.others_dropped(), q.frames_dropped_pending()), (1, 1));
+        while q.try_pop().is_some() {}
+        assert!(q.push(frame(QUEUE_LEN as u64 + 1)));
+        match q.try_pop() {
+            Some(Record::Dropout(d)) => assert_eq!(d.frames_lost, 1),
+            other => panic!("{other:?}"),
         }
     }
 }

@@ -16,7 +16,7 @@
 
 use std::fmt;
 
-use nalgebra::Complex;
+use nalgebra::{Complex, DMatrix};
 
 use crate::eig::{eigen, Eigen};
 use crate::model::{Model, StateRole};
@@ -101,6 +101,21 @@ impl Sweep {
     pub fn run(
         model: &Model,
         speeds_mps: &[f64],
+        progress: impl FnMut(usize),
+    ) -> Result<Self, SweepError> {
+        Self::run_matrices(
+            |u| model.state_matrix(u),
+            &model.state_roles(),
+            speeds_mps,
+            progress,
+        )
+    }
+
+    /// [`Self::run`] on any state matrix function with states of `roles`.
+    fn run_matrices(
+        state_matrix: impl Fn(f64) -> DMatrix<f64>,
+        roles: &[StateRole],
+        speeds_mps: &[f64],
         mut progress: impl FnMut(usize),
     ) -> Result<Self, SweepError> {
         if speeds_mps.is_empty() {
@@ -108,7 +123,7 @@ impl Sweep {
         }
         let mut tracks: Vec<Vec<Eigen>> = Vec::new();
         for (k, &u) in speeds_mps.iter().enumerate() {
-            let found = eigen(&model.state_matrix(u)).ok_or(SweepError::Eigen(u))?;
+            let found = eigen(&state_matrix(u)).ok_or(SweepError::Eigen(u))?;
             if tracks.is_empty() {
                 tracks = found.into_iter().map(|e| vec![e]).collect();
             } else {
@@ -116,8 +131,7 @@ impl Sweep {
             }
             progress(k);
         }
-        let roles = model.state_roles();
-        let branches = name_branches(&tracks, &roles);
+        let branches = name_branches(&tracks, roles);
         Ok(Self {
             speeds_mps: speeds_mps.to_vec(),
             branches,
@@ -351,4 +365,41 @@ pub fn mode_at(
             })
             .collect()
     }))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    proptest! {
+        /// Eigenvalues moving on straight lines, crossing or not, are each
+        /// followed on their own line: the extrapolation carries a branch
+        /// through a crossing instead of swapping it with its neighbour.
+        #[test]
+        fn branches_follow_straight_lines_through_crossings(
+            lines in proptest::collection::vec((-20.0..20.0f64, -5.0..5.0f64), 2..6),
+        ) {
+            // Lines that start apart (by more than a step moves them: the
+            // first step has no slope to extrapolate) and never coincide.
+            for (i, a) in lines.iter().enumerate() {
+                for b in &lines[i + 1..] {
+                    prop_assume!((a.1 - b.1).abs() > 0.5 && (a.0 - b.0).abs() > 1.5);
+                }
+            }
+            let n = lines.len();
+            let speeds: Vec<f64> = (0..=100).map(|i| f64::from(i) * 0.1).collect();
+            let matrix = |u: f64| {
+                DMatrix::from_diagonal(&nalgebra::DVector::from_iterator(n, lines.iter().map(|(a, b)| a + b * u)))
+            };
+            let sweep = Sweep::run_matrices(matrix, &vec![StateRole::Rate; n], &speeds, |_| {}).unwrap();
+            for branch in &sweep.branches {
+                let start = branch.values[0].re;
+                let (a, b) = *lines.iter().min_by(|x, y| (x.0 - start).abs().total_cmp(&(y.0 - start).abs())).unwrap();
+                for (u, v) in speeds.iter().zip(&branch.values) {
+                    prop_assert!((v.re - (a + b * u)).abs() < 1e-9, "at {} m/s: {} not on {} + {} u", u, v, a, b);
+                }
+            }
+        }
+    }
 }

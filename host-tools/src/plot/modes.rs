@@ -1,11 +1,13 @@
 //! The seed paper's Figure 8: every wobble episode as a point in the complex
 //! plane, real part sigma (growth rate) against imaginary part 2 pi f, one
-//! colour per run. Right of the zero line the wobble grew by itself.
+//! colour and shape per run. Right of the zero line the wobble grew by
+//! itself. Beside it, sigma and frequency against the speed at onset: where
+//! the wobble turns unstable, and whether its frequency follows the speed.
 
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::{padded_range, Figure, FONT};
+use super::{padded_range, tick_label, Figure, FONT};
 use crate::analysis::{Episode, Stability};
 
 /// Axis labels.
@@ -31,9 +33,68 @@ const RUN_COLOURS: [RGBColor; 8] = [
     RGBColor(0x7f, 0x7f, 0x7f),
 ];
 
-/// Figure 8 over any number of runs.
+/// Marker shapes, one per round of [`RUN_COLOURS`]: run `k` has colour
+/// `k % 8` and shape `k / 8 % 4`, so 32 runs stay apart.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Shape {
+    /// A dot.
+    Circle,
+    /// A triangle, point up.
+    Triangle,
+    /// A square.
+    Square,
+    /// A diamond.
+    Diamond,
+}
+
+const SHAPES: [Shape; 4] = [
+    Shape::Circle,
+    Shape::Triangle,
+    Shape::Square,
+    Shape::Diamond,
+];
+
+/// The colour and shape of run number `k`.
+#[must_use]
+pub fn run_style(k: usize) -> (RGBColor, Shape) {
+    (
+        RUN_COLOURS[k % RUN_COLOURS.len()],
+        SHAPES[k / RUN_COLOURS.len() % SHAPES.len()],
+    )
+}
+
+/// Figure 8 over any number of runs, with a second view of each episode's
+/// growth rate and frequency against its speed at onset.
 pub struct ModePlot {
     runs: Vec<(String, Vec<Episode>)>,
+}
+
+/// Figure size, px: the complex plane on the left, the two speed panels in
+/// the middle, the key on the right.
+const SIZE_PX: (u32, u32) = (1400, 720);
+/// Width of the key, px.
+const KEY_PX: u32 = 200;
+
+/// Hands a marker of `shape` at `at` in `style` to `draw` as its own element
+/// type: one per shape, as plotters' boxed elements need a `'static` backend.
+macro_rules! with_marker {
+    ($shape:expr, $at:expr, $style:expr, $draw:expr) => {{
+        let r = DOT_PX;
+        let base = EmptyElement::at($at);
+        match $shape {
+            Shape::Circle => $draw(base + Circle::new((0, 0), r, $style)),
+            Shape::Triangle => {
+                $draw(base + Polygon::new(vec![(0, -r - 1), (r + 1, r), (-r - 1, r)], $style))
+            }
+            Shape::Square => $draw(base + Rectangle::new([(-r, -r), (r, r)], $style)),
+            Shape::Diamond => $draw(
+                base + Polygon::new(
+                    vec![(0, -r - 1), (r + 1, 0), (0, r + 1), (-r - 1, 0)],
+                    $style,
+                ),
+            ),
+        }
+    }};
 }
 
 impl ModePlot {
@@ -46,67 +107,143 @@ impl ModePlot {
     fn all(&self) -> impl Iterator<Item = &Episode> {
         self.runs.iter().flat_map(|(_, e)| e)
     }
+
+    /// The style of an episode of run `k`.
+    fn style(k: usize, e: &Episode) -> (Shape, ShapeStyle) {
+        let (colour, shape) = run_style(k);
+        let style = match (e.censored, e.stability) {
+            // Only part of it was seen: hollow and grey.
+            (true, _) => CENSORED_COLOUR.stroke_width(2),
+            (false, Stability::Unstable) => colour.filled(),
+            (false, Stability::Stable) => colour.stroke_width(2),
+        };
+        (shape, style)
+    }
+
+    /// Draws every episode as (`x`, `y`) on `area`.
+    fn panel<DB: DrawingBackend>(
+        &self,
+        area: &DrawingArea<DB, Shift>,
+        labels: (&str, &str),
+        x: fn(&Episode) -> f64,
+        y: fn(&Episode) -> f64,
+        zero_line: bool,
+    ) -> Result<(), String> {
+        let err = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
+        let xs = self.all().map(x).chain(zero_line.then_some(0.0));
+        let x_range = padded_range(xs, if zero_line { 2.0 } else { 1.0 });
+        let y_range = padded_range(self.all().map(y), if zero_line { 10.0 } else { 1.0 });
+        let mut chart = ChartBuilder::on(area)
+            .margin(12)
+            .x_label_area_size(44)
+            .y_label_area_size(64)
+            .build_cartesian_2d(x_range.clone(), y_range.clone())
+            .map_err(err)?;
+        chart
+            .configure_mesh()
+            .x_desc(labels.0)
+            .y_desc(labels.1)
+            .x_label_formatter(&|v| tick_label(*v))
+            .y_label_formatter(&|v| tick_label(*v))
+            .label_style((FONT, 13))
+            .axis_desc_style((FONT, 15))
+            .draw()
+            .map_err(err)?;
+        if zero_line {
+            chart
+                .draw_series(std::iter::once(PathElement::new(
+                    vec![(0.0, y_range.start), (0.0, y_range.end)],
+                    BLACK.stroke_width(1),
+                )))
+                .map_err(err)?;
+        }
+        for (k, (_, episodes)) in self.runs.iter().enumerate() {
+            for e in episodes {
+                let (shape, style) = Self::style(k, e);
+                with_marker!(shape, (x(e), y(e)), style, |m| chart
+                    .draw_series(std::iter::once(m))
+                    .map(drop)
+                    .map_err(err))?;
+            }
+        }
+        Ok(())
+    }
+
+    /// The key, outside the axes: how to read a marker, then one line per
+    /// run that has episodes.
+    fn key<DB: DrawingBackend>(&self, area: &DrawingArea<DB, Shift>) -> Result<(), String> {
+        let err = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
+        let text = |s: &str, at: (i32, i32)| Text::new(s.to_string(), at, (FONT, 14));
+        let mut y = 40;
+        for line in ["filled: unstable", "open: stable", "grey: cut by a gap"] {
+            area.draw(&text(line, (10, y))).map_err(err)?;
+            y += 20;
+        }
+        y += 12;
+        for (k, (name, episodes)) in self.runs.iter().enumerate() {
+            if episodes.is_empty() {
+                continue;
+            }
+            let (colour, shape) = run_style(k);
+            with_marker!(shape, (18, y + 7), colour.filled(), |m| area
+                .draw(&m)
+                .map_err(err))?;
+            area.draw(&text(name, (34, y))).map_err(err)?;
+            y += 20;
+        }
+        Ok(())
+    }
 }
 
 impl Figure for ModePlot {
     fn size_px(&self) -> (u32, u32) {
-        (900, 700)
+        SIZE_PX
     }
 
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String> {
         let err = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
         root.fill(&WHITE).map_err(err)?;
-        // Zero stays in view: it is the line the figure is about.
-        let x = padded_range(self.all().map(|e| e.sigma_per_s).chain([0.0]), 2.0);
-        let y = padded_range(self.all().map(Episode::omega_rad_s), 10.0);
-        let mut chart = ChartBuilder::on(root)
-            .caption(
-                "Wobble modes (filled: unstable, open: stable, grey: cut by a gap)",
-                (FONT, 20),
-            )
-            .margin(16)
-            .x_label_area_size(40)
-            .y_label_area_size(60)
-            .build_cartesian_2d(x, y.clone())
-            .map_err(err)?;
-        chart
-            .configure_mesh()
-            .x_desc(X_LABEL)
-            .y_desc(Y_LABEL)
-            .label_style((FONT, 13))
-            .axis_desc_style((FONT, 15))
-            .draw()
-            .map_err(err)?;
-        chart
-            .draw_series(std::iter::once(PathElement::new(
-                vec![(0.0, y.start), (0.0, y.end)],
-                BLACK.stroke_width(1),
-            )))
-            .map_err(err)?;
-        for (k, (name, episodes)) in self.runs.iter().enumerate() {
-            let colour = RUN_COLOURS[k % RUN_COLOURS.len()];
-            chart
-                .draw_series(episodes.iter().map(|e| {
-                    let style = match (e.censored, e.stability) {
-                        // Only part of it was seen: hollow and grey.
-                        (true, _) => CENSORED_COLOUR.stroke_width(2),
-                        (false, Stability::Unstable) => colour.filled(),
-                        (false, Stability::Stable) => colour.stroke_width(2),
-                    };
-                    Circle::new((e.sigma_per_s, e.omega_rad_s()), DOT_PX, style)
-                }))
-                .map_err(err)?
-                .label(name.as_str())
-                .legend(move |(px, py)| Circle::new((px + 8, py), DOT_PX, colour.filled()));
+        let root = root.titled("Wobble modes", (FONT, 20)).map_err(err)?;
+        let (plots, key) = root.split_horizontally(SIZE_PX.0 - KEY_PX);
+        let (plane, by_speed) = plots.split_horizontally((SIZE_PX.0 - KEY_PX) * 11 / 20);
+        let (sigma, freq) = by_speed.split_vertically((SIZE_PX.1 - 30) / 2);
+        self.panel(
+            &plane,
+            (X_LABEL, Y_LABEL),
+            |e| e.sigma_per_s,
+            Episode::omega_rad_s,
+            true,
+        )?;
+        self.panel(
+            &sigma,
+            (SPEED_LABEL, "sigma (1/s)"),
+            |e| e.speed_at_onset_mps,
+            |e| e.sigma_per_s,
+            false,
+        )?;
+        self.panel(
+            &freq,
+            (SPEED_LABEL, "frequency (Hz)"),
+            |e| e.speed_at_onset_mps,
+            |e| e.freq_hz,
+            false,
+        )?;
+        self.key(&key)
+    }
+}
+
+/// The speed panels' x label.
+pub const SPEED_LABEL: &str = "speed at onset (m/s)";
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn thirty_two_runs_have_distinct_styles() {
+        let styles: Vec<(RGBColor, Shape)> = (0..32).map(run_style).collect();
+        for (i, a) in styles.iter().enumerate() {
+            assert!(styles[i + 1..].iter().all(|b| b != a), "run {i}");
         }
-        chart
-            .configure_series_labels()
-            .label_font((FONT, 14))
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .position(SeriesLabelPosition::UpperLeft)
-            .draw()
-            .map_err(err)?;
-        Ok(())
     }
 }
