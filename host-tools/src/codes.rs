@@ -20,12 +20,13 @@ use wobble_core::drivers::gnss_bringup::{
 };
 use wobble_core::format::{DropoutReason, FaultSource};
 use wobble_core::gps::{
-    FAULT_CHECKSUM, FAULT_FRAMING, FAULT_NO_CHECKSUM, FAULT_OVERLONG, FAULT_UNPARSEABLE,
+    FAULT_CHECKSUM, FAULT_FRAMING, FAULT_NO_CHECKSUM, FAULT_OUT_OF_RANGE, FAULT_OVERLONG,
+    FAULT_UNPARSEABLE,
 };
 use wobble_core::logger::{FAULT_CARD_ABSENT, FAULT_CARD_FULL, FAULT_CARD_WRITE};
 
 /// Every fault code the firmware records: (source, code, meaning).
-pub const FAULT_MEANINGS: [(FaultSource, u8, &str); 32] = [
+pub const FAULT_MEANINGS: [(FaultSource, u8, &str); 33] = [
     (
         FaultSource::Imu,
         FAULT_IMU_NO_RESPONSE,
@@ -66,6 +67,11 @@ pub const FAULT_MEANINGS: [(FaultSource, u8, &str); 32] = [
         FaultSource::Gps,
         FAULT_UNPARSEABLE,
         "RMC/GGA/GLL/VTG/GSA/ZDA sentence the parser rejected",
+    ),
+    (
+        FaultSource::Gps,
+        FAULT_OUT_OF_RANGE,
+        "sentence with a field out of range (position off the globe, minutes of 60 or more, absurd speed, altitude or satellites)",
     ),
     (FaultSource::Gps, FAULT_SETUP_SILENT, "set-up: no valid NMEA at any baud rate (logging at 9600)"),
     (FaultSource::Gps, FAULT_SETUP_UNCONFIRMED, "set-up: no command set confirmed (logging at the receiver's own baud and rate)"),

@@ -69,7 +69,8 @@ const STEP: f64 = 1e-4;
 /// 97.5 % quantile of the normal distribution.
 const Z_975: f64 = 1.959_963_984_540_054;
 
-struct Problem2<'a> {
+/// The least-squares problem: residuals of every episode at given factors.
+struct EpisodeFit<'a> {
     base: &'a ParamSet,
     keys: &'a [String],
     start: Vec<f64>,
@@ -79,7 +80,7 @@ struct Problem2<'a> {
     evaluations: std::cell::Cell<usize>,
 }
 
-impl Problem2<'_> {
+impl EpisodeFit<'_> {
     fn set_at(&self, factors: &DVector<f64>) -> Result<ParamSet, ParamError> {
         let mut set = self.base.clone();
         for ((key, v0), f) in self.keys.iter().zip(&self.start).zip(factors.iter()) {
@@ -102,7 +103,7 @@ impl Problem2<'_> {
     }
 }
 
-impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem2<'_> {
+impl LeastSquaresProblem<f64, Dyn, Dyn> for EpisodeFit<'_> {
     type ResidualStorage = Owned<f64, Dyn>;
     type JacobianStorage = Owned<f64, Dyn, Dyn>;
     type ParameterStorage = Owned<f64, Dyn>;
@@ -154,7 +155,7 @@ pub fn fit(
             )),
         ));
     }
-    let problem = Problem2 {
+    let problem = EpisodeFit {
         base: set,
         keys,
         start: start.clone(),

@@ -189,3 +189,29 @@ fn bicycle_parameters_txt_reads_like_the_toml() {
     assert!((a.k0 - b.k0).abs().max() < 1e-12);
     assert!((a.k2 - b.k2).abs().max() < 1e-12);
 }
+
+#[test]
+fn critical_speeds_do_not_depend_on_the_grid() {
+    let model = benchmark();
+    for step in [0.5, 2.0] {
+        let speeds: Vec<f64> = (0..=(10.0 / step) as usize)
+            .map(|i| i as f64 * step)
+            .collect();
+        let sweep = Sweep::run(&model, &speeds, |_| {}).expect("sweep");
+        let c = critical_speeds(&model, &sweep);
+        let at = |mode| {
+            c.iter()
+                .find(|c| c.mode == mode)
+                .expect("crossing")
+                .speed_mps
+        };
+        assert!(
+            (at(Mode::Weave) - 4.29238253634111).abs() < 1e-10,
+            "step {step}: {c:?}"
+        );
+        assert!(
+            (at(Mode::Capsize) - 6.02426201538837).abs() < 1e-10,
+            "step {step}: {c:?}"
+        );
+    }
+}

@@ -47,8 +47,13 @@ pub const FAULT_FRAMING: u8 = 4;
 /// GPS fault 5: a sentence of a type the fix is built from (RMC, GGA, GLL,
 /// VTG, GSA, ZDA) had a valid checksum but could not be parsed.
 pub const FAULT_UNPARSEABLE: u8 = 5;
+/// GPS fault 6: a sentence of such a type parsed, but a field is outside
+/// what a receiver can mean (position off the globe, minutes of 60 or more,
+/// speed over 514 m/s, altitude outside -500 m to 18 km, more than 99
+/// satellites): none of it is used.
+pub const FAULT_OUT_OF_RANGE: u8 = 6;
 /// Number of GPS fault codes (`1..=FAULT_CODES`).
-pub const FAULT_CODES: usize = 5;
+pub const FAULT_CODES: usize = 6;
 
 /// A short name for GPS fault `code`, for reports.
 #[must_use]
@@ -59,6 +64,7 @@ pub const fn fault_name(code: u8) -> Option<&'static str> {
         FAULT_OVERLONG => "overlong lines",
         FAULT_FRAMING => "broken lines (lost or corrupt bytes)",
         FAULT_UNPARSEABLE => "unparseable sentences",
+        FAULT_OUT_OF_RANGE => "sentences with fields out of range",
         _ => return None,
     })
 }
@@ -189,6 +195,7 @@ impl GpsReceiver {
                 match sentence::parse(text) {
                     Sentence::Ignored => stats.ignored = stats.ignored.saturating_add(1),
                     Sentence::Unparseable(_) => fault(FAULT_UNPARSEABLE, t_us),
+                    Sentence::OutOfRange(_) => fault(FAULT_OUT_OF_RANGE, t_us),
                     Sentence::Update(kind, update) => {
                         // One sentence ends at most two epochs: the previous
                         // one and, when it is the learned closer, its own.
@@ -374,7 +381,7 @@ $POLYN,TIME,RESTART_OCCURRED\r\n";
             ]
         );
         let stats = rx.stats();
-        assert_eq!(stats.faults, [1, 1, 0, 1, 1]);
+        assert_eq!(stats.faults, [1, 1, 0, 1, 1, 0]);
         assert_eq!(stats.proprietary_rejected, 1);
         assert_eq!(stats.fixes, 0);
     }

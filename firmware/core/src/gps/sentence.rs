@@ -9,6 +9,7 @@
 use nmea::sentences::{FixType, GgaData, GllData, GsaData, RmcData, VtgData, ZdaData};
 use nmea::ParseResult;
 
+use crate::format::limits::{self, SATS_MAX, SPEED_CM_S_MAX};
 use crate::format::{quantise_i32, FixMode, UtcTime};
 
 /// Metres per second in one knot.
@@ -107,6 +108,10 @@ pub enum Sentence {
     Ignored,
     /// A sentence of a merged type that the `nmea` crate rejected.
     Unparseable(Kind),
+    /// A sentence of a merged type with a field no receiver can mean: a
+    /// position off the globe, minutes of 60 or more, an absurd speed,
+    /// altitude or satellite count. None of its fields are used.
+    OutOfRange(Kind),
 }
 
 /// Classifies and parses `text`, a complete line `$...*hh` whose checksum
@@ -125,7 +130,11 @@ pub fn parse(text: &str) -> Sentence {
     let Some(kind) = address.get(2..).and_then(Kind::from_type) else {
         return Sentence::Ignored;
     };
-    let update = match nmea::parse_str(text) {
+    // The crate refuses 23:59:60; a leap second is parsed as :59 and the
+    // second added back.
+    let leap = leap_second_as_59(text, kind);
+    let parsed = leap.as_ref().map_or(text, |l| l.as_str());
+    let update = match nmea::parse_str(parsed) {
         Ok(ParseResult::RMC(d)) => from_rmc(&d),
         Ok(ParseResult::GGA(d)) => from_gga(&d),
         Ok(ParseResult::GLL(d)) => from_gll(&d),
@@ -135,9 +144,104 @@ pub fn parse(text: &str) -> Sentence {
         _ => None,
     };
     match update {
-        Some(u) => Sentence::Update(kind, u),
+        Some(_) if !minutes_in_range(text, kind) => Sentence::OutOfRange(kind),
+        Some(u) if !in_range(&u) => Sentence::OutOfRange(kind),
+        Some(mut u) => {
+            if leap.is_some() {
+                u.tod_ms = u.tod_ms.map(|ms| ms + 1000);
+            }
+            Sentence::Update(kind, u)
+        }
         None => Sentence::Unparseable(kind),
     }
+}
+
+/// Whether every field of `u` is one a receiver can mean (the card format's
+/// limits; conversions saturate, so absurd inputs land outside them).
+fn in_range(u: &Update) -> bool {
+    let position = match (u.lat_e7, u.lon_e7) {
+        (Some(lat), Some(lon)) => limits::position_is_valid(lat, lon),
+        (None, None) => true,
+        _ => false,
+    };
+    position
+        && u.speed_cm_s.is_none_or(|v| v <= SPEED_CM_S_MAX)
+        && u.alt_cm.is_none_or(limits::altitude_is_valid)
+        && u.sats.is_none_or(|n| n <= SATS_MAX)
+}
+
+/// Fields (after the address) of the latitude and longitude.
+const fn position_fields(kind: Kind) -> Option<(usize, usize)> {
+    match kind {
+        Kind::Rmc => Some((3, 5)),
+        Kind::Gga => Some((2, 4)),
+        Kind::Gll => Some((1, 3)),
+        _ => None,
+    }
+}
+
+/// Whether the minutes of the sentence's latitude and longitude
+/// (`ddmm.mmmm`, `dddmm.mmmm`) are below 60: the crate adds them to the
+/// degrees as they come.
+fn minutes_in_range(text: &str, kind: Kind) -> bool {
+    let Some((lat, lon)) = position_fields(kind) else {
+        return true;
+    };
+    let ok = |field: &str| {
+        let whole = field.find('.').unwrap_or(field.len());
+        field.is_empty()
+            || field
+                .get(whole.saturating_sub(2)..)
+                .and_then(|m| m.parse::<f32>().ok())
+                .is_some_and(|m| m < 60.0)
+    };
+    let body = text.split('*').next().unwrap_or("");
+    let mut fields = body.split(',');
+    let lat_field = fields.nth(lat).unwrap_or("");
+    let lon_field = fields.nth(lon - lat - 1).unwrap_or("");
+    ok(lat_field) && ok(lon_field)
+}
+
+/// Field (after the address) holding the UTC time `hhmmss.sss`.
+const fn time_field(kind: Kind) -> Option<usize> {
+    match kind {
+        Kind::Rmc | Kind::Gga | Kind::Zda => Some(1),
+        Kind::Gll => Some(5),
+        _ => None,
+    }
+}
+
+/// A line at most this long: the longest NMEA allows.
+type Line = heapless::String<{ super::line::MAX_LINE }>;
+
+/// The sentence with a leap second `23:59:60` written as `23:59:59` and its
+/// checksum recomputed; `None` when its time is not a leap second.
+fn leap_second_as_59(text: &str, kind: Kind) -> Option<Line> {
+    let index = time_field(kind)?;
+    let (body, _) = text.get(1..)?.split_once('*')?;
+    let time = body.split(',').nth(index)?;
+    if time.get(..6) != Some("235960") {
+        return None;
+    }
+    let mut out = Line::new();
+    out.push('$').ok()?;
+    for (i, field) in body.split(',').enumerate() {
+        if i > 0 {
+            out.push(',').ok()?;
+        }
+        if i == index {
+            out.push_str("235959").ok()?;
+            out.push_str(field.get(6..)?).ok()?;
+        } else {
+            out.push_str(field).ok()?;
+        }
+    }
+    let sum = out.bytes().skip(1).fold(0u8, |a, b| a ^ b);
+    let hex = |n: u8| char::from(b"0123456789ABCDEF"[usize::from(n & 0xF)]);
+    for c in ['*', hex(sum >> 4), hex(sum)] {
+        out.push(c).ok()?;
+    }
+    Some(out)
 }
 
 fn from_rmc(d: &RmcData) -> Option<Update> {
@@ -312,11 +416,16 @@ mod tests {
     #[test]
     fn rmc_status_v_is_invalid() {
         // A receiver without a fix sends its RTC's date (here "80", which the
-        // crate reads as 2080) and a placeholder position: the V status is
-        // what keeps them out of the fix.
+        // crate reads as 2080) and a stale position: the V status is what
+        // keeps them out of the fix.
         let (_, u) =
-            update("$GPRMC,235946.005,V,8960.000000,N,00000.000000,E,0.000,0.00,050180,,,N*47");
+            update("$GPRMC,235946.005,V,5213.000000,N,00653.000000,E,0.000,0.00,050180,,,N*45");
         assert_eq!(u.validity, Validity::Invalid);
+        // The MTK-3301's power-up placeholder, 89 deg 60 min, is no position.
+        assert_eq!(
+            parse("$GPRMC,235946.005,V,8960.000000,N,00000.000000,E,0.000,0.00,050180,,,N*47"),
+            Sentence::OutOfRange(Kind::Rmc)
+        );
     }
 
     #[test]

@@ -25,7 +25,7 @@ pub struct Args {
     #[arg(required = true)]
     pub logs: Vec<PathBuf>,
     /// A parameter to fit, as named in the file (repeat for more).
-    #[arg(long = "param", required = true)]
+    #[arg(long = "param", required = true, value_name = "KEY")]
     pub params_to_fit: Vec<String>,
     /// The fitted parameter file to write (TOML, whole or not at all).
     #[arg(short, long)]

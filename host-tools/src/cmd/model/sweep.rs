@@ -21,7 +21,7 @@ pub struct Args {
     /// Parameter file (TOML or BicycleParameters `*Benchmark.txt`).
     pub params: PathBuf,
     /// The parameter to vary, as named in the file (`section.key`).
-    #[arg(long)]
+    #[arg(long, value_name = "KEY")]
     pub param: String,
     /// Factors to scale it by, comma-separated.
     #[arg(long, value_delimiter = ',', default_value = "0.5,1,2")]
