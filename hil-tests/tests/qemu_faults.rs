@@ -64,14 +64,12 @@ fn assert_accounted(out: &Outcome, log: &Log, reason: DropoutReason) -> u64 {
     lost
 }
 
+/// The Figure-6 wobble alerted once, within the latency goal of the ground
+/// truth and at its frequency, whatever the fault.
 fn assert_alerted(out: &Outcome) {
-    assert!(
-        out.alerts()
-            .iter()
-            .any(|&(on, t_us)| on && (12_000_000..20_000_000).contains(&t_us)),
-        "{:?}",
-        out.alerts()
-    );
+    if let Err(e) = bundle().check_alerts(&out.alert_ons()) {
+        panic!("{e}; all alert changes: {:?}", out.alerts());
+    }
 }
 
 #[test]

@@ -8,6 +8,24 @@ fn wobblog() -> Command {
     Command::cargo_bin("wobblog").unwrap()
 }
 
+/// `wobblog model SUB` on a shipped parameter file.
+fn model(sub: &str, file: &str) -> Command {
+    let mut cmd = wobblog();
+    cmd.args(["model", sub]).arg(params(file));
+    cmd
+}
+
+/// Encodes a ride CSV into a card log.
+fn encode(csv: &Path, log: &Path) {
+    wobblog()
+        .args(["encode", "--csv"])
+        .arg(csv)
+        .arg("-o")
+        .arg(log)
+        .assert()
+        .success();
+}
+
 fn params(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("bicycle-model/params")
@@ -16,9 +34,7 @@ fn params(name: &str) -> PathBuf {
 
 #[test]
 fn eig_csv_has_one_row_per_eigenvalue_and_critical_speeds_on_stderr() {
-    let out = wobblog()
-        .args(["model", "eig"])
-        .arg(params("benchmark.toml"))
+    let out = model("eig", "benchmark.toml")
         .args(["--speeds", "0:10:0.5", "--format", "csv"])
         .output()
         .unwrap();
@@ -48,9 +64,7 @@ fn eig_csv_has_one_row_per_eigenvalue_and_critical_speeds_on_stderr() {
 fn eig_writes_its_output_file_whole() {
     let dir = tempfile::tempdir().unwrap();
     let target = dir.path().join("eig.jsonl");
-    wobblog()
-        .args(["model", "eig"])
-        .arg(params("benchmark.toml"))
+    model("eig", "benchmark.toml")
         .args(["--speeds", "4:7:0.25", "--format", "jsonl", "-o"])
         .arg(&target)
         .assert()
@@ -91,9 +105,7 @@ fn unphysical_parameters_exit_1_naming_file_and_parameter() {
 
 #[test]
 fn usage_errors_exit_2() {
-    let out = wobblog()
-        .args(["model", "eig"])
-        .arg(params("benchmark.toml"))
+    let out = model("eig", "benchmark.toml")
         .args(["--speeds", "5:1:0.1"])
         .output()
         .unwrap();
@@ -105,13 +117,7 @@ fn corpus_log(dir: &Path, name: &str) -> PathBuf {
         .join("../hil-tests/fixtures/corpus")
         .join(format!("{name}.csv"));
     let log = dir.join(format!("{name}.WBL"));
-    wobblog()
-        .args(["encode", "--csv"])
-        .arg(&csv)
-        .arg("-o")
-        .arg(&log)
-        .assert()
-        .success();
+    encode(&csv, &log);
     log
 }
 
@@ -119,17 +125,13 @@ fn corpus_log(dir: &Path, name: &str) -> PathBuf {
 fn plot_and_sweep_draw_figures_and_print_critical_speeds() {
     let dir = tempfile::tempdir().unwrap();
     let fig = dir.path().join("fig4.png");
-    wobblog()
-        .args(["model", "plot"])
-        .arg(params("test-bicycle.toml"))
+    model("plot", "test-bicycle.toml")
         .args(["--both", "--speeds", "0:8:0.25", "-o"])
         .arg(&fig)
         .assert()
         .success();
     assert!(std::fs::read(&fig).unwrap().starts_with(b"\x89PNG"));
-    let out = wobblog()
-        .args(["model", "sweep"])
-        .arg(params("test-bicycle.toml"))
+    let out = model("sweep", "test-bicycle.toml")
         .args([
             "--param",
             "front_tyre.cornering_stiffness",
@@ -151,9 +153,7 @@ fn plot_and_sweep_draw_figures_and_print_critical_speeds() {
         text.contains("x 1 (11.5 1/rad):\n  wobble speed 3.80"),
         "{text}"
     );
-    let out = wobblog()
-        .args(["model", "sweep"])
-        .arg(params("test-bicycle.toml"))
+    let out = model("sweep", "test-bicycle.toml")
         .args(["--param", "front_tyre.no_such", "--speeds", "0:1:1"])
         .output()
         .unwrap();
@@ -167,9 +167,7 @@ fn plot_and_sweep_draw_figures_and_print_critical_speeds() {
 fn compare_prints_residuals_and_fit_writes_the_fitted_file() {
     let dir = tempfile::tempdir().unwrap();
     let log = corpus_log(dir.path(), "wobble_fig6");
-    let out = wobblog()
-        .args(["model", "compare"])
-        .arg(params("test-bicycle.toml"))
+    let out = model("compare", "test-bicycle.toml")
         .arg(&log)
         .arg("-o")
         .arg(dir.path().join("fig8.svg"))
@@ -195,9 +193,7 @@ fn compare_prints_residuals_and_fit_writes_the_fitted_file() {
     assert!((cols[2] - cols[3] - cols[4]).abs() < 0.011, "{row}");
     assert!(text.contains("rms residuals over 1 episodes"));
     let fitted = dir.path().join("fitted.toml");
-    let out = wobblog()
-        .args(["model", "fit"])
-        .arg(params("test-bicycle.toml"))
+    let out = model("fit", "test-bicycle.toml")
         .arg(&log)
         .args(["--param", "steer_head.damping", "-o"])
         .arg(&fitted)
@@ -218,9 +214,7 @@ fn compare_prints_residuals_and_fit_writes_the_fitted_file() {
 
 #[test]
 fn eig_whipple_gives_the_four_states_of_the_lumped_bicycle() {
-    let out = wobblog()
-        .args(["model", "eig"])
-        .arg(params("test-bicycle.toml"))
+    let out = model("eig", "test-bicycle.toml")
         .args(["--whipple", "--speeds", "5:5:1", "--format", "csv"])
         .output()
         .unwrap();
@@ -236,4 +230,50 @@ fn eig_whipple_gives_the_four_states_of_the_lumped_bicycle() {
         modes.contains(&"weave") && modes.contains(&"castering"),
         "{text}"
     );
+}
+
+#[test]
+fn censored_episodes_are_compared_but_never_fitted() {
+    let dir = tempfile::tempdir().unwrap();
+    // The Figure 6 ride cut off while its wobble still grows: the episode
+    // meets the end of the data.
+    let csv =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../hil-tests/fixtures/corpus/wobble_fig6.csv");
+    let text = std::fs::read_to_string(csv).unwrap();
+    let mut lines = text.lines();
+    let mut cut = String::from(lines.next().unwrap());
+    cut.push('\n');
+    for line in lines.take_while(|l| l.split(',').next().unwrap().parse::<f64>().unwrap() < 14.6) {
+        cut.push_str(line);
+        cut.push('\n');
+    }
+    let cut_csv = dir.path().join("cut.csv");
+    std::fs::write(&cut_csv, cut).unwrap();
+    let log = dir.path().join("CUT.WBL");
+    encode(&cut_csv, &log);
+    let out = model("compare", "test-bicycle.toml")
+        .arg(&log)
+        .output()
+        .unwrap();
+    let text = String::from_utf8(out.stdout).unwrap();
+    let row = text
+        .lines()
+        .find(|l| l.starts_with("CUT.WBL"))
+        .expect(&text);
+    assert!(row.ends_with("yes"), "{text}");
+    assert!(
+        text.contains("no episodes to compare") || text.contains("over 0 episodes"),
+        "{text}"
+    );
+    let out = model("fit", "test-bicycle.toml")
+        .arg(&log)
+        .args(["--param", "steer_head.damping", "-o"])
+        .arg(dir.path().join("fitted.toml"))
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8(out.stderr)
+        .unwrap()
+        .contains("0 episodes cannot determine 1 parameters"));
+    assert!(!dir.path().join("fitted.toml").exists());
 }

@@ -183,6 +183,21 @@ mod tests {
     }
 
     #[test]
+    fn an_edge_exactly_the_oldest_age_is_accepted_one_more_is_stale() {
+        let mut clock = EdgeClock::new();
+        let now = 10_000_000;
+        let at = |age: u32| raw(5_000_000 + age, 5_000_000, now);
+        assert_eq!(
+            clock.edge_time_us(at(MAX_EDGE_AGE_US + 1)),
+            Err(Refused::Stale)
+        );
+        assert_eq!(
+            clock.edge_time_us(at(MAX_EDGE_AGE_US)),
+            Ok(now - u64::from(MAX_EDGE_AGE_US))
+        );
+    }
+
+    #[test]
     fn an_edge_before_boot_or_out_of_order_is_refused() {
         let mut clock = EdgeClock::new();
         assert_eq!(

@@ -79,7 +79,13 @@ pub fn prove_alive() {
 pub async fn feed(iwdg: Peri<'static, IWDG>) -> ! {
     let mut dog = IndependentWatchdog::new(iwdg, TIMEOUT_REQUEST_US as u32);
     dog.unleash();
-    DOG.lock(|d| d.borrow_mut().iwdg = Some(dog));
+    DOG.lock(|d| {
+        let mut d = d.borrow_mut();
+        d.iwdg = Some(dog);
+        // Rounds count from here: the card reads at boot checked before
+        // the tasks that beat had started.
+        d.liveness = Liveness::new();
+    });
     loop {
         prove_alive();
         Timer::after_millis(ASK_MS).await;

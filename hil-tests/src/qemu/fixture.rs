@@ -5,8 +5,7 @@
 
 use std::path::{Path, PathBuf};
 
-use wobble_core::format::{GpsFix, ACCEL_COUNTS_PER_G, GYRO_COUNTS_PER_DPS};
-use wobble_core::gps::{GpsConfig, GpsEvent, GpsReceiver};
+use wobble_core::format::{ACCEL_COUNTS_PER_G, GYRO_COUNTS_PER_DPS};
 use wobble_core::wheel::WheelConfig;
 
 use crate::corpus::{self, FixtureTruth, Row};
@@ -195,20 +194,42 @@ pub fn write_gps(path: &Path, chunks: &[GpsChunk]) -> std::io::Result<()> {
     std::fs::write(path, out)
 }
 
-/// The fixes the firmware's GPS path makes of `chunks` (the same code, run
-/// on the host): what the card must hold.
-#[must_use]
-pub fn expected_fixes(chunks: &[GpsChunk]) -> Vec<GpsFix> {
-    let mut rx = GpsReceiver::new(GpsConfig::default());
-    let mut fixes = Vec::new();
-    let mut emit = |ev: GpsEvent| {
-        if let GpsEvent::Fix(f) = ev {
-            fixes.push(f);
+/// One position fix as gpsd reported it for a capture.
+#[derive(Clone, Debug, PartialEq)]
+pub struct GpsdFix {
+    /// UTC, as gpsd writes it (`2020-03-18T13:28:20.600Z`).
+    pub time: String,
+    /// Latitude, degrees.
+    pub lat_deg: f64,
+    /// Longitude, degrees.
+    pub lon_deg: f64,
+}
+
+/// gpsd's own decoding of capture `name`: every TPV report with a position
+/// in its regression output (`NAME.chk` beside the capture), one per time
+/// (gpsd reports an epoch again after each of its sentences).
+///
+/// # Errors
+/// The file is missing or a report does not parse.
+pub fn gpsd_fixes(name: &str) -> Result<Vec<GpsdFix>, String> {
+    let path = gps_capture_path(&format!("{name}.chk"));
+    let text = std::fs::read_to_string(&path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let mut out: Vec<GpsdFix> = Vec::new();
+    for line in text.lines().filter(|l| l.starts_with('{')) {
+        let v: serde_json::Value =
+            serde_json::from_str(line).map_err(|e| format!("{}: {e}", path.display()))?;
+        let (Some(time), Some(lat_deg), Some(lon_deg)) =
+            (v["time"].as_str(), v["lat"].as_f64(), v["lon"].as_f64())
+        else {
+            continue;
+        };
+        if v["class"] == "TPV" && out.last().is_none_or(|f| f.time != time) {
+            out.push(GpsdFix {
+                time: time.to_owned(),
+                lat_deg,
+                lon_deg,
+            });
         }
-    };
-    for c in chunks {
-        // The image hands the chunk over when its record's ms comes due.
-        rx.feed(&c.bytes, c.t_us / 1000 * 1000, &mut emit);
     }
-    fixes
+    Ok(out)
 }

@@ -48,6 +48,48 @@ pub fn bundle(frames: u32) -> Result<Bundle, String> {
 }
 
 impl Bundle {
+    /// Checks alert-ons (time µs, reported frequency Hz) against the ride's
+    /// ground truth and the detector's goals: exactly one per episode that
+    /// expects one, none elsewhere, each within
+    /// [`goals::WORST_LATENCY_S`](crate::metrics::goals::WORST_LATENCY_S) of
+    /// the envelope reaching 0.5 deg (and not more than 0.5 s before it)
+    /// and within [`goals::FREQ_ERROR_HZ`](crate::metrics::goals::FREQ_ERROR_HZ)
+    /// of the true frequency.
+    ///
+    /// # Errors
+    /// What is wrong, for the test's message.
+    pub fn check_alerts(&self, ons: &[(u64, f64)]) -> Result<(), String> {
+        use crate::metrics::goals;
+        let episodes: Vec<_> = self
+            .ride
+            .truth
+            .episodes
+            .iter()
+            .filter(|e| e.alert_expected)
+            .collect();
+        if ons.len() != episodes.len() {
+            return Err(format!(
+                "{} alerts for {} episodes: {ons:?}",
+                ons.len(),
+                episodes.len()
+            ));
+        }
+        for (&(t_us, freq_hz), e) in ons.iter().zip(&episodes) {
+            let latency_s = t_us as f64 / 1e6 - e.t_ref_s;
+            let freq_error_hz = (freq_hz - e.freq_hz).abs();
+            if !(-0.5..=goals::WORST_LATENCY_S).contains(&latency_s)
+                || freq_error_hz > goals::FREQ_ERROR_HZ
+            {
+                return Err(format!(
+                    "alert at {t_us} µs, {freq_hz} Hz: latency {latency_s:.2} s, frequency error \
+                     {freq_error_hz:.2} Hz for the episode at {} Hz reaching 0.5 deg at {} s",
+                    e.freq_hz, e.t_ref_s
+                ));
+            }
+        }
+        Ok(())
+    }
+
     /// A setup for running this bundle with `scenario` in `dir`.
     #[must_use]
     pub fn setup(&self, dir: PathBuf, scenario: Scenario) -> Setup<'_> {

@@ -170,6 +170,24 @@ impl Outcome {
     }
 }
 
+impl Outcome {
+    /// The alert-ons reported live: (time µs, frequency Hz).
+    #[must_use]
+    pub fn alert_ons(&self) -> Vec<(u64, f64)> {
+        self.lines
+            .iter()
+            .filter(|l| l.starts_with("ALERT on "))
+            .filter_map(|l| {
+                let f = parse_fields(l);
+                Some((
+                    f.get("t_us")?.parse().ok()?,
+                    f.get("freq_hz")?.parse().ok()?,
+                ))
+            })
+            .collect()
+    }
+}
+
 fn parse_fields(line: &str) -> BTreeMap<String, String> {
     line.split(' ')
         .filter_map(|kv| kv.split_once('='))

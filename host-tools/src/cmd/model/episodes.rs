@@ -19,12 +19,11 @@ pub struct LoggedEpisode {
 }
 
 impl LoggedEpisode {
-    /// Whether the episode may not be fitted. The analysis does not mark
-    /// censored episodes (cut by a gap or the end of the log) yet, so
-    /// every episode counts until it does.
+    /// Whether the episode may not be fitted: the analysis marks it
+    /// censored when a gap or an end of the data cut it.
     #[must_use]
     pub fn censored(&self) -> bool {
-        false
+        self.episode.censored
     }
 
     /// The point drawn for it.
