@@ -372,6 +372,33 @@ mod tests {
     use super::*;
     use proptest::prelude::*;
 
+    /// The names are the CSV interface's (`wobblog model eig`).
+    #[test]
+    fn mode_names_are_the_interface_names() {
+        let all = [
+            Mode::Wobble,
+            Mode::Weave,
+            Mode::Capsize,
+            Mode::Castering,
+            Mode::Lean,
+            Mode::Twist,
+            Mode::Other,
+        ];
+        let names: Vec<String> = all.iter().map(ToString::to_string).collect();
+        assert_eq!(
+            names,
+            [
+                "wobble",
+                "weave",
+                "capsize",
+                "castering",
+                "lean",
+                "twist",
+                "other"
+            ]
+        );
+    }
+
     proptest! {
         /// Eigenvalues moving on straight lines, crossing or not, are each
         /// followed on their own line: the extrapolation carries a branch
