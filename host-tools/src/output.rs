@@ -51,6 +51,8 @@ enum Sink {
         target: PathBuf,
     },
     Stdout(BufWriter<Stdout>),
+    /// A device or FIFO named as the output, written in place.
+    Device(BufWriter<std::fs::File>),
 }
 
 impl Output {
@@ -59,6 +61,19 @@ impl Output {
     pub fn create(target: &Path, inputs: &[&Path]) -> Result<Self, CliError> {
         refuse_inputs(target, inputs)?;
         let resolved = resolve_symlink(target);
+        // A device or a pipe (`-o /dev/null`, a FIFO) is written as it is:
+        // renaming a file over it would replace the device itself.
+        if std::fs::metadata(&resolved).is_ok_and(|m| !m.is_file() && !m.is_dir()) {
+            let file = std::fs::OpenOptions::new()
+                .write(true)
+                .open(&resolved)
+                .map_err(|e| CliError::file(target, e))?;
+            return Ok(Self {
+                sink: Sink::Device(BufWriter::with_capacity(BUFFER_LEN, file)),
+                name: target.to_path_buf(),
+                pipe_closed: false,
+            });
+        }
         let temp = temp_beside(&resolved)
             .map_err(|e| CliError::file(target, format!("cannot create the output: {e}")))?;
         Ok(Self {
@@ -133,6 +148,7 @@ impl Output {
     pub fn commit(self) -> Result<(), CliError> {
         let name = self.name;
         match self.sink {
+            Sink::Device(mut out) => out.flush().map_err(|e| CliError::file(&name, e)),
             Sink::Stdout(mut out) => out.flush().map_err(|e| {
                 if e.kind() == io::ErrorKind::BrokenPipe {
                     CliError::PipeClosed
@@ -160,6 +176,7 @@ impl Write for Output {
         let mut written = 0;
         let result = match &mut self.sink {
             Sink::File { temp, .. } => temp.write(buf),
+            Sink::Device(out) => out.write(buf),
             Sink::Stdout(out) => out.write(buf),
         }
         .map(|n| written = n);
@@ -169,6 +186,7 @@ impl Write for Output {
     fn flush(&mut self) -> io::Result<()> {
         let result = match &mut self.sink {
             Sink::File { temp, .. } => temp.flush(),
+            Sink::Device(out) => out.flush(),
             Sink::Stdout(out) => out.flush(),
         };
         self.note(result)
@@ -243,6 +261,16 @@ mod tests {
         out.commit().unwrap();
         assert_eq!(std::fs::read(&target).unwrap(), b"whole\n");
         assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+    }
+
+    #[test]
+    fn a_device_is_written_in_place_not_replaced() {
+        let null = Path::new("/dev/null");
+        let mut out = Output::create(null, &[]).unwrap();
+        out.write_all(b"gone").unwrap();
+        out.commit().unwrap();
+        let meta = std::fs::metadata(null).unwrap();
+        assert!(!meta.is_file(), "/dev/null is still a device");
     }
 
     #[test]
