@@ -54,6 +54,17 @@ fn duckdb(sql: &str) -> Option<Vec<serde_json::Value>> {
     Some(serde_json::from_slice(&out.stdout).unwrap())
 }
 
+/// Runs `wobblog export DIR -o DS`.
+fn export(dir: &Path, ds: &Path) -> std::process::Output {
+    wobblog()
+        .arg("export")
+        .arg(dir)
+        .arg("-o")
+        .arg(ds)
+        .output()
+        .unwrap()
+}
+
 #[test]
 fn duckdb_queries_a_dataset_of_several_runs() {
     let dir = tempfile::tempdir().unwrap();
@@ -140,13 +151,7 @@ fn the_dataset_appears_whole_or_not_at_all() {
     card(&card_dir);
     std::fs::write(card_dir.join("RUN00004.WBL"), vec![0u8; 4096]).unwrap();
     let ds = dir.path().join("season");
-    let out = wobblog()
-        .arg("export")
-        .arg(&card_dir)
-        .arg("-o")
-        .arg(&ds)
-        .output()
-        .unwrap();
+    let out = export(&card_dir, &ds);
     assert_eq!(out.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&out.stderr).contains("RUN00004.WBL"));
     let left: Vec<_> = std::fs::read_dir(dir.path())
@@ -159,13 +164,7 @@ fn the_dataset_appears_whole_or_not_at_all() {
     std::fs::remove_file(card_dir.join("RUN00004.WBL")).unwrap();
     std::fs::create_dir(&ds).unwrap();
     std::fs::write(ds.join("mine.txt"), "keep").unwrap();
-    let out = wobblog()
-        .arg("export")
-        .arg(&card_dir)
-        .arg("-o")
-        .arg(&ds)
-        .output()
-        .unwrap();
+    let out = export(&card_dir, &ds);
     assert_eq!(out.status.code(), Some(1));
     assert_eq!(
         std::fs::read_to_string(ds.join("mine.txt")).unwrap(),

@@ -187,11 +187,12 @@ impl<W: Write + Send> RowWriter<W> {
 
 fn write_csv<W: Write>(w: &mut csv::Writer<W>, columns: &[Column], row: &Row) -> csv::Result<()> {
     let mut num = ryu::Buffer::new();
+    let mut time = [0u8; UTC_LEN];
     for column in columns {
         match (column.value)(row) {
             Value::Number(Some(v)) => w.write_field(num.format(v))?,
             Value::Label(Some(s)) => w.write_field(s)?,
-            Value::Utc(Some(us)) => w.write_field(utc_text(us))?,
+            Value::Utc(Some(us)) => w.write_field(utc_text(us, &mut time))?,
             Value::Integer(Some(n)) => w.write_field(n.to_string())?,
             Value::Text(Some(s)) => w.write_field(s)?,
             Value::Number(None)
@@ -206,39 +207,98 @@ fn write_csv<W: Write>(w: &mut csv::Writer<W>, columns: &[Column], row: &Row) ->
 
 /// One JSON object per row; absent values are left out. Written by hand:
 /// every key is a plain column name and every string value a fixed name or
-/// an ISO time, so nothing needs escaping, and no map is built per row.
+/// an ISO time, so nothing needs escaping, and nothing is allocated per
+/// cell (the one-hour export is benchmarked).
 fn write_json<W: Write>(w: &mut W, columns: &[Column], row: &Row) -> std::io::Result<()> {
     let mut num = ryu::Buffer::new();
-    let mut line = String::with_capacity(256);
+    let mut time = [0u8; UTC_LEN];
+    let mut line = String::with_capacity(320);
     line.push('{');
     for column in columns {
-        let text = match (column.value)(row) {
-            Value::Number(Some(v)) => num.format(v).to_string(),
-            Value::Label(Some(s)) => format!("\"{s}\""),
-            Value::Utc(Some(us)) => format!("\"{}\"", utc_text(us)),
-            Value::Integer(Some(n)) => n.to_string(),
-            Value::Text(Some(s)) => serde_json::to_string(&s).map_err(std::io::Error::other)?,
-            Value::Number(None)
-            | Value::Label(None)
-            | Value::Utc(None)
-            | Value::Integer(None)
-            | Value::Text(None) => continue,
+        let value = (column.value)(row);
+        let is_some = match &value {
+            Value::Number(v) => v.is_some(),
+            Value::Label(v) => v.is_some(),
+            Value::Utc(v) | Value::Integer(v) => v.is_some(),
+            Value::Text(v) => v.is_some(),
         };
+        if !is_some {
+            continue;
+        }
         if line.len() > 1 {
             line.push(',');
         }
         line.push('"');
         line.push_str(column.name);
         line.push_str("\":");
-        line.push_str(&text);
+        match value {
+            Value::Number(Some(v)) => line.push_str(num.format(v)),
+            Value::Label(Some(s)) => {
+                line.push('"');
+                line.push_str(s);
+                line.push('"');
+            }
+            Value::Utc(Some(us)) => {
+                line.push('"');
+                line.push_str(utc_text(us, &mut time));
+                line.push('"');
+            }
+            Value::Integer(Some(n)) => line.push_str(&n.to_string()),
+            Value::Text(Some(s)) => {
+                line.push_str(&serde_json::to_string(&s).map_err(std::io::Error::other)?);
+            }
+            _ => {}
+        }
     }
     line.push_str("}\n");
     w.write_all(line.as_bytes())
 }
 
-/// UTC in ISO 8601 to the millisecond (rounded down).
-fn utc_text(us: i64) -> String {
-    crate::time::iso8601_unix_ms(us.div_euclid(1000)).unwrap_or_default()
+/// Length of `2020-03-18T13:28:20.600Z`.
+const UTC_LEN: usize = 24;
+
+/// UTC in ISO 8601 to the millisecond (rounded down), as
+/// [`crate::time::iso8601`] writes it, into `buf` without allocating;
+/// empty outside the card's dates.
+fn utc_text(us: i64, buf: &mut [u8; UTC_LEN]) -> &str {
+    const MS_PER_DAY: i64 = 86_400_000;
+    const UNIX_MS_AT_2000: i64 = 10_957 * MS_PER_DAY;
+    let since_2000 = us.div_euclid(1000) - UNIX_MS_AT_2000;
+    let Ok(days_since_2000) = u16::try_from(since_2000.div_euclid(MS_PER_DAY)) else {
+        return "";
+    };
+    let ms = since_2000.rem_euclid(MS_PER_DAY);
+    let utc = wobble_core::format::UtcTime {
+        days_since_2000,
+        ms_of_day: ms as u32,
+    };
+    let (year, month, day) = utc.date();
+    let mut put = |at: usize, value: i64, digits: usize| {
+        let mut v = value;
+        for i in (0..digits).rev() {
+            buf[at + i] = b'0' + (v % 10) as u8;
+            v /= 10;
+        }
+    };
+    put(0, i64::from(year), 4);
+    put(5, i64::from(month), 2);
+    put(8, i64::from(day), 2);
+    put(11, ms / 3_600_000, 2);
+    put(14, ms / 60_000 % 60, 2);
+    put(17, ms / 1000 % 60, 2);
+    put(20, ms % 1000, 3);
+    for (at, sep) in [
+        (4, b'-'),
+        (7, b'-'),
+        (10, b'T'),
+        (13, b':'),
+        (16, b':'),
+        (19, b'.'),
+        (23, b'Z'),
+    ] {
+        buf[at] = sep;
+    }
+    std::str::from_utf8(buf).unwrap_or("")
 }
 
 /// Keeps the kind of an I/O error wrapped by `mcap`.
@@ -267,6 +327,23 @@ mod tests {
     fn the_documented_csv_columns_come_first() {
         let names: Vec<&str> = columns::COLUMNS.iter().map(|c| c.name).collect();
         assert_eq!(names[..CSV_COLUMNS.len()], CSV_COLUMNS);
+    }
+
+    #[test]
+    fn fast_utc_text_is_iso8601() {
+        let mut buf = [0u8; UTC_LEN];
+        for ms in [
+            946_684_800_000i64,
+            1_584_538_100_600,
+            1_584_575_999_999,
+            4_102_444_800_123,
+        ] {
+            assert_eq!(
+                utc_text(ms * 1000 + 999, &mut buf),
+                crate::time::iso8601_unix_ms(ms).unwrap()
+            );
+        }
+        assert_eq!(utc_text(0, &mut buf), "");
     }
 
     #[test]

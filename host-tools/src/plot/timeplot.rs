@@ -234,39 +234,33 @@ impl Figure for TimePlot {
             let span = |&(a, b): &(f64, f64), colour: RGBAColor| {
                 Rectangle::new([(a, y.start), (b, y.end)], colour.filled())
             };
-            let alerts = chart
-                .draw_series(
-                    self.alerts_s
-                        .iter()
-                        .map(|s| span(s, ALERT_COLOUR.mix(0.18))),
-                )
-                .map_err(err)?;
-            if k == 0 && !self.alerts_s.is_empty() {
-                alerts.label("wobble alert (on board)").legend(|(x, y)| {
-                    Rectangle::new(
-                        [(x, y - 6), (x + 16, y + 6)],
-                        ALERT_COLOUR.mix(0.18).filled(),
-                    )
-                });
-            }
-            let lost = chart
-                .draw_series(self.lost_s.iter().map(|s| span(s, LOST_COLOUR.mix(0.35))))
-                .map_err(err)?;
-            if k == 0 && !self.lost_s.is_empty() {
-                lost.label("data lost (missing blocks)").legend(|(x, y)| {
-                    Rectangle::new(
-                        [(x, y - 6), (x + 16, y + 6)],
-                        LOST_COLOUR.mix(0.35).filled(),
-                    )
-                });
-            }
-            let jumps = chart
-                .draw_series(self.jumps_s.iter().map(|s| span(s, JUMP_COLOUR.mix(0.3))))
-                .map_err(err)?;
-            if k == 0 && !self.jumps_s.is_empty() {
-                jumps.label("time jump (logger clock)").legend(|(x, y)| {
-                    Rectangle::new([(x, y - 6), (x + 16, y + 6)], JUMP_COLOUR.mix(0.3).filled())
-                });
+            // The shaded spans, each kind in the key of the top panel if present.
+            let shaded = [
+                (
+                    &self.alerts_s,
+                    ALERT_COLOUR.mix(0.18),
+                    "wobble alert (on board)",
+                ),
+                (
+                    &self.lost_s,
+                    LOST_COLOUR.mix(0.35),
+                    "data lost (missing blocks)",
+                ),
+                (
+                    &self.jumps_s,
+                    JUMP_COLOUR.mix(0.3),
+                    "time jump (logger clock)",
+                ),
+            ];
+            for (spans, colour, label) in shaded {
+                let drawn = chart
+                    .draw_series(spans.iter().map(|s| span(s, colour)))
+                    .map_err(err)?;
+                if k == 0 && !spans.is_empty() {
+                    drawn.label(label).legend(move |(x, y)| {
+                        Rectangle::new([(x, y - 6), (x + 16, y + 6)], colour.filled())
+                    });
+                }
             }
             let markers = chart
                 .draw_series(self.markers_s.iter().map(|&t| {
