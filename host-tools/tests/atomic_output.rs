@@ -1,32 +1,14 @@
 //! Outputs appear whole or not at all, and no command writes over its input.
 
+mod analysis_support;
+
+use analysis_support::{steady_ride_log, wobblog};
 use assert_cmd::Command;
 use std::path::{Path, PathBuf};
 
-fn wobblog() -> Command {
-    Command::cargo_bin("wobblog").unwrap()
-}
-
 /// A 10 s ride CSV with GPS and the log `wobblog encode` makes of it.
 fn sample(dir: &Path) -> (PathBuf, PathBuf) {
-    let mut csv =
-        String::from("t_s,steer_deg,speed_mps,gps_lat_deg,gps_lon_deg,gps_speed_mps,gps_fix\n");
-    for i in 0..1000 {
-        let t = f64::from(i) / 100.0;
-        let steer = (t * 6.4 * std::f64::consts::TAU).sin();
-        csv.push_str(&format!("{t},{steer:.2},4.0,52.2,6.88,4.0,3d\n"));
-    }
-    let csv_path = dir.join("ride.csv");
-    std::fs::write(&csv_path, csv).unwrap();
-    let log = dir.join("RUN00001.WBL");
-    wobblog()
-        .args(["encode", "--csv"])
-        .arg(&csv_path)
-        .arg("-o")
-        .arg(&log)
-        .assert()
-        .success();
-    (csv_path, log)
+    steady_ride_log(dir, 1000, "ride.csv", "RUN00001.WBL")
 }
 
 /// The names in `dir`, sorted.

@@ -1,47 +1,13 @@
 //! The `wobblog` binary: exit codes, messages and damage reports.
 
-use assert_cmd::Command;
-use std::path::{Path, PathBuf};
+mod analysis_support;
 
-fn wobblog() -> Command {
-    Command::cargo_bin("wobblog").unwrap()
-}
+use analysis_support::{info_json, steady_ride_log, wobblog};
+use std::path::{Path, PathBuf};
 
 /// A 30 s log of a steady ride with GPS, from CSV through `wobblog encode`.
 fn sample_log(dir: &Path) -> PathBuf {
-    let mut csv =
-        String::from("t_s,steer_deg,speed_mps,gps_lat_deg,gps_lon_deg,gps_speed_mps,gps_fix\n");
-    for i in 0..3000 {
-        let t = f64::from(i) / 100.0;
-        let steer = (t * 6.4 * std::f64::consts::TAU).sin();
-        csv.push_str(&format!("{t},{steer:.2},4.0,52.2,6.88,4.0,3d\n"));
-    }
-    let csv_path = dir.join("in.csv");
-    std::fs::write(&csv_path, csv).unwrap();
-    let log = dir.join("run.wbl");
-    wobblog()
-        .args(["encode", "--csv"])
-        .arg(&csv_path)
-        .arg("-o")
-        .arg(&log)
-        .assert()
-        .success();
-    log
-}
-
-fn info_json(log: &Path) -> serde_json::Value {
-    let out = wobblog()
-        .arg("info")
-        .arg(log)
-        .arg("--json")
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    serde_json::from_slice(&out.stdout).unwrap()
+    steady_ride_log(dir, 3000, "in.csv", "run.wbl").1
 }
 
 #[test]

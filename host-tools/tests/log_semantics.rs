@@ -1,16 +1,13 @@
 //! Logs whose blocks pass their CRC but whose content is impossible: what
 //! `wobblog` reports of them, and what it refuses to show as data.
 
+mod analysis_support;
+
 use std::path::Path;
 
-use assert_cmd::Command;
-use serde_json::Value;
+use analysis_support::{info_json, wobblog};
 use wobble_core::format::header::header_records;
 use wobble_core::format::{BlockEncoder, FixMode, Frame, GpsFix, LogInfo, Record, UtcTime};
-
-fn wobblog() -> Command {
-    Command::cargo_bin("wobblog").unwrap()
-}
 
 fn frame(t_us: u64) -> Record<'static> {
     Record::Frame(Frame {
@@ -47,21 +44,6 @@ fn write_log<'a>(
         file.extend_from_slice(b);
     }
     std::fs::write(path, file).unwrap();
-}
-
-fn info_json(log: &Path) -> Value {
-    let out = wobblog()
-        .arg("info")
-        .arg(log)
-        .arg("--json")
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    serde_json::from_slice(&out.stdout).unwrap()
 }
 
 const DAY_US: u64 = 86_400_000_000;

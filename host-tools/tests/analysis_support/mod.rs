@@ -32,6 +32,40 @@ pub fn stdout_of(cmd: &mut Command) -> String {
     String::from_utf8(out.stdout).unwrap()
 }
 
+/// `wobblog info --json` of `log`, which must succeed.
+pub fn info_json(log: &Path) -> serde_json::Value {
+    serde_json::from_str(&stdout_of(wobblog().arg("info").arg(log).arg("--json"))).unwrap()
+}
+
+/// A steady ride of `frames` 100 Hz frames (a 6.4 Hz steering sine at
+/// 4 m/s with a GPS fix on every row) written as `csv_name` in `dir`, and the
+/// log `wobblog encode` makes of it as `log_name`; returns both paths.
+pub fn steady_ride_log(
+    dir: &Path,
+    frames: u32,
+    csv_name: &str,
+    log_name: &str,
+) -> (std::path::PathBuf, std::path::PathBuf) {
+    let mut csv =
+        String::from("t_s,steer_deg,speed_mps,gps_lat_deg,gps_lon_deg,gps_speed_mps,gps_fix\n");
+    for i in 0..frames {
+        let t = f64::from(i) / 100.0;
+        let steer = (t * 6.4 * TAU).sin();
+        csv.push_str(&format!("{t},{steer:.2},4.0,52.2,6.88,4.0,3d\n"));
+    }
+    let csv_path = dir.join(csv_name);
+    std::fs::write(&csv_path, csv).unwrap();
+    let log = dir.join(log_name);
+    wobblog()
+        .args(["encode", "--csv"])
+        .arg(&csv_path)
+        .arg("-o")
+        .arg(&log)
+        .assert()
+        .success();
+    (csv_path, log)
+}
+
 /// The synthetic corpus: `hil-tests/fixtures/corpus`, or the
 /// directory `CORPUS_DIR` names (e.g. a freshly generated one).
 #[must_use]
