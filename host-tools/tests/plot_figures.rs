@@ -52,7 +52,10 @@ fn assert_font_embedded(svg: &str) -> usize {
             _ => {}
         }
     }
-    assert!(css.contains(&format!("font-family: \"{FONT}\"")), "{css:.200}");
+    assert!(
+        css.contains(&format!("font-family: \"{FONT}\"")),
+        "{css:.200}"
+    );
     let uri = "url(\"data:font/ttf;base64,";
     let start = css.find(uri).expect("no data URI") + uri.len();
     let data = &css[start..start + css[start..].find('"').unwrap()];
@@ -60,7 +63,10 @@ fn assert_font_embedded(svg: &str) -> usize {
         .decode(data)
         .unwrap();
     let bundled = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/DejaVuSans.ttf");
-    assert!(ttf == std::fs::read(bundled).unwrap(), "not the bundled font");
+    assert!(
+        ttf == std::fs::read(bundled).unwrap(),
+        "not the bundled font"
+    );
     texts
 }
 
@@ -79,7 +85,8 @@ fn every_svg_carries_the_bundled_font() {
         .assert()
         .success();
     assert!(assert_font_embedded(&std::fs::read_to_string(&fig8).unwrap()) > 20);
-    let params = Path::new(env!("CARGO_MANIFEST_DIR")).join("bicycle-model/params/test-bicycle.toml");
+    let params =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("bicycle-model/params/test-bicycle.toml");
     let eig = dir.path().join("eig.svg");
     wobblog()
         .args(["model", "plot"])
@@ -261,7 +268,13 @@ fn figure_8_has_a_dot_per_episode_and_a_legend_per_run() {
         .split('<')
         .filter(|e| e.starts_with("polyline") && e.to_uppercase().contains(&hex(ZERO_LINE_COLOUR)))
         .map(|e| {
-            let points = e.split("points=\"").nth(1).unwrap().split('"').next().unwrap();
+            let points = e
+                .split("points=\"")
+                .nth(1)
+                .unwrap()
+                .split('"')
+                .next()
+                .unwrap();
             points
                 .split_whitespace()
                 .map(|p| {

@@ -178,7 +178,10 @@ impl ModePlot {
         };
         if let Some(line) = zero_line {
             chart
-                .draw_series(std::iter::once(PathElement::new(line, ZERO_LINE_COLOUR.stroke_width(1))))
+                .draw_series(std::iter::once(PathElement::new(
+                    line,
+                    ZERO_LINE_COLOUR.stroke_width(1),
+                )))
                 .map_err(err)?;
         }
         for (k, (_, episodes)) in self.runs.iter().enumerate() {
