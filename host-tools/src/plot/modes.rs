@@ -25,6 +25,9 @@ pub const CENSORED_COLOUR: RGBColor = RGBColor(0xa0, 0xa0, 0xa0);
 /// below) and unstable (right, above) wobble.
 pub const ZERO_LINE_COLOUR: RGBColor = RGBColor(0x30, 0x30, 0x30);
 
+/// An episode's value on a panel's axis.
+type Coordinate = fn(&Episode) -> f64;
+
 /// Which axis of a panel is sigma, so its zero line is drawn.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum SigmaAxis {
@@ -138,7 +141,7 @@ impl ModePlot {
         &self,
         area: &DrawingArea<DB, Shift>,
         labels: (&str, &str),
-        (x, y): (fn(&Episode) -> f64, fn(&Episode) -> f64),
+        (x, y): (Coordinate, Coordinate),
         sigma_on: SigmaAxis,
     ) -> Result<(), String> {
         let err = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
