@@ -124,10 +124,16 @@ fn main() -> ! {
         startup::blink_code(&mut led, code);
     }
 
-    let selftest = marker_held(&mut board);
+    let button = marker_held(&mut board);
     let (card, loaded) = card_and_config(board.card);
     let config = loaded.config;
-    if selftest {
+    if button || loaded.selftest {
+        if loaded.selftest {
+            defmt::info!(
+                "{}: selftest=1 (remove the line to ride)",
+                config::FILE_NAME
+            );
+        }
         let _wheel_timer = adapters::wheel::start(board.wheel);
         let (_, ports) = sampler_parts(board.imu, board.steering, board.rider, &config);
         let parts = wobble_stm32f405::selftest::Parts {
