@@ -112,7 +112,8 @@ fn main() -> ! {
     for code in boot_faults.into_iter().flatten() {
         QUEUE.push(Record::Fault(boot::system_fault(code, 0)));
     }
-    if reset.is_abnormal() || !crystal {
+    let debugger = cortex_m::peripheral::DCB::is_debugger_attached();
+    if reset.blink_at_boot(debugger) || !crystal {
         // Shown on the alert LED before logging starts: the cause, or 9
         // for the crystal.
         let code = if crystal {
