@@ -81,11 +81,17 @@ for t in "${targets[@]}"; do
   out="mutants.out/$name"
   mkdir -p "$out"
   start=$(date +%s)
-  # Exit status 2 (missed mutants) or 3 (timeouts) is the result, not a failure.
-  cargo mutants -j 1 --no-shuffle --in-place --timeout "$timeout_s" "${filters[@]}" \
-    "${cargo_args[@]}" --output "$out" || true
+  # In place runs one mutant at a time (no `-j`). Exit status 2 (missed
+  # mutants) or 3 (timeouts) is the result; anything else is a failed run.
+  status=0
+  cargo mutants --no-shuffle --in-place --timeout "$timeout_s" "${filters[@]}" \
+    "${cargo_args[@]}" --output "$out" || status=$?
+  if ((status != 0 && status != 2 && status != 3)); then
+    echo "mutants.sh: cargo mutants failed on $name (status $status)" >&2
+    exit 1
+  fi
   r="$out/mutants.out"
-  count() { grep -c . "$r/$1.txt" 2>/dev/null || true; }
+  count() { if [[ -s "$r/$1.txt" ]]; then grep -c . "$r/$1.txt"; else echo 0; fi; }
   echo "== $name: $(count caught) caught, $(count missed) missed, $(count unviable) unviable," \
     "$(count timeout) timeouts in $(($(date +%s) - start)) s"
   sed 's/^/  missed: /' "$r/missed.txt" 2>/dev/null || true
