@@ -130,6 +130,37 @@ proptest! {
         prop_assert!(events.is_empty(), "{:?}", events);
     }
 
+    /// The impulse detector sees a jolt in the hop it arrives, before its
+    /// ring shows in the analysis window (whose newest samples weigh least),
+    /// and holds the alert off from that analysis on; a blip below
+    /// `impulse_min_deg` over the noise floor is no impulse.
+    #[test]
+    fn a_jolt_holds_off_from_the_hop_it_arrives(
+        f in 6.0f32..9.0, jolt in prop::bool::ANY, level in 0.0f32..1.0, offset in 0usize..5,
+    ) {
+        let cfg = DetectorConfig::default();
+        let amp = if jolt {
+            // Twice the minimum: the high-pass takes some of a jolt's edge.
+            cfg.impulse_min_deg * (2.0 + level)
+        } else {
+            cfg.impulse_min_deg * (0.2 + 0.4 * level)
+        };
+        let mut d = detector();
+        let start = 300 + offset;
+        let mut first = None;
+        for i in 0..start + 100 {
+            let tau = (i as f32 - start as f32) / FS;
+            let ring = if tau >= 0.0 { amp * (-6.0 * tau).exp() * (TAU * f * tau).cos() } else { 0.0 };
+            d.push(ring + noise(i as u32), None);
+            if d.analysed() && i >= start {
+                let held = d.estimate().impulse_holdoff;
+                first.get_or_insert(held);
+                prop_assert!(jolt || !held, "{amp} deg blip held off at sample {i}: {:?}", d.estimate());
+            }
+        }
+        prop_assert_eq!(first, Some(jolt), "{} deg, first analysis after it", amp);
+    }
+
     /// Any input, NaN and infinities included, leaves the detector finite and
     /// its events alternating on/off.
     #[test]
