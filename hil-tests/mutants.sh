@@ -6,6 +6,9 @@
 #   hil-tests/mutants.sh                   # every target below, in order
 #   hil-tests/mutants.sh detector wheel    # some targets by name
 #   hil-tests/mutants.sh --list            # the targets and their mutant counts
+#   hil-tests/mutants.sh --iterate detector
+#       # again, skipping the mutants the last run caught or found unviable
+#       # (after adding tests, or to finish an interrupted run)
 #
 # It mutates the checkout it lives in (`--in-place`) and restores each file
 # after each mutant, so run it in a clone you are not editing meanwhile:
@@ -47,9 +50,14 @@ targets=(
 )
 
 list=false
+iterate=()
 wanted=()
 for a in "$@"; do
-  if [[ "$a" == --list ]]; then list=true; else wanted+=("$a"); fi
+  case "$a" in
+    --list) list=true ;;
+    --iterate) iterate=(--iterate) ;;
+    *) wanted+=("$a") ;;
+  esac
 done
 
 # In place means a mutated file is briefly in the work tree: refuse a tree
@@ -85,7 +93,7 @@ for t in "${targets[@]}"; do
   # mutants) or 3 (timeouts) is the result; anything else is a failed run.
   status=0
   cargo mutants --no-shuffle --in-place --timeout "$timeout_s" "${filters[@]}" \
-    "${cargo_args[@]}" --output "$out" || status=$?
+    "${cargo_args[@]}" "${iterate[@]}" --output "$out" || status=$?
   if ((status != 0 && status != 2 && status != 3)); then
     echo "mutants.sh: cargo mutants failed on $name (status $status)" >&2
     exit 1
@@ -93,7 +101,8 @@ for t in "${targets[@]}"; do
   r="$out/mutants.out"
   count() { if [[ -s "$r/$1.txt" ]]; then grep -c . "$r/$1.txt"; else echo 0; fi; }
   echo "== $name: $(count caught) caught, $(count missed) missed, $(count unviable) unviable," \
-    "$(count timeout) timeouts in $(($(date +%s) - start)) s"
+    "$(count timeout) timeouts in $(($(date +%s) - start)) s" \
+    "$( ((${#iterate[@]})) && echo "($(count previously_caught) caught or unviable before)")"
   sed 's/^/  missed: /' "$r/missed.txt" 2>/dev/null || true
   if ! git diff --quiet HEAD; then
     echo "mutants.sh: the run left $(git diff --name-only HEAD) changed; restore it with git checkout" >&2
