@@ -161,6 +161,62 @@ proptest! {
         prop_assert_eq!(first, Some(jolt), "{} deg, first analysis after it", amp);
     }
 
+    /// The hold-off ends `impulse_holdoff_s` after the jolt's last jump,
+    /// also while a steady oscillation smaller than the jolt goes on (which
+    /// never catches up with the jolt's peak).
+    #[test]
+    fn the_hold_off_runs_out_after_a_jolt(
+        f in 6.0f32..9.0, steady_f in 6.0f32..9.0, jolt_deg in 2.0f32..5.0,
+    ) {
+        let cfg = DetectorConfig::default();
+        // Between the thresholds: no alert, but well above the noise.
+        let steady_deg = 0.5 * (cfg.amp_on_deg + cfg.amp_off_deg);
+        let t_jolt = 3.0;
+        let mut d = detector();
+        let mut held = Vec::new();
+        for i in 0..(7.0 * FS) as usize {
+            let t = i as f32 / FS;
+            let tau = t - t_jolt;
+            let ring = if tau >= 0.0 { jolt_deg * (-8.0 * tau).exp() * (TAU * f * tau).cos() } else { 0.0 };
+            d.push(steady_deg * (TAU * steady_f * t).sin() + ring, None);
+            if d.analysed() && t > t_jolt {
+                held.push((t, d.estimate().impulse_holdoff));
+            }
+        }
+        prop_assert!(held[0].1, "the jolt held nothing off");
+        // The last jump is seen by the time the ring's start has crossed
+        // the analysis window.
+        let t_free = t_jolt + cfg.window_s + cfg.impulse_holdoff_s + 2.0 * cfg.hop_s;
+        for &(t, h) in &held {
+            prop_assert!(t < t_free || !h, "still held off at {} s", t);
+        }
+    }
+
+    /// A wobble growing out of the jolt that excited it alerts once it has
+    /// outgrown the jolt's peak (taken over `impulse_capture_s`), before the
+    /// hold-off would have run out.
+    #[test]
+    fn a_wobble_outgrowing_its_jolt_alerts_within_the_hold_off(
+        f in 6.0f32..9.0, jolt_deg in 0.8f32..1.2, growth_per_s in 3.0f32..3.5,
+    ) {
+        let cfg = DetectorConfig::default();
+        let t_jolt = 3.0;
+        let events = run(6.0, None, |t| {
+            let tau = t - t_jolt;
+            if tau < 0.0 {
+                return noise((t * FS) as u32);
+            }
+            let ring = jolt_deg * (-8.0 * tau).exp() * (TAU * f * tau).cos();
+            let wobble = (0.2 * (growth_per_s * tau).exp()).min(3.0) * (TAU * f * tau).sin();
+            ring + wobble + noise((t * FS) as u32)
+        });
+        let on = events.iter().find(|e| matches!(e.1, AlertEvent::On { .. }));
+        prop_assert!(
+            on.is_some_and(|e| e.0 < t_jolt + cfg.impulse_holdoff_s),
+            "{:?}", events
+        );
+    }
+
     /// Any input, NaN and infinities included, leaves the detector finite and
     /// its events alternating on/off.
     #[test]
