@@ -66,6 +66,16 @@ impl Model {
         }
     }
 
+    /// Whether `freq_hz` lies within `harmonic_tol_hz` of a multiple of the
+    /// wheel's rotation frequency at `speed_mps` (never without a speed).
+    fn at_wheel_harmonic(&self, freq_hz: f32, speed_mps: Option<f32>) -> bool {
+        let Some(f_wheel) = speed_mps.map(|v| v / WheelConfig::DEFAULT.circumference_m) else {
+            return false;
+        };
+        let highest = (freq_hz / f_wheel) as u32 + 1;
+        (1..=highest).any(|n| (freq_hz - n as f32 * f_wheel).abs() <= self.cfg.harmonic_tol_hz)
+    }
+
     /// What the analysis with estimate `e` must switch.
     fn analyse(&mut self, e: &Estimate, speed_mps: Option<f32>) -> Option<bool> {
         let c = &self.cfg;
@@ -128,6 +138,13 @@ fn replay(
         let expected = if d.analysed() {
             let e = d.estimate();
             prop_assert_eq!(e.in_band, model.in_band(e.freq_hz), "sample {}: {:?}", i, e);
+            prop_assert_eq!(
+                e.at_wheel_harmonic,
+                model.at_wheel_harmonic(e.freq_hz, speed_mps),
+                "sample {}: {:?}",
+                i,
+                e
+            );
             let growth = model.growth_ratio(e.amp_deg);
             prop_assert!(
                 (e.growth_ratio - growth).abs() <= 1e-5 * growth.abs(),
