@@ -31,6 +31,9 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 export CARGO_PROFILE_DEV_DEBUG=0 CARGO_INCREMENTAL=1
+# A mutant's failures are no regressions of the code: keep proptest from
+# writing them into the committed regression files.
+export PROPTEST_DISABLE_FAILURE_PERSISTENCE=1
 # Longest a mutant's tests may run, s: the slowest target's baseline is
 # under 10 s, so a mutant past this has made something loop.
 timeout_s="${MUTANTS_TIMEOUT_S:-60}"

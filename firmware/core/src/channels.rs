@@ -327,7 +327,7 @@ mod tests {
     #[test]
     fn len_and_is_empty_follow_pushes_and_pops() {
         let q = RecordQueue::new();
-        assert!(q.is_empty() && q.len() == 0);
+        assert_eq!((q.len(), q.is_empty()), (0, true));
         for n in 1..=QUEUE_LEN {
             assert!(q.push(frame(n as u64)));
             assert!(!q.is_empty() && q.len() == n);
