@@ -1,5 +1,6 @@
 //! A sensor that does not answer, or another part in its place, is reported
-//! after the identity check and nothing is written to it.
+//! after the identity check and nothing is written to it; the identity
+//! itself can be read raw.
 
 mod icm42688_support;
 
@@ -35,4 +36,15 @@ fn another_part_is_named_by_its_id() {
     let err = init_with_who_am_i(0x12);
     assert_eq!(err, Error::WrongId(0x12));
     assert_eq!(err.sensor_error(), SensorError::NoResponse);
+}
+
+#[test]
+fn the_identity_is_read_raw_whatever_answers() {
+    for answer in [WHO_AM_I_VALUE, 0x12, 0x00, 0xFF] {
+        let expectations = [write_reg(REG_BANK_SEL, 0), read_regs(WHO_AM_I, &[answer])].concat();
+        let mut spi = Mock::new(&expectations);
+        let mut imu = Icm42688::new(spi.clone(), Config::default());
+        assert_eq!(block_on(imu.who_am_i()), Ok(answer));
+        spi.done();
+    }
 }

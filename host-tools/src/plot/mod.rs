@@ -2,9 +2,10 @@
 //! run) and Figure 8 (wobble modes in the complex plane).
 //!
 //! Text is drawn with the DejaVu Sans font compiled into the program, so
-//! plotting needs no system font libraries.
+//! plotting needs no system font libraries; an SVG carries the font with it.
 
 pub mod modes;
+mod svg_font;
 pub mod timeplot;
 
 use std::io::Write;
@@ -17,8 +18,9 @@ use plotters::prelude::*;
 use crate::output::Output;
 use crate::CliError;
 
-/// The font every figure uses.
-pub const FONT: &str = "sans-serif";
+/// The font every figure uses: its family name, which an SVG's text
+/// elements name and its embedded font face defines.
+pub const FONT: &str = "DejaVu Sans";
 static FONT_BYTES: &[u8] = include_bytes!("../../assets/DejaVuSans.ttf");
 
 /// A figure that can draw itself on any plotters backend.
@@ -87,7 +89,7 @@ fn draw(figure: &impl Figure, kind: ImageKind) -> Result<Vec<u8>, String> {
                 figure.draw(&root)?;
                 root.present().map_err(|e| e.to_string())?;
             }
-            Ok(svg.into_bytes())
+            Ok(svg_font::embed(&svg, FONT, FONT_BYTES)?.into_bytes())
         }
     }
 }
@@ -108,8 +110,12 @@ fn register_font() {
     static ONCE: Once = Once::new();
     ONCE.call_once(|| {
         // The bytes are the committed font file; if they ever failed to
-        // parse, text would be missing and plotters would report it.
-        let _ = plotters::style::register_font(FONT, FontStyle::Normal, FONT_BYTES);
+        // parse, text would be missing and plotters would report it. Text
+        // left in plotters' default family gets the same glyphs in a PNG
+        // (and fails the SVG tests, which want the embedded family).
+        for family in [FONT, "sans-serif"] {
+            let _ = plotters::style::register_font(family, FontStyle::Normal, FONT_BYTES);
+        }
     });
 }
 

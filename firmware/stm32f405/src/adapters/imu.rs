@@ -54,6 +54,11 @@ impl ImuAdapter {
         }
     }
 
+    /// The sensor's `WHO_AM_I` as read, `None` when the bus fails.
+    pub async fn identity(&mut self) -> Option<u8> {
+        self.driver.who_am_i().await.ok()
+    }
+
     fn failed<E>(&mut self, e: Error<E>) -> SensorError {
         defmt::warn!("IMU: {}", e.sensor_error());
         self.ready = false;
