@@ -113,14 +113,23 @@ mod tests {
     use super::*;
     use proptest::prelude::*;
 
-    fn row(t_us: u64, steer_cdeg: i16) -> CsvRow {
+    /// A row at `t_us` whose every channel is a multiple of `v` (wrapping:
+    /// the property below takes any `v`).
+    fn row(t_us: u64, v: i16) -> CsvRow {
         CsvRow {
             frame: Frame {
                 t_us,
-                steer_cdeg,
+                accel: [v, v.wrapping_neg(), v.wrapping_mul(2)],
+                gyro: [v.wrapping_neg(), v, v.wrapping_mul(3)],
+                steer_cdeg: v,
+                speed_mm_s: v.unsigned_abs().wrapping_mul(4),
                 ..Frame::default()
             },
-            gps: None,
+            gps: Some(GpsFix {
+                t_us,
+                lat_e7: Some(i32::from(v)),
+                ..GpsFix::default()
+            }),
             utc_ms: Some(1_600_000_000_000 + (t_us / 1000) as i64),
         }
     }
@@ -147,21 +156,24 @@ mod tests {
         let times: Vec<u64> = out.iter().map(|f| f.frame.t_us).collect();
         assert_eq!(times, (0..=10).map(|k| 10_000 * k).collect::<Vec<_>>());
         for f in &out {
-            assert_eq!(i64::from(f.frame.steer_cdeg), (f.frame.t_us / 1000) as i64);
-            assert_eq!(
-                f.utc_ms,
-                Some(1_600_000_000_000 + (f.frame.t_us / 1000) as i64)
-            );
+            let ms = (f.frame.t_us / 1000) as i16;
+            assert_eq!(f.frame, row(f.frame.t_us, ms).frame);
+            assert_eq!(f.utc_ms, Some(1_600_000_000_000 + i64::from(ms)));
+            // The fix of the row at or before the frame, never made up.
+            assert_eq!(f.gps, rows[(f.frame.t_us / 25_000) as usize].gps);
         }
     }
 
     #[test]
     fn no_frame_is_made_across_a_gap() {
         let rows = [row(0, 0), row(5_000, 5), row(500_000, 50), row(505_000, 55)];
-        let out = resample(&rows, 10_000);
-        let times: Vec<u64> = out.iter().map(|f| f.frame.t_us).collect();
-        // The grid starts again at the row after the gap.
-        assert_eq!(times, vec![0, 500_000]);
+        // The grid starts again at the row after the gap; each frame is the
+        // row at its time.
+        assert_eq!(resample(&rows, 10_000), vec![rows[0], rows[2]]);
+        // A stretch's last row is a frame when it lies on the grid, with its
+        // own fix.
+        let rows = [row(0, 0), row(5_000, 5), row(10_000, 10), row(500_000, 50)];
+        assert_eq!(resample(&rows, 10_000), vec![rows[0], rows[2], rows[3]]);
     }
 
     proptest! {
