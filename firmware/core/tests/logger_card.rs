@@ -206,6 +206,13 @@ fn flushes_keep_the_file_size_within_one_flush_period() {
             "{on_card} of {end} frames on card"
         );
         assert_eq!(on_card, u64::from(log.stats().frames_on_card));
+        // ...and no more often than that: each flush costs block writes.
+        let periods = end / period_frames;
+        let flushes = u64::from(log.stats().flushes);
+        assert!(
+            (periods..=periods + 1).contains(&flushes),
+            "{flushes} flushes in {periods} flush periods"
+        );
     }
 }
 
