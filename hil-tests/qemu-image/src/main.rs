@@ -173,12 +173,13 @@ async fn writer_task(card: SemihostingCard, config: &'static Config) {
     let st = logger.stats();
     report::line(format_args!(
         "END frames={} t_us={} max_late_us={} queue_high_water={} queue_frames_dropped={} \
-         card_frames_lost={} card_absent={} card_write_failed={} card_full={} files={} closed={}",
+         queue_others_dropped={} card_frames_lost={} card_absent={} card_write_failed={} card_full={} files={} closed={}",
         FRAMES_SAMPLED.load(Ordering::Relaxed),
         Instant::now().as_micros(),
         MAX_LATE_US.load(Ordering::Relaxed),
         QUEUE.high_water(),
         QUEUE.frames_dropped_pending(),
+        QUEUE.others_dropped(),
         st.frames_lost,
         st.faults[usize::from(FAULT_CARD_ABSENT - 1)],
         st.faults[usize::from(FAULT_CARD_WRITE - 1)],

@@ -8,7 +8,7 @@ use wobble_core::detector::AlertEvent;
 
 /// Writes one line.
 pub fn line(args: core::fmt::Arguments<'_>) {
-    let mut text = heapless::String::<192>::new();
+    let mut text = heapless::String::<256>::new();
     let _ = text.write_fmt(args);
     let _ = text.push('\n');
     semihosting::print!("{text}");
