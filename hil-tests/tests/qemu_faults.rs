@@ -136,7 +136,10 @@ fn stall_beyond_the_design_is_a_dropout_with_the_exact_count() {
         .iter()
         .filter(|g| g.time <= last && !on_card.contains(&g.time))
         .count() as u64;
-    assert!(missing >= 1 && missing <= others, "{missing} fixes missing, {others} records dropped");
+    assert!(
+        missing >= 1 && missing <= others,
+        "{missing} fixes missing, {others} records dropped"
+    );
     println!("FIGURES long stall: 2000 ms stall lost {lost} frames, all in one dropout record; \
               the GPS task met the full queue: {missing} fixes missing, {others} GPS records counted dropped");
     assert_alerted(&out);
@@ -310,7 +313,10 @@ fn imu_that_freezes_is_found_stuck_and_set_up_again() {
         .iter()
         .filter(|f| f.status.has(FrameStatus::IMU_FAULT))
         .count() as u64;
-    assert!(counted >= 1 && counted <= flagged, "{counted} counted, {flagged} flagged");
+    assert!(
+        counted >= 1 && counted <= flagged,
+        "{counted} counted, {flagged} flagged"
+    );
     assert_alerted(&out);
 }
 

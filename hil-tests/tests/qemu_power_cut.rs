@@ -77,8 +77,14 @@ fn one_cut(bundle: &qemu::Bundle, base: &Path, write: u32) -> (u32, u64, u64) {
 }
 
 /// Runs one cut `permille` thousandths into block write `write`; returns
-/// (frames sampled, frames on card, bytes of the block programmed).
-fn one_torn_cut(bundle: &qemu::Bundle, base: &Path, write: u32, permille: u32) -> (u64, u64, u64) {
+/// (frames sampled, frames on card, bytes of the block programmed, damaged
+/// blocks).
+fn one_torn_cut(
+    bundle: &qemu::Bundle,
+    base: &Path,
+    write: u32,
+    permille: u32,
+) -> (u64, u64, u64, u64) {
     let scenario = Scenario {
         cut_in_write: Some((write, permille)),
         ..Scenario::ride(FRAMES)
@@ -92,7 +98,7 @@ fn one_torn_cut(bundle: &qemu::Bundle, base: &Path, write: u32, permille: u32) -
         cut.damaged,
         cut.torn
     );
-    (cut.sampled, cut.frames.len() as u64, cut.torn)
+    (cut.sampled, cut.frames.len() as u64, cut.torn, cut.damaged)
 }
 
 /// What a cut left.
@@ -143,11 +149,17 @@ fn cut_run(bundle: &qemu::Bundle, base: &Path, name: &str, scenario: Scenario) -
     for (k, &index) in frames.iter().enumerate() {
         if index != expected {
             gaps += 1;
-            assert!(index > expected, "{name}: frame {k} is {index}, expected {expected}");
+            assert!(
+                index > expected,
+                "{name}: frame {k} is {index}, expected {expected}"
+            );
         }
         expected = index + 1;
     }
-    assert!(gaps <= damaged, "{name}: {gaps} gaps in the frames, {damaged} damaged blocks");
+    assert!(
+        gaps <= damaged,
+        "{name}: {gaps} gaps in the frames, {damaged} damaged blocks"
+    );
     assert!(logs.iter().all(|l| l.dropouts.is_empty()));
     let on_card = frames.len() as u64;
     // At most a flush period and the queue, plus the frames of a block the
@@ -178,7 +190,7 @@ fn power_cut_inside_40_random_block_writes() {
         }
     }
     let base = Path::new(env!("CARGO_TARGET_TMPDIR"));
-    let results: Vec<(u64, u64, u64)> = std::thread::scope(|s| {
+    let results: Vec<(u64, u64, u64, u64)> = std::thread::scope(|s| {
         let workers: Vec<_> = cuts
             .chunks(TORN_CUTS / 2)
             .map(|chunk| {
@@ -198,6 +210,11 @@ fn power_cut_inside_40_random_block_writes() {
     });
     let torn = results.iter().filter(|r| r.2 > 0).count();
     assert!(torn >= TORN_CUTS / 2, "only {torn} cuts left a block torn");
+    let damaged: u64 = results.iter().map(|r| r.3).sum();
     let worst = results.iter().map(|r| r.0 - r.1).max().unwrap_or(0);
-    println!("FIGURES torn power cut: {} cuts inside block writes, {torn} of them into a block being programmed; frames lost per cut worst {worst}", results.len());
+    println!(
+        "FIGURES torn power cut: {} cuts inside block writes, {torn} of them into a block being \
+         programmed, {damaged} left a damaged block (reported by the decoder); frames lost per cut worst {worst}",
+        results.len()
+    );
 }

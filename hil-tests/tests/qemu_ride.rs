@@ -87,13 +87,22 @@ fn bundled_ride_logs_every_frame_fix_and_alert() {
     for (k, f) in log.frames.iter().enumerate() {
         let row = bundle.ride.rows[k];
         let steer_err = (f64::from(f.steer_deg()) - f64::from(row.steer_deg)).abs();
-        assert!(steer_err <= steer_tol, "frame {k}: steering off by {steer_err} deg");
+        assert!(
+            steer_err <= steer_tol,
+            "frame {k}: steering off by {steer_err} deg"
+        );
         let (accel_g, gyro_dps) = fixture::imu_truth(&row);
         for i in 0..3 {
             let accel_err = (f64::from(f.accel_g()[i]) - accel_g[i]).abs();
             let gyro_err = (f64::from(f.gyro_dps()[i]) - gyro_dps[i]).abs();
-            assert!(accel_err <= accel_tol, "frame {k}: accel axis {i} off by {accel_err} g");
-            assert!(gyro_err <= gyro_tol, "frame {k}: gyro axis {i} off by {gyro_err} deg/s");
+            assert!(
+                accel_err <= accel_tol,
+                "frame {k}: accel axis {i} off by {accel_err} g"
+            );
+            assert!(
+                gyro_err <= gyro_tol,
+                "frame {k}: gyro axis {i} off by {gyro_err} deg/s"
+            );
             worst[1] = worst[1].max(accel_err);
             worst[2] = worst[2].max(gyro_err);
         }

@@ -60,7 +60,8 @@ impl InterruptSlot {
     }
 
     fn start(&'static self, context: usize) -> Spawner {
-        let executor: &'static raw::Executor = self.cell.init(raw::Executor::new(context as *mut ()));
+        let executor: &'static raw::Executor =
+            self.cell.init(raw::Executor::new(context as *mut ()));
         self.running
             .store(core::ptr::from_ref(executor).cast_mut(), Ordering::Release);
         executor.spawner()

@@ -122,7 +122,10 @@ impl ErrorType for EmulatedIcm42688 {
 impl SpiDevice for EmulatedIcm42688 {
     /// One chip-select frame: the first byte written is the address (bit 7
     /// set for a read); the rest of the frame reads or writes from there.
-    async fn transaction(&mut self, operations: &mut [Operation<'_, u8>]) -> Result<(), Infallible> {
+    async fn transaction(
+        &mut self,
+        operations: &mut [Operation<'_, u8>],
+    ) -> Result<(), Infallible> {
         let now_ms = Instant::now().as_millis();
         let mut addr: Option<(u8, bool)> = None;
         for op in operations {
@@ -148,7 +151,9 @@ impl SpiDevice for EmulatedIcm42688 {
                         out.fill(0xFF);
                     }
                 }
-                Operation::Transfer(_, _) | Operation::TransferInPlace(_) | Operation::DelayNs(_) => {}
+                Operation::Transfer(_, _)
+                | Operation::TransferInPlace(_)
+                | Operation::DelayNs(_) => {}
             }
         }
         Ok(())

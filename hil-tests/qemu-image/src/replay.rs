@@ -166,7 +166,11 @@ pub struct ReplayedAdc {
 }
 
 impl ReplayedAdc {
-    pub fn new(ride: &'static RefCell<Ride>, channel: Steering, scenario: &'static Scenario) -> Self {
+    pub fn new(
+        ride: &'static RefCell<Ride>,
+        channel: Steering,
+        scenario: &'static Scenario,
+    ) -> Self {
         Self {
             ride,
             channel,

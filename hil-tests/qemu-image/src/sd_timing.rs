@@ -54,7 +54,7 @@ impl SdTiming {
 
     /// The time before a read block has arrived.
     pub fn read(&self) -> Duration {
-        let access = if self.next() % 256 == 0 {
+        let access = if self.next().is_multiple_of(256) {
             self.between(10_000, READ_LIMIT_US)
         } else {
             self.between(300, 1_000)
@@ -64,7 +64,7 @@ impl SdTiming {
 
     /// A written block's transfer and the busy time after it.
     pub fn write(&self) -> (Duration, Duration) {
-        let busy = if self.next() % 128 == 0 {
+        let busy = if self.next().is_multiple_of(128) {
             self.between(25_000, WRITE_LIMIT_US)
         } else {
             self.between(500, 2_000)

@@ -126,10 +126,10 @@ pub fn counts_for(cal: &SteeringCalibration, deg: f64) -> f64 {
 fn imu_registers(config: &Config, row: &Row, rng: &mut Rng) -> Vec<u8> {
     let scale = icm42688::Config::default().imu_config(config.imu);
     let (accel_g, gyro_dps) = imu_truth(row);
-    let accel = to_sensor(&config.imu.axis_map, accel_g)
-        .map(|g| g / f64::from(scale.accel_g_per_lsb));
-    let gyro = to_sensor(&config.imu.axis_map, gyro_dps)
-        .map(|d| d / f64::from(scale.gyro_dps_per_lsb));
+    let accel =
+        to_sensor(&config.imu.axis_map, accel_g).map(|g| g / f64::from(scale.accel_g_per_lsb));
+    let gyro =
+        to_sensor(&config.imu.axis_map, gyro_dps).map(|d| d / f64::from(scale.gyro_dps_per_lsb));
     accel
         .iter()
         .chain(&gyro)
@@ -162,7 +162,12 @@ fn adc_conversions(cal: &SteeringCalibration, deg: f64) -> Vec<u16> {
 ///
 /// # Errors
 /// The file could not be written.
-pub fn write_ride(path: &Path, rows: &[Row], frames: usize, config: &Config) -> std::io::Result<()> {
+pub fn write_ride(
+    path: &Path,
+    rows: &[Row],
+    frames: usize,
+    config: &Config,
+) -> std::io::Result<()> {
     let wheel = WheelConfig::DEFAULT;
     let pitch_m = f64::from(wheel.circumference_m) / f64::from(wheel.holes);
     let mut out = Vec::with_capacity(frames * 32);
