@@ -1,6 +1,7 @@
 //! A sensor that does not answer, or another part in its place, is reported
-//! after the identity check and nothing is written to it; one that goes
-//! away after its set-up reads as the floating bus, which is no sample.
+//! after the identity check and nothing is written to it; the identity
+//! itself can be read raw; one that goes away after its set-up reads as the
+//! floating bus, which is no sample.
 
 mod icm42688_support;
 
@@ -53,4 +54,15 @@ fn a_sensor_gone_after_init_is_no_response_not_a_sample() {
     let mut imu = Icm42688::new(spi.clone(), Config::default());
     assert!(block_on(imu.read()).is_ok());
     spi.done();
+}
+
+#[test]
+fn the_identity_is_read_raw_whatever_answers() {
+    for answer in [WHO_AM_I_VALUE, 0x12, 0x00, 0xFF] {
+        let expectations = [write_reg(REG_BANK_SEL, 0), read_regs(WHO_AM_I, &[answer])].concat();
+        let mut spi = Mock::new(&expectations);
+        let mut imu = Icm42688::new(spi.clone(), Config::default());
+        assert_eq!(block_on(imu.who_am_i()), Ok(answer));
+        spi.done();
+    }
 }

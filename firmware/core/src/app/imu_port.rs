@@ -63,6 +63,12 @@ impl<SPI: SpiDevice, D: DelayNs> Icm42688Port<SPI, D> {
         }
     }
 
+    /// The sensor's `WHO_AM_I` as read, `None` when the bus fails (the
+    /// self-test's report).
+    pub async fn identity(&mut self) -> Option<u8> {
+        self.driver.who_am_i().await.ok()
+    }
+
     fn failed<E>(&mut self, e: &Error<E>) -> SensorError {
         #[cfg(feature = "defmt")]
         defmt::warn!("IMU: {}", e.sensor_error());

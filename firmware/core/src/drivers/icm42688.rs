@@ -285,9 +285,7 @@ impl<SPI: SpiDevice> Icm42688<SPI> {
     /// [`Error::WrongId`] when the sensor is not there.
     pub async fn init(&mut self, delay: &mut impl DelayNs) -> Result<(), Error<SPI::Error>> {
         use reg::*;
-        // The MCU may have reset while the sensor was left in another bank.
-        self.write(REG_BANK_SEL, 0).await?;
-        match self.read_reg(WHO_AM_I).await? {
+        match self.who_am_i().await? {
             WHO_AM_I_VALUE => {}
             0x00 | 0xFF => return Err(Error::NoResponse),
             other => return Err(Error::WrongId(other)),
@@ -303,6 +301,17 @@ impl<SPI: SpiDevice> Icm42688<SPI> {
             }
         }
         Ok(())
+    }
+
+    /// Reads the identity register as it is, whatever part answers (the
+    /// self-test reports the raw value). Works before [`Self::init`].
+    ///
+    /// # Errors
+    /// [`Error::Comm`] on a bus error.
+    pub async fn who_am_i(&mut self) -> Result<u8, Error<SPI::Error>> {
+        // The MCU may have reset while the sensor was left in another bank.
+        self.write(reg::REG_BANK_SEL, 0).await?;
+        self.read_reg(reg::WHO_AM_I).await
     }
 
     /// Reads the latest accel and gyro sample (one 12-byte burst), in the
