@@ -64,6 +64,15 @@ fn assert_accounted(out: &Outcome, log: &Log, reason: DropoutReason) -> u64 {
     lost
 }
 
+/// IMU faults the log's fault records count.
+fn imu_faults_counted(log: &Log) -> u64 {
+    log.faults
+        .iter()
+        .filter(|f| f.source == FaultSource::Imu)
+        .map(|f| u64::from(f.count))
+        .sum()
+}
+
 /// The Figure-6 wobble alerted once, within the latency goal of the ground
 /// truth and at its frequency, whatever the fault.
 fn assert_alerted(out: &Outcome) {
@@ -242,12 +251,7 @@ fn imu_that_stops_answering_is_flagged_and_counted() {
         "{} frames flagged, {after} after 5 s",
         dead.len()
     );
-    let counted: u64 = log
-        .faults
-        .iter()
-        .filter(|f| f.source == FaultSource::Imu)
-        .map(|f| u64::from(f.count))
-        .sum();
+    let counted = imu_faults_counted(log);
     // Counts are recorded once a second: the last second may be pending.
     assert!(
         counted + 100 >= dead.len() as u64 && counted <= dead.len() as u64,
@@ -302,12 +306,7 @@ fn imu_that_freezes_is_found_stuck_and_set_up_again() {
             assert!(flagged, "frame at {} µs not flagged", f.t_us);
         }
     }
-    let counted: u64 = log
-        .faults
-        .iter()
-        .filter(|f| f.source == FaultSource::Imu)
-        .map(|f| u64::from(f.count))
-        .sum();
+    let counted = imu_faults_counted(log);
     let flagged = log
         .frames
         .iter()

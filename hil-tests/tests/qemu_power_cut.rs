@@ -40,27 +40,26 @@ fn power_cut_at_100_random_block_writes() {
         }
     }
     let base = Path::new(env!("CARGO_TARGET_TMPDIR"));
-    let results: Vec<(u32, u64, u64)> = std::thread::scope(|s| {
-        let workers: Vec<_> = cuts
-            .chunks(CUTS / 2)
-            .map(|chunk| {
-                let bundle = &bundle;
-                s.spawn(move || {
-                    chunk
-                        .iter()
-                        .map(|&w| one_cut(bundle, base, w))
-                        .collect::<Vec<_>>()
-                })
-            })
+    let results = on_two_workers(&cuts, |&w| one_cut(&bundle, base, w));
+    let worst = results.iter().map(|r| r.1 - r.2).max().unwrap_or(0);
+    let mean = results.iter().map(|r| (r.1 - r.2) as f64).sum::<f64>() / results.len() as f64;
+    println!("FIGURES power cut: {} cuts, frames lost per cut mean {mean:.1}, worst {worst} (flush period {FLUSH_FRAMES} frames)", results.len());
+}
+
+/// `run` over `items` on two threads (QEMU runs one core each), results in
+/// the order of `items`.
+fn on_two_workers<T: Sync, R: Send>(items: &[T], run: impl Fn(&T) -> R + Sync) -> Vec<R> {
+    let run = &run;
+    std::thread::scope(|s| {
+        let workers: Vec<_> = items
+            .chunks(items.len().div_ceil(2).max(1))
+            .map(|chunk| s.spawn(move || chunk.iter().map(run).collect::<Vec<_>>()))
             .collect();
         workers
             .into_iter()
             .flat_map(|h| h.join().expect("worker"))
             .collect()
-    });
-    let worst = results.iter().map(|r| r.1 - r.2).max().unwrap_or(0);
-    let mean = results.iter().map(|r| (r.1 - r.2) as f64).sum::<f64>() / results.len() as f64;
-    println!("FIGURES power cut: {} cuts, frames lost per cut mean {mean:.1}, worst {worst} (flush period {FLUSH_FRAMES} frames)", results.len());
+    })
 }
 
 /// Runs one cut before block write `write`; returns (write, frames sampled,
@@ -190,24 +189,7 @@ fn power_cut_inside_40_random_block_writes() {
         }
     }
     let base = Path::new(env!("CARGO_TARGET_TMPDIR"));
-    let results: Vec<(u64, u64, u64, u64)> = std::thread::scope(|s| {
-        let workers: Vec<_> = cuts
-            .chunks(TORN_CUTS / 2)
-            .map(|chunk| {
-                let bundle = &bundle;
-                s.spawn(move || {
-                    chunk
-                        .iter()
-                        .map(|&(w, p)| one_torn_cut(bundle, base, w, p))
-                        .collect::<Vec<_>>()
-                })
-            })
-            .collect();
-        workers
-            .into_iter()
-            .flat_map(|h| h.join().expect("worker"))
-            .collect()
-    });
+    let results = on_two_workers(&cuts, |&(w, p)| one_torn_cut(&bundle, base, w, p));
     let torn = results.iter().filter(|r| r.2 > 0).count();
     assert!(torn >= TORN_CUTS / 2, "only {torn} cuts left a block torn");
     let damaged: u64 = results.iter().map(|r| r.3).sum();
