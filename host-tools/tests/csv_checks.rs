@@ -27,29 +27,52 @@ fn csv_text(rows: &[String]) -> String {
 /// Runs `encode` and `detect` on `text`; both must fail with exit 1 and a
 /// message holding `expected`; no log may appear.
 fn assert_both_refuse(dir: &Path, text: &str, expected: &str) {
+    for command in ["encode", "detect"] {
+        assert_refuses(dir, command, text, expected);
+    }
+}
+
+/// Runs `wobblog COMMAND --csv` on `text`: it must fail with exit 1 and one
+/// line naming the file, the line and `expected`; no log may appear.
+fn assert_refuses(dir: &Path, command: &str, text: &str, expected: &str) {
     let csv = dir.join("in.csv");
     std::fs::write(&csv, text).unwrap();
     let log = dir.join("out.wbl");
-    let encode = wobblog()
-        .args(["encode", "--csv"])
-        .arg(&csv)
-        .arg("-o")
-        .arg(&log)
-        .output()
-        .unwrap();
-    let detect = wobblog()
-        .args(["detect", "--csv"])
-        .arg(&csv)
-        .output()
-        .unwrap();
-    for (what, out) in [("encode", encode), ("detect", detect)] {
-        let stderr = String::from_utf8_lossy(&out.stderr);
-        assert_eq!(out.status.code(), Some(1), "{what}: {stderr}");
-        assert!(stderr.contains(expected), "{what}: {stderr}");
-        assert!(stderr.contains("in.csv: line "), "{what}: {stderr}");
-        assert_eq!(stderr.lines().count(), 1, "{what}: {stderr}");
+    let mut cmd = wobblog();
+    cmd.args([command, "--csv"]).arg(&csv);
+    if command == "encode" {
+        cmd.arg("-o").arg(&log);
     }
+    let out = cmd.output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{command}: {stderr}");
+    assert!(stderr.contains(expected), "{command}: {stderr}");
+    assert!(stderr.contains("in.csv: line "), "{command}: {stderr}");
+    assert_eq!(stderr.lines().count(), 1, "{command}: {stderr}");
     assert!(!log.exists());
+}
+
+/// A `utc` column `encode` cannot turn into sync pairs.
+#[test]
+fn utc_that_cannot_be_stored_names_the_cell() {
+    let dir = tempfile::tempdir().unwrap();
+    for (rows, expected) in [
+        (
+            "0.01,1,2020-03-18T10:00:01Z\n0.02,1,yesterday\n",
+            "line 3, column 3: `utc` is not a UTC time",
+        ),
+        (
+            "0.01,1,2020-03-18T10:00:01Z\n0.02,1,\n",
+            "line 3, column 3: `utc` is empty after a row with a UTC",
+        ),
+        (
+            "0.01,1,2150-01-01T00:00:00Z\n",
+            "line 2, column 3: `utc` is outside the years",
+        ),
+    ] {
+        let text = format!("t_s,steer_deg,utc\n{rows}");
+        assert_refuses(dir.path(), "encode", &text, expected);
+    }
 }
 
 #[test]

@@ -238,6 +238,31 @@ fn card_absent_at_boot_is_reported_with_the_exact_loss() {
 }
 
 #[test]
+fn queue_dropouts_while_the_card_is_absent_join_the_count() {
+    // The queue dropped 37 frames while the writer was busy with a card
+    // that then went away: its dropout record must not vanish with them.
+    let card = MockCard::new(fat32_image());
+    card.set_removed(true);
+    let mut log = logger(card);
+    run(&mut log, 0, 100);
+    let dropout = Record::Dropout(Dropout {
+        t_us: 100 * FRAME_PERIOD_US,
+        frames_lost: 37,
+        reason: DropoutReason::QueueFull,
+    });
+    log.push(&dropout, 137 * FRAME_PERIOD_US);
+    run(&mut log, 137, 150);
+    assert_eq!(log.stats().frames_lost, 100 + 37 + 13);
+    log.with_device(|c| c.set_removed(false));
+    run(&mut log, 150, 300);
+    log.close(300 * FRAME_PERIOD_US).expect("close");
+    let image = log.with_device(|c| c.image());
+    let d = decode(&read_file(&image, "RUN00001.WBL").expect("file"));
+    let lost: u32 = d.dropouts.iter().map(|x| x.frames_lost).sum();
+    assert_eq!(d.frames.len() as u32 + lost, 300, "{:?}", d.dropouts);
+}
+
+#[test]
 fn card_pulled_mid_run_loses_only_what_was_not_on_it() {
     let mut log = logger(MockCard::new(fat32_image()));
     run(&mut log, 0, 1234);

@@ -8,12 +8,13 @@ use wobble_core::format::header::header_records;
 use wobble_core::format::limits::SPEED_CM_S_MAX;
 use wobble_core::format::{
     quantise_i16, quantise_i32, quantise_u16, BlockEncoder, FixMode, Frame, GpsFix, LogInfo,
-    Record, ACCEL_COUNTS_PER_G, EDGE_AGE_NONE, GYRO_COUNTS_PER_DPS, STEER_COUNTS_PER_DEG,
+    Record, UtcSync, ACCEL_COUNTS_PER_G, EDGE_AGE_NONE, GYRO_COUNTS_PER_DPS, STEER_COUNTS_PER_DEG,
 };
 
 use crate::csv_input::{number_in, Cell, TimeSteps};
 use crate::export::CSV_COLUMNS;
 use crate::output::Output;
+use crate::time::parse_iso8601;
 use crate::CliError;
 
 /// Arguments of `wobblog encode`.
@@ -21,6 +22,8 @@ use crate::CliError;
 pub struct Args {
     /// Input CSV with a header line; columns as `wobblog decode` writes them
     /// (`t_s` required, missing channels are zero, other columns ignored).
+    /// A `utc` column becomes the log's GPS sync pairs, so the decoded log
+    /// has the same UTC.
     #[arg(long)]
     pub csv: PathBuf,
     /// The card log to write.
@@ -43,12 +46,64 @@ pub fn run(args: &Args) -> Result<(), CliError> {
     output.commit()
 }
 
-/// Index of each known column in the CSV, if present.
-struct Columns([Option<usize>; CSV_COLUMNS.len()]);
+/// Index of each known column in the CSV, if present, and of `utc`.
+struct Columns([Option<usize>; CSV_COLUMNS.len()], Option<usize>);
+
+/// The column `decode` writes UTC into.
+const UTC_COLUMN: &str = "utc";
 
 impl Columns {
     fn new(header: &csv::StringRecord) -> Self {
-        Self(CSV_COLUMNS.map(|name| header.iter().position(|h| h.trim() == name)))
+        let at = |name: &str| header.iter().position(|h| h.trim() == name);
+        Self(CSV_COLUMNS.map(at), at(UTC_COLUMN))
+    }
+
+    /// The `utc` cell of `line`, for messages.
+    fn utc_cell(&self, line: u64) -> Cell<'static> {
+        Cell {
+            line,
+            column: self.1.unwrap_or(0) + 1,
+            name: UTC_COLUMN,
+        }
+    }
+}
+
+/// The sync pairs that give every row its CSV UTC back: a pair at a row
+/// whenever the last pair does not already give that row's UTC, to the
+/// millisecond as `decode` prints it (so a log decoded and encoded again
+/// has pairs only where its clock and UTC drifted apart by a millisecond).
+#[derive(Default)]
+struct SyncWriter {
+    last: Option<UtcSync>,
+}
+
+impl SyncWriter {
+    /// The pair to write before the frame at `t_us` whose UTC is `utc_ms`
+    /// (`None`: the row has no UTC), or why the row cannot be stored.
+    fn update(&mut self, t_us: u64, utc_ms: Option<i64>) -> Result<Option<UtcSync>, String> {
+        let Some(ms) = utc_ms else {
+            return match self.last {
+                Some(_) => Err("is empty after a row with a UTC: a log's UTC cannot stop".into()),
+                None => Ok(None),
+            };
+        };
+        let given = self.last.and_then(|s| {
+            let since_us = i64::try_from(t_us.checked_sub(s.t_us)?).ok()?;
+            let us = i64::try_from(s.unix_ms).ok()?.checked_mul(1000)? + since_us;
+            Some(us.div_euclid(1000))
+        });
+        if given == Some(ms) {
+            return Ok(None);
+        }
+        let sync = UtcSync {
+            t_us,
+            unix_ms: u64::try_from(ms).unwrap_or(u64::MAX),
+        };
+        if !sync.is_valid() {
+            return Err("is outside the years a GPS states (2000 to 2099)".into());
+        }
+        self.last = Some(sync);
+        Ok(Some(sync))
     }
 }
 
@@ -80,6 +135,7 @@ pub fn encode(
         })
     };
     let mut last_gps: Option<(u64, GpsFix)> = None;
+    let mut syncs = SyncWriter::default();
     let mut record = csv::StringRecord::new();
     let mut rows = 0u64;
     let mut steps = TimeSteps::new(f64::from(SAMPLE_RATE_HZ));
@@ -111,6 +167,17 @@ pub fn encode(
             }
         }
         rows += 1;
+        // Before the frame, so the pair is in force for it.
+        let sync = syncs
+            .update(row.frame.t_us, row.utc_ms)
+            .map_err(|e| columns.utc_cell(line).error(in_name, e))?;
+        if let Some(sync) = sync {
+            write(
+                encoder
+                    .push(&Record::UtcSync(sync))
+                    .map_err(|e| CliError::file(in_name, e))?,
+            )?;
+        }
         write(
             encoder
                 .push(&Record::Frame(row.frame))
@@ -136,6 +203,8 @@ pub fn encode(
 struct Row {
     frame: Frame,
     gps: Option<GpsFix>,
+    /// UTC, ms since 1970.
+    utc_ms: Option<i64>,
 }
 
 fn parse_row(
@@ -231,7 +300,16 @@ fn parse_row(
             ));
         }
     };
-    Ok(Row { frame, gps })
+    let utc_ms = match columns.1.and_then(|c| record.get(c)) {
+        Some("") | None => None,
+        Some(text) => Some(parse_iso8601(text).ok_or_else(|| {
+            columns.utc_cell(line).error(
+                path,
+                format!("is not a UTC time like 2020-03-18T13:28:20.600Z: {text:?}"),
+            )
+        })?),
+    };
+    Ok(Row { frame, gps, utc_ms })
 }
 
 /// The GPS record to write at `t_us`, if any: when the fix changes, when it
