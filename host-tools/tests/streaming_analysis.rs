@@ -144,3 +144,41 @@ fn roll_does_not_depend_on_the_chunk() {
         assert!(worst < 1e-9, "chunk {chunk}: {worst} deg");
     }
 }
+
+/// Frames at 100 Hz from `t0_s` for `len_s`: quiet, then a 7 Hz wobble
+/// growing at 5/s from 0.05 degrees, 0.5 s in.
+fn growing(t0_s: f64, len_s: f64) -> Vec<(f64, f64)> {
+    let n = (len_s * FS_HZ).round() as usize;
+    (0..n)
+        .map(|i| {
+            let u = i as f64 / FS_HZ;
+            let amp = if u < 0.5 {
+                0.0
+            } else {
+                0.05 * (5.0 * (u - 0.5)).exp()
+            };
+            (t0_s + u, amp * (TAU * 7.0 * u).sin())
+        })
+        .collect()
+}
+
+/// A stretch between gaps shorter than 2 s is too short to measure a mode
+/// in: nothing is reported from it, where a longer one shows the wobble.
+#[test]
+fn stretches_under_two_seconds_are_not_analysed() {
+    let found = |len_s: f64| {
+        let mut search = EpisodeSearch::new(FS_HZ);
+        for t0 in [0.0, 10.0, 20.0] {
+            for (t, steer) in growing(t0, len_s) {
+                search.push(t, steer, 5.0);
+            }
+        }
+        search.finish(&Losses::default())
+    };
+    assert!(found(1.9).is_empty(), "{:#?}", found(1.9));
+    let longer = found(2.5);
+    for t0 in [0.0, 10.0, 20.0] {
+        let within = |e: &Episode| (t0..t0 + 2.5).contains(&e.onset_s);
+        assert!(longer.iter().any(within), "{longer:#?}");
+    }
+}
