@@ -257,6 +257,20 @@ mod tests {
         );
     }
 
+    /// A line that is only its `$` is no proprietary sentence, whatever
+    /// the line before it left in the buffer.
+    #[test]
+    fn a_bare_dollar_is_not_proprietary_after_a_proprietary_line() {
+        let out = run(b"$POLYN,TIME\r\n$\r\n");
+        assert_eq!(
+            out,
+            [
+                Err((LineError::NoChecksum, true, 0)),
+                Err((LineError::NoChecksum, false, 13))
+            ]
+        );
+    }
+
     #[test]
     fn overlong_line_is_dropped_and_the_next_one_parsed() {
         let mut long = b"$PMTKCHN,".to_vec();
