@@ -58,6 +58,9 @@ fn stuck_and_vanished_sensors_are_set_up_again_once_per_retry() {
     // Back a retry later.
     traffic.extend(init());
     traffic.extend(data_read(LIVE));
+    // The self-test's identity read.
+    traffic.extend(write_reg(reg::REG_BANK_SEL, 0));
+    traffic.extend(read_regs(reg::WHO_AM_I, &[reg::WHO_AM_I_VALUE]));
     let (mut spi, mut port) = port(&traffic);
 
     block_on(port.start());
