@@ -92,5 +92,6 @@ fn stuck_and_vanished_sensors_are_set_up_again_once_per_retry() {
         block_on(port.read()).is_ok(),
         "set up again a retry after the failure"
     );
+    assert_eq!(block_on(port.identity()), Some(reg::WHO_AM_I_VALUE));
     spi.done();
 }
