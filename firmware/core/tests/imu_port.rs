@@ -40,6 +40,11 @@ fn port(expected: &[Transaction<u8>]) -> (Mock<u8>, Icm42688Port<Mock<u8>, NoopD
 #[test]
 fn stuck_and_vanished_sensors_are_set_up_again_once_per_retry() {
     let clock = MockDriver::get();
+    // `start` alone sets the sensor up, before the sampler's first tick.
+    let (mut spi, mut port_started) = port(&init());
+    block_on(port_started.start());
+    spi.done();
+
     let stuck = usize::from(ImuConfig::DEFAULT.stuck_samples);
     let mut traffic = init();
     traffic.extend(data_read(LIVE));
