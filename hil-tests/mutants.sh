@@ -48,7 +48,7 @@ targets=(
   "episode-fit|wobblog|host-tools/src/analysis/episodes.rs|measure|--test analysis_corpus --test analysis_residual"
   "wheel|wobble-core|firmware/core/src/wheel.rs|.|--lib --test wheel_sensor"
   "sdcard|wobble-core|firmware/core/src/drivers/sdcard.rs|.|--test sd_init --test sd_init_no_card --test sd_operation --test sd_reidentify"
-  "gnss-bringup|wobble-core|firmware/core/src/drivers/gnss_bringup.rs|.|--test gnss_bringup --test gnss_setup"
+  "gnss-bringup|wobble-core|firmware/core/src/drivers/gnss_bringup.rs|.|--test gnss_bringup --test gnss_setup --test gps_setup_runner"
   "selftest|wobble-core|firmware/core/src/selftest.rs|.|--lib --test selftest_card"
 )
 

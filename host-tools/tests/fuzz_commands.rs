@@ -317,12 +317,15 @@ fn arbitrary_csv_through_encode_and_detect() {
                 }
                 text.push('\n');
             }
-            let _ = encode::encode(
-                text.as_bytes(),
-                Path::new("in.csv"),
-                std::io::sink(),
-                Path::new("out"),
-            );
+            for resample in [false, true] {
+                let _ = encode::encode(
+                    text.as_bytes(),
+                    Path::new("in.csv"),
+                    std::io::sink(),
+                    Path::new("out"),
+                    resample,
+                );
+            }
             let _ = detect::replay(
                 Path::new("in.csv"),
                 text.as_bytes(),

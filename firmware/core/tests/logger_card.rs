@@ -206,6 +206,13 @@ fn flushes_keep_the_file_size_within_one_flush_period() {
             "{on_card} of {end} frames on card"
         );
         assert_eq!(on_card, u64::from(log.stats().frames_on_card));
+        // ...and no more often than that: each flush costs block writes.
+        let periods = end / period_frames;
+        let flushes = u64::from(log.stats().flushes);
+        assert!(
+            (periods..=periods + 1).contains(&flushes),
+            "{flushes} flushes in {periods} flush periods"
+        );
     }
 }
 
@@ -319,6 +326,30 @@ fn full_card_keeps_logging_and_counts_the_loss() {
         1,
         "{names:?}"
     );
+}
+
+/// A card whose run numbers are used up (`RUN99999.WBL` is there) is a full
+/// card, not a missing one: each attempt to open it counts as the full-card
+/// fault, and every frame meanwhile as lost.
+#[test]
+fn a_card_out_of_run_numbers_counts_as_full() {
+    let mut image = fat32_image();
+    with_fs(&mut image, |fs| {
+        fs.root_dir().create_file("RUN99999.WBL").expect("create");
+    });
+    let mut log = logger(MockCard::new(image));
+    // Three attempts, one per retry period.
+    run(&mut log, 0, 250);
+    assert_eq!(log.state(), LoggerState::NoCard);
+    let stats = log.stats();
+    assert_eq!(
+        (
+            stats.faults[usize::from(FAULT_CARD_FULL) - 1],
+            stats.faults[usize::from(FAULT_CARD_ABSENT) - 1]
+        ),
+        (3, 0)
+    );
+    assert_eq!(stats.frames_lost, 250);
 }
 
 proptest! {
