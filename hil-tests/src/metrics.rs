@@ -200,6 +200,42 @@ impl Report {
         self.latencies_s().into_iter().reduce(f64::max)
     }
 
+    /// Every way the detector missed the goals with this report: an episode
+    /// without an alert or with chatter, the median or worst latency, the
+    /// frequency error (empty: all goals met).
+    #[must_use]
+    pub fn goal_failures(&self) -> Vec<String> {
+        let mut out = Vec::new();
+        for e in &self.episodes {
+            if e.alert_s.is_none() {
+                out.push(format!("{}: no alert", e.fixture));
+            }
+            if e.extra_alerts > 0 {
+                out.push(format!("{}: {} extra alerts", e.fixture, e.extra_alerts));
+            }
+        }
+        let over = |what: &str, v: Option<f64>, goal: f64| {
+            v.filter(|&v| v > goal)
+                .map(|v| format!("{what} {v:.3} over {goal}"))
+        };
+        out.extend(over(
+            "median latency (s)",
+            self.median_latency_s(),
+            goals::MEDIAN_LATENCY_S,
+        ));
+        out.extend(over(
+            "worst latency (s)",
+            self.worst_latency_s(),
+            goals::WORST_LATENCY_S,
+        ));
+        out.extend(over(
+            "frequency error (Hz)",
+            self.max_freq_error_hz(),
+            goals::FREQ_ERROR_HZ,
+        ));
+        out
+    }
+
     /// Largest frequency error at alert.
     #[must_use]
     pub fn max_freq_error_hz(&self) -> Option<f64> {

@@ -10,7 +10,7 @@ use std::sync::OnceLock;
 use wobble_core::config::Config;
 use wobble_hil::corpus::simulated::{self, catalog, Simulation};
 use wobble_hil::corpus::Fixture;
-use wobble_hil::metrics::{self, goals, Report};
+use wobble_hil::metrics::{self, Report};
 use wobblog::analysis::{estimate_roll_deg, find_episodes, Run, Stability};
 
 fn rides() -> &'static [Simulation] {
@@ -81,25 +81,9 @@ fn the_detector_alerts_on_every_wobble_on_time() {
             e.alert_freq_hz
         ));
     }
-    for e in &r.episodes {
-        assert!(e.alert_s.is_some(), "{}: no alert\n{table}", e.fixture);
-        assert_eq!(e.extra_alerts, 0, "{}: alert chattered\n{table}", e.fixture);
-    }
-    let median = r.median_latency_s().expect("episodes");
-    let worst = r.worst_latency_s().expect("episodes");
-    assert!(
-        median <= goals::MEDIAN_LATENCY_S,
-        "median {median:.3} s\n{table}"
-    );
-    assert!(
-        worst <= goals::WORST_LATENCY_S,
-        "worst {worst:.3} s\n{table}"
-    );
-    let err = r.max_freq_error_hz().expect("episodes");
-    assert!(
-        err <= goals::FREQ_ERROR_HZ,
-        "frequency error {err:.3} Hz\n{table}"
-    );
+    assert!(!r.episodes.is_empty());
+    let failures = r.goal_failures();
+    assert!(failures.is_empty(), "{}\n{table}", failures.join("\n"));
 }
 
 #[test]
