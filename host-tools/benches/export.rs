@@ -1,6 +1,7 @@
 //! Export throughput on a one-hour 100 Hz log (20 Hz GPS, a UTC sync pair
 //! every 10 s, as the firmware writes): decoded to CSV and JSON lines, and
-//! the `events` and `config` commands on it.
+//! the `events` and `config` commands on it; `config` also on a 64 MiB log
+//! of the same ride, which it must read no more of.
 //!
 //! `cargo bench -p wobblog --bench export`; figures in `firmware/docs/benchmarks.md`.
 
@@ -18,9 +19,10 @@ use wobblog::export::Format;
 
 const FRAMES_PER_HOUR: u64 = 100 * 3600;
 
-/// A one-hour ride: a 6.4 Hz steering wobble, speed, a GPS track north.
-fn one_hour_log() -> Vec<u8> {
-    let mut bytes = Vec::with_capacity(12 << 20);
+/// A ride of `frames` frames: a 6.4 Hz steering wobble, speed, a GPS
+/// track north.
+fn ride_log(frames: u64) -> Vec<u8> {
+    let mut bytes = Vec::new();
     let mut encoder = BlockEncoder::new();
     let mut put = |encoder: &mut BlockEncoder, rec: Record<'_>| {
         if let Some(block) = encoder.push(&rec).unwrap() {
@@ -39,7 +41,7 @@ fn one_hour_log() -> Vec<u8> {
     for rec in header_records(info, config.lines()) {
         put(&mut encoder, rec);
     }
-    for i in 0..FRAMES_PER_HOUR {
+    for i in 0..frames {
         let t_us = i * 10_000;
         let t = t_us as f64 / 1e6;
         let steer = 2.0 * (t * 6.4 * std::f64::consts::TAU).sin();
@@ -88,7 +90,11 @@ fn benches(c: &mut Criterion) {
     let dir = std::env::temp_dir().join(format!("wobblog-bench-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let log = dir.join("hour.wbl");
-    std::fs::write(&log, one_hour_log()).unwrap();
+    let hour = ride_log(FRAMES_PER_HOUR);
+    std::fs::write(&log, &hour).unwrap();
+    let big = dir.join("64mib.wbl");
+    let big_frames = FRAMES_PER_HOUR * (64 << 20) / hour.len() as u64 + 1;
+    std::fs::write(&big, ride_log(big_frames)).unwrap();
 
     let mut group = c.benchmark_group("export");
     group.sample_size(10);
@@ -112,9 +118,11 @@ fn benches(c: &mut Criterion) {
     group.bench_function("events_one_hour", |b| {
         b.iter(|| events::table(&events::collect(&log).unwrap()))
     });
-    group.bench_function("config_one_hour", |b| {
-        b.iter(|| config::read_header(&log).unwrap().config_text(&log))
-    });
+    for (name, path) in [("config_one_hour", &log), ("config_64_mib", &big)] {
+        group.bench_function(name, |b| {
+            b.iter(|| config::read_header(path).unwrap().config_text(path))
+        });
+    }
     group.finish();
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -6,7 +6,11 @@ mod analysis_support;
 use std::path::Path;
 
 use analysis_support::{stdout_of, wobblog};
+use base64::Engine;
+use quick_xml::events::Event;
+use wobblog::plot::modes::ZERO_LINE_COLOUR;
 use wobblog::plot::timeplot::{ALERT_COLOUR, LINE_COLOUR, LOST_COLOUR, MARKER_COLOUR, PANELS};
+use wobblog::plot::FONT;
 
 fn hex(c: plotters::style::RGBColor) -> String {
     format!("#{:02X}{:02X}{:02X}", c.0, c.1, c.2)
@@ -25,6 +29,73 @@ fn texts(svg: &str) -> Vec<&str> {
         .skip(1)
         .filter_map(|e| Some(e[e.find('>')? + 1..e.find("</text>")?].trim()))
         .collect()
+}
+
+/// Reads `svg` with an XML parser and checks that it carries the bundled
+/// font: a `<style>` with an `@font-face` whose `data:` URI decodes to the
+/// committed TrueType file, and every `<text>` element in that family.
+/// Returns the number of text elements.
+fn assert_font_embedded(svg: &str) -> usize {
+    let mut reader = quick_xml::Reader::from_str(svg);
+    let (mut in_style, mut css, mut texts) = (false, String::new(), 0);
+    loop {
+        match reader.read_event().unwrap() {
+            Event::Start(e) if e.name().as_ref() == b"style" => in_style = true,
+            Event::End(e) if e.name().as_ref() == b"style" => in_style = false,
+            Event::Text(t) if in_style => css.push_str(&t.decode().unwrap()),
+            Event::Start(e) if e.name().as_ref() == b"text" => {
+                texts += 1;
+                let family = e.try_get_attribute("font-family").unwrap().unwrap();
+                assert_eq!(family.unescape_value().unwrap(), FONT);
+            }
+            Event::Eof => break,
+            _ => {}
+        }
+    }
+    assert!(
+        css.contains(&format!("font-family: \"{FONT}\"")),
+        "{css:.200}"
+    );
+    let uri = "url(\"data:font/ttf;base64,";
+    let start = css.find(uri).expect("no data URI") + uri.len();
+    let data = &css[start..start + css[start..].find('"').unwrap()];
+    let ttf = base64::engine::general_purpose::STANDARD
+        .decode(data)
+        .unwrap();
+    let bundled = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/DejaVuSans.ttf");
+    assert!(
+        ttf == std::fs::read(bundled).unwrap(),
+        "not the bundled font"
+    );
+    texts
+}
+
+#[test]
+fn every_svg_carries_the_bundled_font() {
+    let dir = tempfile::tempdir().unwrap();
+    let log = dir.path().join("RUN00003.WBL");
+    analysis_support::standard_log(&log);
+    let fig6 = plot_svg(&log, &dir.path().join("fig6.svg"), &[]);
+    assert!(assert_font_embedded(&fig6) > 20);
+    let fig8 = dir.path().join("fig8.svg");
+    wobblog()
+        .args(["wobble", "--plot"])
+        .arg(&fig8)
+        .arg(&log)
+        .assert()
+        .success();
+    assert!(assert_font_embedded(&std::fs::read_to_string(&fig8).unwrap()) > 20);
+    let params =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("bicycle-model/params/test-bicycle.toml");
+    let eig = dir.path().join("eig.svg");
+    wobblog()
+        .args(["model", "plot"])
+        .arg(&params)
+        .args(["--speeds", "0:8:1", "-o"])
+        .arg(&eig)
+        .assert()
+        .success();
+    assert!(assert_font_embedded(&std::fs::read_to_string(&eig).unwrap()) > 10);
 }
 
 fn plot_svg(log: &Path, out: &Path, extra: &[&str]) -> String {
@@ -191,6 +262,33 @@ fn figure_8_has_a_dot_per_episode_and_a_legend_per_run() {
     let svg = std::fs::read_to_string(&svg_path).unwrap();
     // Each episode in the three panels, and a marker per run in the key.
     assert_eq!(svg.matches("<circle").count(), 3 * episodes + 2);
+    // The stability boundary: sigma = 0, upright in the complex plane and
+    // level in the sigma-against-speed panel.
+    let zero_lines: Vec<Vec<(f64, f64)>> = svg
+        .split('<')
+        .filter(|e| e.starts_with("polyline") && e.to_uppercase().contains(&hex(ZERO_LINE_COLOUR)))
+        .map(|e| {
+            let points = e
+                .split("points=\"")
+                .nth(1)
+                .unwrap()
+                .split('"')
+                .next()
+                .unwrap();
+            points
+                .split_whitespace()
+                .map(|p| {
+                    let (x, y) = p.split_once(',').unwrap();
+                    (x.parse().unwrap(), y.parse().unwrap())
+                })
+                .collect()
+        })
+        .collect();
+    assert_eq!(zero_lines.len(), 2, "{zero_lines:?}");
+    let upright = |l: &Vec<(f64, f64)>| l.iter().all(|p| p.0 == l[0].0) && l[0].1 != l[1].1;
+    let level = |l: &Vec<(f64, f64)>| l.iter().all(|p| p.1 == l[0].1) && l[0].0 != l[1].0;
+    assert!(upright(&zero_lines[0]), "{zero_lines:?}");
+    assert!(level(&zero_lines[1]), "{zero_lines:?}");
     let labels = texts(&svg);
     for label in [
         "A.WBL",

@@ -67,7 +67,7 @@ fn round_trip(csv: &str, format: Format) -> String {
     let dir = tempfile::tempdir().unwrap();
     let log = dir.path().join("run.wbl");
     let out = std::fs::File::create(&log).unwrap();
-    encode::encode(csv.as_bytes(), Path::new("in.csv"), out, &log).unwrap();
+    encode::encode(csv.as_bytes(), Path::new("in.csv"), out, &log, false).unwrap();
     let mut decoded = Vec::new();
     let losses = decode::decode_to(
         &log,
@@ -147,4 +147,85 @@ fn missing_columns_are_zero() {
     let lines: Vec<&str> = out.lines().collect();
     assert_eq!(lines[1], "0.01,0.0,0.0,0.0,0.0,0.0,0.0,1.5,0.0,,,,,");
     assert_eq!(lines[2], "0.02,0.0,0.0,0.0,0.0,0.0,0.0,-2.25,0.0,,,,,");
+}
+
+/// `csv` with a `utc` column appended: `utc_ms[i]` for data row `i`, empty
+/// where `None`.
+fn with_utc(csv: &str, utc_ms: &[Option<i64>]) -> String {
+    let mut lines = csv.lines();
+    let mut out = format!("{},utc\n", lines.next().unwrap());
+    for (line, ms) in lines.zip(utc_ms) {
+        let utc = ms.map_or(String::new(), |ms| {
+            wobblog::time::iso8601_unix_ms(ms).unwrap()
+        });
+        out.push_str(&format!("{line},{utc}\n"));
+    }
+    out
+}
+
+/// The `utc` column of a decoded CSV.
+fn utc_column(csv: &str) -> Vec<String> {
+    let mut reader = csv::Reader::from_reader(csv.as_bytes());
+    let at = reader
+        .headers()
+        .unwrap()
+        .iter()
+        .position(|h| h == "utc")
+        .unwrap();
+    reader
+        .records()
+        .map(|r| r.unwrap()[at].to_string())
+        .collect()
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(64))]
+
+    /// Whatever UTC a CSV gives its rows (a clock that drifts, steps or
+    /// stands still against UTC), the log built from it decodes to the same
+    /// UTC text on every row; rows before the first UTC stay without one.
+    #[test]
+    fn utc_round_trips_to_the_millisecond(
+        rows in rows(),
+        start_ms in 946_684_810_000i64..4_102_444_000_000,
+        steps_ms in vec(prop_oneof![8 => Just(10i64), 1 => 0..12i64, 1 => -3..1000i64], 600),
+        first in 0..50usize,
+    ) {
+        let mut ms = start_ms;
+        let utc: Vec<Option<i64>> = (0..rows.len())
+            .map(|i| {
+                ms += steps_ms[i];
+                (i >= first).then_some(ms)
+            })
+            .collect();
+        let given = with_utc(&to_csv(&rows), &utc);
+        let expected: Vec<String> = utc_column(&given);
+        prop_assert_eq!(utc_column(&round_trip(&given, Format::Csv)), expected);
+    }
+}
+
+#[test]
+fn a_decoded_log_encodes_to_the_same_utc() {
+    let dir = tempfile::tempdir().unwrap();
+    let csv = dir.path().join("ride.csv");
+    let first = wobblog::time::parse_iso8601("2020-03-18T10:00:01.000Z").unwrap();
+    // A GPS clock 0.4 ms off the logger's frames, as real pairs are.
+    let utc: Vec<Option<i64>> = (0..3000)
+        .map(|i| (i >= 100).then(|| first + (i - 100) * 10 + i64::from(i % 7 == 0)))
+        .collect();
+    let rows: Vec<CsvRow> = (0..3000)
+        .map(|i| CsvRow {
+            t_s: 1.0 + f64::from(i) / 100.0,
+            values: [0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.5, 5.0],
+            gps: None,
+        })
+        .collect();
+    std::fs::write(&csv, with_utc(&to_csv(&rows), &utc)).unwrap();
+    let once = round_trip(&std::fs::read_to_string(&csv).unwrap(), Format::Csv);
+    let twice = round_trip(&once, Format::Csv);
+    assert_eq!(once, twice);
+    let column = utc_column(&once);
+    assert_eq!(column[99], "");
+    assert_eq!(column[100], "2020-03-18T10:00:01.000Z");
+    assert_eq!(column[2999], "2020-03-18T10:00:29.990Z");
 }

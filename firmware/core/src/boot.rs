@@ -108,6 +108,16 @@ impl ResetCause {
     pub const fn is_abnormal(self) -> bool {
         !matches!(self, Self::PowerOn | Self::Pin)
     }
+
+    /// Whether to blink it at boot. A software reset with a debugger
+    /// attached is the probe's own reset after flashing (probe-rs resets
+    /// through SYSRESETREQ), so it is recorded but not blinked; a panic
+    /// under a probe is printed over defmt anyway. The debug enable bit
+    /// stays set until a power-on, so in the field nothing changes.
+    #[must_use]
+    pub const fn blink_at_boot(self, debugger_attached: bool) -> bool {
+        self.is_abnormal() && !(debugger_attached && matches!(self, Self::Software))
+    }
 }
 
 /// A system fault record with `code` at `t_us`, counted once.
@@ -225,6 +235,15 @@ mod tests {
         );
         let abnormal: Vec<bool> = causes.iter().map(|c| c.is_abnormal()).collect();
         assert_eq!(abnormal, [false, true, true, true, true, false, true, true]);
+        let blinked =
+            |debugger| -> Vec<bool> { causes.iter().map(|c| c.blink_at_boot(debugger)).collect() };
+        assert_eq!(blinked(false), abnormal);
+        let software = causes.iter().position(|&c| c == ResetCause::Software);
+        let expected: Vec<bool> = (0..causes.len())
+            .map(|i| abnormal[i] && Some(i) != software)
+            .collect();
+        assert_eq!(blinked(true), expected);
+        assert!(software.is_some_and(|i| abnormal[i]));
     }
 
     #[test]

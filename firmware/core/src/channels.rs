@@ -322,6 +322,22 @@ mod tests {
         }
     }
 
+    /// The writer stops once `is_empty` says everything queued is on its
+    /// way: `len` and `is_empty` follow every push and pop, up to full.
+    #[test]
+    fn len_and_is_empty_follow_pushes_and_pops() {
+        let q = RecordQueue::new();
+        assert_eq!((q.len(), q.is_empty()), (0, true));
+        for n in 1..=QUEUE_LEN {
+            assert!(q.push(frame(n as u64)));
+            assert!(!q.is_empty() && q.len() == n);
+        }
+        for n in (0..QUEUE_LEN).rev() {
+            assert!(q.try_pop().is_some());
+            assert_eq!((q.len(), q.is_empty()), (n, n == 0));
+        }
+    }
+
     /// The case the property must reach: the queue full when both kinds
     /// arrive.
     #[test]

@@ -565,6 +565,11 @@ const KEYS: &[Key] = &[
 /// Number of `key=value` lines [`Config::write_lines`] produces.
 pub const KEY_COUNT: usize = KEYS.len();
 
+/// The boot-mode key: `selftest=1` runs the field self-test at power-on
+/// instead of a ride, like holding the marker button. Not a ride setting, so
+/// not among [`KEYS`]: the log header never records it.
+pub const SELFTEST_KEY: &str = "selftest";
+
 /// Keys of older firmware that are skipped with [`FAULT_OBSOLETE_KEY`].
 const OBSOLETE_KEYS: [&str; 1] = ["detector.wheel_circumference_m"];
 
@@ -575,6 +580,7 @@ impl Config {
     pub fn parse(text: &[u8]) -> Loaded {
         let mut config = Self::default();
         let mut faults = ConfigFaults::default();
+        let mut selftest = false;
         // Per section, the last line that set one of its keys (for reports).
         let mut touched: [Option<u16>; SECTIONS.len()] = [None; SECTIONS.len()];
         for (index, raw) in text.split(|&b| b == b'\n').enumerate() {
@@ -599,6 +605,12 @@ impl Config {
                 faults.push(line_no, FAULT_SYNTAX);
                 continue;
             }
+            if name == SELFTEST_KEY {
+                if !set(&mut selftest, value) {
+                    faults.push(line_no, FAULT_BAD_VALUE);
+                }
+                continue;
+            }
             let Some(key) = KEYS.iter().find(|k| k.name == name) else {
                 let code = if OBSOLETE_KEYS.contains(&name) {
                     FAULT_OBSOLETE_KEY
@@ -620,7 +632,11 @@ impl Config {
                 faults.push(line.unwrap_or(0), FAULT_REJECTED);
             }
         }
-        Loaded { config, faults }
+        Loaded {
+            config,
+            faults,
+            selftest,
+        }
     }
 
     /// The wobble detector this configuration runs: its detector settings on
@@ -797,6 +813,8 @@ pub struct Loaded {
     pub config: Config,
     /// What was skipped or replaced by defaults.
     pub faults: ConfigFaults,
+    /// The file asks for the field self-test ([`SELFTEST_KEY`]).
+    pub selftest: bool,
 }
 
 #[cfg(test)]
@@ -875,6 +893,34 @@ mod tests {
         assert!(f
             .records(7)
             .all(|r| r.source == FaultSource::Config && r.t_us == 7));
+    }
+
+    #[test]
+    fn selftest_asks_for_the_field_test_and_leaves_the_ride_settings_alone() {
+        let plain = Config::parse(b"wheel.holes=36\n");
+        assert!(!plain.selftest);
+        for (value, asked) in [("1", true), ("on", true), ("0", false), ("no", false)] {
+            let text = format!("wheel.holes=36\nselftest = {value}  # bench\n");
+            let loaded = Config::parse(text.as_bytes());
+            assert_eq!(loaded.selftest, asked, "selftest={value}");
+            assert!(loaded.faults.is_empty(), "{:?}", loaded.faults);
+            assert_eq!(loaded.config, plain.config);
+        }
+        // The header records the ride settings only.
+        assert!(!text_of(&Config::default()).contains(SELFTEST_KEY));
+    }
+
+    #[test]
+    fn a_bad_selftest_value_is_a_counted_fault_and_no_selftest() {
+        let loaded = Config::parse(b"selftest=maybe\n");
+        assert!(!loaded.selftest);
+        assert_eq!(
+            loaded.faults.first(),
+            [LineFault {
+                line: 1,
+                code: FAULT_BAD_VALUE
+            }]
+        );
     }
 
     #[test]

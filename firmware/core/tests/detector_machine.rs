@@ -28,7 +28,8 @@ struct Model {
     cfg: DetectorConfig,
     lookback: usize,
     off_hold: usize,
-    analyses: usize,
+    /// The dominant amplitude of every analysis so far.
+    amps: Vec<f32>,
     confirm: u8,
     /// `Some(hops below the off threshold)` while the alert is on.
     alerting: Option<usize>,
@@ -43,18 +44,44 @@ impl Model {
             cfg,
             lookback: hops(cfg.lookback_s),
             off_hold: hops(cfg.off_hold_s).max(1),
-            analyses: 0,
+            amps: Vec::new(),
             confirm: 0,
             alerting: None,
             longest_unconfirmed: 0,
         }
     }
 
+    /// Whether the estimated frequency may raise the alert. The edge bins
+    /// lie outside the band (`bin_lo_hz < band_lo_hz`, `band_hi_hz <
+    /// bin_hi_hz`), so a peak on one is out of band by its frequency alone.
+    fn in_band(&self, freq_hz: f32) -> bool {
+        freq_hz >= self.cfg.band_lo_hz && freq_hz <= self.cfg.band_hi_hz
+    }
+
+    /// Amplitude now over amplitude `lookback_s` ago, 1 until known.
+    fn growth_ratio(&self, amp_deg: f32) -> f32 {
+        match self.amps.len().checked_sub(self.lookback) {
+            Some(i) => amp_deg / self.amps[i].max(1e-6),
+            None => 1.0,
+        }
+    }
+
+    /// Whether `freq_hz` lies within `harmonic_tol_hz` of a multiple of the
+    /// wheel's rotation frequency at `speed_mps` (never without a speed).
+    fn at_wheel_harmonic(&self, freq_hz: f32, speed_mps: Option<f32>) -> bool {
+        let Some(f_wheel) = speed_mps.map(|v| v / WheelConfig::DEFAULT.circumference_m) else {
+            return false;
+        };
+        let highest = (freq_hz / f_wheel) as u32 + 1;
+        (1..=highest).any(|n| (freq_hz - n as f32 * f_wheel).abs() <= self.cfg.harmonic_tol_hz)
+    }
+
     /// What the analysis with estimate `e` must switch.
     fn analyse(&mut self, e: &Estimate, speed_mps: Option<f32>) -> Option<bool> {
         let c = &self.cfg;
-        let has_lookback = self.analyses >= self.lookback;
-        self.analyses += 1;
+        assert!(c.bin_lo_hz < c.band_lo_hz && c.band_hi_hz < c.bin_hi_hz);
+        let has_lookback = self.amps.len() >= self.lookback;
+        self.amps.push(e.amp_deg);
         if let Some(below) = self.alerting {
             let below = if e.amp_deg < c.amp_off_deg {
                 below + 1
@@ -75,7 +102,7 @@ impl Model {
         };
         let on = has_lookback
             && e.amp_deg >= c.amp_on_deg
-            && e.in_band
+            && self.in_band(e.freq_hz)
             && !e.impulse_holdoff
             && e.growth_ratio >= min_ratio
             && speed_mps.is_none_or(|v| v >= c.min_speed_mps);
@@ -109,7 +136,24 @@ fn replay(
             .push(x, speed_mps)
             .map(|e| matches!(e, AlertEvent::On { .. }));
         let expected = if d.analysed() {
-            model.analyse(&d.estimate(), speed_mps)
+            let e = d.estimate();
+            prop_assert_eq!(e.in_band, model.in_band(e.freq_hz), "sample {}: {:?}", i, e);
+            prop_assert_eq!(
+                e.at_wheel_harmonic,
+                model.at_wheel_harmonic(e.freq_hz, speed_mps),
+                "sample {}: {:?}",
+                i,
+                e
+            );
+            let growth = model.growth_ratio(e.amp_deg);
+            prop_assert!(
+                (e.growth_ratio - growth).abs() <= 1e-5 * growth.abs(),
+                "sample {}: growth ratio {} over the look-back, {:?}",
+                i,
+                growth,
+                e
+            );
+            model.analyse(&e, speed_mps)
         } else {
             None
         };
@@ -245,4 +289,38 @@ fn bursts_shorter_and_longer_than_the_confirmation() {
         "no burst ended one analysis short of the confirmation"
     );
     assert!(long_alerted, "no burst was long enough to alert");
+}
+
+/// An oscillation on a wheel harmonic, growing too slowly to count as a
+/// wobble while it could still be ripple, alerts once it is above the
+/// ripple ceiling, where the wheel-harmonic guard no longer applies.
+#[test]
+fn above_the_ripple_ceiling_a_harmonic_oscillation_alerts() {
+    let cfg = DetectorConfig {
+        // No canceller: the oscillation reaches the analysis as it is.
+        harmonic_tau_s: 0.0,
+        ..Config::default().detector
+    };
+    let ceiling_deg = RIPPLE_CEILING * cfg.amp_on_deg;
+    let f = 7.0;
+    // The wheel's 4th harmonic at 7 Hz.
+    let speed = f / 4.0 * WheelConfig::DEFAULT.circumference_m;
+    // Growth over the look-back between the two ratios: enough for a
+    // wobble, too little for ripple.
+    let rate_per_s =
+        0.5 * (cfg.min_growth_ratio.max(1.0) * cfg.harmonic_growth_ratio).ln() / cfg.lookback_s;
+    let amp = |t: f32| (0.5 * cfg.amp_on_deg * (rate_per_s * t).exp()).min(1.5 * ceiling_deg);
+    let signal: Vec<f32> = (0..3000)
+        .map(|i| {
+            let t = i as f32 / FS;
+            amp(t) * (TAU * f * t).sin()
+        })
+        .collect();
+    let (_, changes) = replay(cfg, Some(speed), &signal).expect("agrees with the rules");
+    let (on_at, _) = changes.first().copied().expect("an alert");
+    let envelope = amp(on_at as f32 / FS);
+    assert!(
+        envelope > ceiling_deg && envelope < 1.2 * ceiling_deg,
+        "alert at {envelope} deg, ceiling {ceiling_deg} deg"
+    );
 }

@@ -130,6 +130,89 @@ proptest! {
         prop_assert!(events.is_empty(), "{:?}", events);
     }
 
+    /// The impulse detector sees a jolt in the hop it arrives, before its
+    /// ring shows in the analysis window (whose newest samples weigh least),
+    /// and holds the alert off from that analysis on; a blip below
+    /// `impulse_min_deg` over the noise floor is no impulse.
+    #[test]
+    fn a_jolt_holds_off_from_the_hop_it_arrives(
+        f in 6.0f32..9.0, jolt in prop::bool::ANY, level in 0.0f32..1.0, offset in 0usize..5,
+    ) {
+        let cfg = DetectorConfig::default();
+        let amp = if jolt {
+            // Twice the minimum: the high-pass takes some of a jolt's edge.
+            cfg.impulse_min_deg * (2.0 + level)
+        } else {
+            cfg.impulse_min_deg * (0.2 + 0.4 * level)
+        };
+        let mut d = detector();
+        let start = 300 + offset;
+        let mut first = None;
+        for i in 0..start + 100 {
+            let tau = (i as f32 - start as f32) / FS;
+            let ring = if tau >= 0.0 { amp * (-6.0 * tau).exp() * (TAU * f * tau).cos() } else { 0.0 };
+            d.push(ring + noise(i as u32), None);
+            if d.analysed() && i >= start {
+                let held = d.estimate().impulse_holdoff;
+                first.get_or_insert(held);
+                prop_assert!(jolt || !held, "{amp} deg blip held off at sample {i}: {:?}", d.estimate());
+            }
+        }
+        prop_assert_eq!(first, Some(jolt), "{} deg, first analysis after it", amp);
+    }
+
+    /// The hold-off ends `impulse_holdoff_s` after the jolt's last jump (the
+    /// ring decays below the jolt's peak long before, so only the hold-off's
+    /// own count keeps it on).
+    #[test]
+    fn the_hold_off_runs_out_after_a_jolt(f in 6.0f32..9.0, jolt_deg in 2.0f32..5.0) {
+        let cfg = DetectorConfig::default();
+        let t_jolt = 3.0;
+        let mut d = detector();
+        let mut held = Vec::new();
+        for i in 0..(7.0 * FS) as usize {
+            let t = i as f32 / FS;
+            let tau = t - t_jolt;
+            let ring = if tau >= 0.0 { jolt_deg * (-8.0 * tau).exp() * (TAU * f * tau).cos() } else { 0.0 };
+            d.push(ring + noise(i as u32), None);
+            if d.analysed() && t > t_jolt {
+                held.push((t, d.estimate().impulse_holdoff));
+            }
+        }
+        prop_assert!(held[0].1, "the jolt held nothing off");
+        // The last jump is seen by the time the ring's start has crossed
+        // the analysis window.
+        let t_free = t_jolt + cfg.window_s + cfg.impulse_holdoff_s + 2.0 * cfg.hop_s;
+        for &(t, h) in &held {
+            prop_assert!(t < t_free || !h, "still held off at {} s", t);
+        }
+    }
+
+    /// A wobble growing out of the jolt that excited it alerts once it has
+    /// outgrown the jolt's peak (taken over `impulse_capture_s`), before the
+    /// hold-off would have run out.
+    #[test]
+    fn a_wobble_outgrowing_its_jolt_alerts_within_the_hold_off(
+        f in 6.0f32..9.0, jolt_deg in 0.8f32..1.2, growth_per_s in 3.0f32..3.5,
+    ) {
+        let cfg = DetectorConfig::default();
+        let t_jolt = 3.0;
+        let events = run(6.0, None, |t| {
+            let tau = t - t_jolt;
+            if tau < 0.0 {
+                return noise((t * FS) as u32);
+            }
+            let ring = jolt_deg * (-8.0 * tau).exp() * (TAU * f * tau).cos();
+            let wobble = (0.2 * (growth_per_s * tau).exp()).min(3.0) * (TAU * f * tau).sin();
+            ring + wobble + noise((t * FS) as u32)
+        });
+        let on = events.iter().find(|e| matches!(e.1, AlertEvent::On { .. }));
+        prop_assert!(
+            on.is_some_and(|e| e.0 < t_jolt + cfg.impulse_holdoff_s),
+            "{:?}", events
+        );
+    }
+
     /// Any input, NaN and infinities included, leaves the detector finite and
     /// its events alternating on/off.
     #[test]

@@ -112,7 +112,8 @@ fn main() -> ! {
     for code in boot_faults.into_iter().flatten() {
         QUEUE.push(Record::Fault(boot::system_fault(code, 0)));
     }
-    if reset.is_abnormal() || !crystal {
+    let debugger = cortex_m::peripheral::DCB::is_debugger_attached();
+    if reset.blink_at_boot(debugger) || !crystal {
         // Shown on the alert LED before logging starts: the cause, or 9
         // for the crystal.
         let code = if crystal {
@@ -124,10 +125,16 @@ fn main() -> ! {
         startup::blink_code(&mut led, code);
     }
 
-    let selftest = marker_held(&mut board);
+    let button = marker_held(&mut board);
     let (card, loaded) = card_and_config(board.card);
     let config = loaded.config;
-    if selftest {
+    if button || loaded.selftest {
+        if loaded.selftest {
+            defmt::info!(
+                "{}: selftest=1 (remove the line to ride)",
+                config::FILE_NAME
+            );
+        }
         let _wheel_timer = adapters::wheel::start(board.wheel);
         let (_, ports) = sampler_parts(board.imu, board.steering, board.rider, &config);
         let parts = wobble_stm32f405::selftest::Parts {
@@ -239,7 +246,7 @@ fn sampler_parts(
     let driver_config = icm42688::Config::default();
     // `Config::parse` only lets through what the core's modules accept.
     let channel = defmt::unwrap!(Imu::try_new(driver_config.imu_config(config.imu)).ok());
-    let imu = ImuAdapter::new(Icm42688::new(device, driver_config), channel);
+    let imu = ImuAdapter::new(Icm42688::new(device, driver_config), channel, Delay);
 
     let steering = SteeringAdapter::new(
         steering_adc(steering.adc, steering.wiper, steering.dma),
@@ -289,6 +296,7 @@ fn steering_adc(
 
 #[embassy_executor::task]
 async fn sampler_task(mut sampler: Sampler, mut ports: Ports) {
+    ports.imu.start().await;
     sampler::run(
         &mut sampler,
         &mut ports,

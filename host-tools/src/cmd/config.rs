@@ -1,13 +1,14 @@
 //! `wobblog config`: the `CONFIG.TXT` a log was recorded with, from its
 //! header, ready to copy back to a card.
 
+use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
 
 use wobble_core::config::Config;
-use wobble_core::format::{Event, Record};
+use wobble_core::format::{DecodeStats, Event, Record, BLOCK_LEN};
 
 use crate::cmd::logs::print_stdout;
-use crate::reader::read_log;
+use crate::reader::read_log_until;
 use crate::text::escape_controls;
 use crate::CliError;
 
@@ -71,19 +72,106 @@ impl Header {
     }
 }
 
-/// Reads the header records of the log at `path`.
-///
-/// The header comes first, so reading stops being interesting after it;
-/// the whole file is still read to keep one code path for damage reports.
+/// Bytes `config` reads first: the header of a default configuration
+/// fills about two blocks.
+const HEADER_CHUNK_LEN: usize = 8 * BLOCK_LEN;
+
+/// Reads the header records of the log at `path`: it stops at the first
+/// record that is not one (the header comes first), so a large log costs
+/// no more than a small one.
 pub fn read_header(path: &Path) -> Result<Header, CliError> {
+    scan_header(path).map(|(header, _)| header)
+}
+
+/// The header, and how much of the log was decoded to find it.
+fn scan_header(path: &Path) -> Result<(Header, DecodeStats), CliError> {
     let mut header = Header::default();
-    read_log(path, |event| match event {
+    let stats = read_log_until(path, HEADER_CHUNK_LEN, |event| match event {
         Event::Record(Record::LogInfo(info)) => {
             header.firmware = Some(info.firmware.to_string());
             header.run = Some(info.run);
+            ControlFlow::Continue(())
         }
-        Event::Record(Record::Config(line)) => header.config.push(line.text.to_string()),
-        _ => {}
+        Event::Record(Record::Config(line)) => {
+            header.config.push(line.text.to_string());
+            ControlFlow::Continue(())
+        }
+        Event::Record(Record::Channel(_)) => ControlFlow::Continue(()),
+        Event::Record(_) => ControlFlow::Break(()),
+        // Damage before the first record is skipped like anywhere else.
+        _ => ControlFlow::Continue(()),
     })?;
-    Ok(header)
+    Ok((header, stats))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use wobble_core::format::header::header_records;
+    use wobble_core::format::{BlockEncoder, Frame, LogInfo, EDGE_AGE_NONE};
+
+    /// A log with the default configuration in its header and `frames`
+    /// frames after it, behind `garbage` bytes of damage.
+    fn log(frames: u64, garbage: usize) -> (tempfile::NamedTempFile, Vec<String>) {
+        let mut text = String::new();
+        Config::default().write_lines(&mut text).unwrap();
+        let lines: Vec<String> = text.lines().map(String::from).collect();
+        let info = LogInfo {
+            t_us: 0,
+            firmware: "test",
+            device_id: [7; 12],
+            sample_rate_hz: 100,
+            run: 12,
+        };
+        let mut bytes = vec![0x5a; garbage];
+        let mut encoder = BlockEncoder::new();
+        let frames = (0..frames).map(|i| {
+            Record::Frame(Frame {
+                t_us: i * 10_000,
+                accel: [0; 3],
+                gyro: [0; 3],
+                steer_cdeg: (i % 100) as i16,
+                wheel_count: 0,
+                wheel_edge_age_us: EDGE_AGE_NONE,
+                speed_mm_s: 4000,
+                status: Default::default(),
+            })
+        });
+        for rec in header_records(info, lines.iter().map(String::as_str)).chain(frames) {
+            if let Some(block) = encoder.push(&rec).unwrap() {
+                bytes.extend_from_slice(block);
+            }
+        }
+        bytes.extend_from_slice(encoder.finish().unwrap());
+        let file = tempfile::NamedTempFile::new().unwrap();
+        std::fs::write(file.path(), &bytes).unwrap();
+        (file, lines)
+    }
+
+    #[test]
+    fn the_header_is_read_and_the_rest_is_not() {
+        let (file, lines) = log(60_000, 0);
+        let blocks = std::fs::metadata(file.path()).unwrap().len() / BLOCK_LEN as u64;
+        let (header, stats) = scan_header(file.path()).unwrap();
+        assert_eq!(header.config, lines);
+        assert_eq!(header.run, Some(12));
+        assert_eq!(header.firmware.as_deref(), Some("test"));
+        // The first chunk holds the header and the first frames.
+        assert!(stats.blocks > 0 && stats.blocks <= 8, "{stats:?}");
+        assert!(blocks > 100, "{blocks} blocks");
+    }
+
+    #[test]
+    fn damage_before_the_header_is_skipped() {
+        let (file, lines) = log(100, 3000);
+        let (header, stats) = scan_header(file.path()).unwrap();
+        assert_eq!(header.config, lines);
+        assert_eq!(stats.bytes_skipped, 3000);
+    }
+
+    #[test]
+    fn a_log_of_header_only_is_read_to_its_end() {
+        let (file, lines) = log(0, 0);
+        assert_eq!(read_header(file.path()).unwrap().config, lines);
+    }
 }

@@ -28,7 +28,9 @@ pub struct Args {
     #[arg(short, long)]
     pub output: Option<PathBuf>,
     /// Only these columns, in this order (comma-separated names, e.g.
-    /// `t_s,steer_deg,speed_mps,utc`).
+    /// `t_s,steer_deg,speed_mps,utc`). In MCAP, the sensor channels carry
+    /// only these fields, a channel with none of them is left out, and
+    /// `/gps` is written when a GPS column is named.
     #[arg(long, value_name = "NAMES")]
     pub columns: Option<String>,
     /// The time window (`--from`, `--to`).
@@ -66,11 +68,6 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         columns: columns::select(args.columns.as_deref()).map_err(CliError::Usage)?,
         window: args.window.window(),
     };
-    if args.columns.is_some() && export.format == Format::Mcap {
-        return Err(CliError::Usage(
-            "--columns does not apply to MCAP, whose channels are the sensor groups".into(),
-        ));
-    }
     let binary = matches!(export.format, Format::Parquet | Format::Mcap);
     if binary && args.output.is_none() && std::io::stdout().is_terminal() {
         return Err(CliError::Usage(format!(

@@ -8,12 +8,14 @@ use wobble_core::format::header::header_records;
 use wobble_core::format::limits::SPEED_CM_S_MAX;
 use wobble_core::format::{
     quantise_i16, quantise_i32, quantise_u16, BlockEncoder, FixMode, Frame, GpsFix, LogInfo,
-    Record, ACCEL_COUNTS_PER_G, EDGE_AGE_NONE, GYRO_COUNTS_PER_DPS, STEER_COUNTS_PER_DEG,
+    Record, UtcSync, ACCEL_COUNTS_PER_G, EDGE_AGE_NONE, GYRO_COUNTS_PER_DPS, STEER_COUNTS_PER_DEG,
 };
 
 use crate::csv_input::{number_in, Cell, TimeSteps};
 use crate::export::CSV_COLUMNS;
 use crate::output::Output;
+use crate::resample::{CsvRow, Resampler};
+use crate::time::parse_iso8601;
 use crate::CliError;
 
 /// Arguments of `wobblog encode`.
@@ -21,11 +23,19 @@ use crate::CliError;
 pub struct Args {
     /// Input CSV with a header line; columns as `wobblog decode` writes them
     /// (`t_s` required, missing channels are zero, other columns ignored).
+    /// A `utc` column becomes the log's GPS sync pairs, so the decoded log
+    /// has the same UTC.
     #[arg(long)]
     pub csv: PathBuf,
     /// The card log to write.
     #[arg(short, long)]
     pub output: PathBuf,
+    /// Accept a CSV at another rate than the log's 100 Hz (or an uneven
+    /// one) and interpolate it linearly onto 100 Hz frames. Rows more than
+    /// 0.1 s apart are a gap (no frame is made in it); GPS and UTC come from
+    /// the row before each frame. Without this, such a CSV is an error.
+    #[arg(long)]
+    pub resample: bool,
 }
 
 /// The frame rate of the logs `encode` writes, as the firmware's.
@@ -39,25 +49,79 @@ const GPS_REPEAT_US: u64 = 500_000;
 pub fn run(args: &Args) -> Result<(), CliError> {
     let mut output = Output::create(&args.output, &[&args.csv])?;
     let input = File::open(&args.csv).map_err(|e| CliError::file(&args.csv, e))?;
-    encode(input, &args.csv, &mut output, &args.output)?;
+    encode(input, &args.csv, &mut output, &args.output, args.resample)?;
     output.commit()
 }
 
-/// Index of each known column in the CSV, if present.
-struct Columns([Option<usize>; CSV_COLUMNS.len()]);
+/// Index of each known column in the CSV, if present, and of `utc`.
+struct Columns([Option<usize>; CSV_COLUMNS.len()], Option<usize>);
+
+/// The column `decode` writes UTC into.
+const UTC_COLUMN: &str = "utc";
 
 impl Columns {
     fn new(header: &csv::StringRecord) -> Self {
-        Self(CSV_COLUMNS.map(|name| header.iter().position(|h| h.trim() == name)))
+        let at = |name: &str| header.iter().position(|h| h.trim() == name);
+        Self(CSV_COLUMNS.map(at), at(UTC_COLUMN))
+    }
+
+    /// The `utc` cell of `line`, for messages.
+    fn utc_cell(&self, line: u64) -> Cell<'static> {
+        Cell {
+            line,
+            column: self.1.unwrap_or(0) + 1,
+            name: UTC_COLUMN,
+        }
     }
 }
 
-/// Encodes CSV rows from `input` into a log written to `output`.
+/// The sync pairs that give every row its CSV UTC back: a pair at a row
+/// whenever the last pair does not already give that row's UTC, to the
+/// millisecond as `decode` prints it (so a log decoded and encoded again
+/// has pairs only where its clock and UTC drifted apart by a millisecond).
+#[derive(Default)]
+struct SyncWriter {
+    last: Option<UtcSync>,
+}
+
+impl SyncWriter {
+    /// The pair to write before the frame at `t_us` whose UTC is `utc_ms`
+    /// (`None`: the row has no UTC), or why the row cannot be stored.
+    fn update(&mut self, t_us: u64, utc_ms: Option<i64>) -> Result<Option<UtcSync>, String> {
+        let Some(ms) = utc_ms else {
+            return match self.last {
+                Some(_) => Err("is empty after a row with a UTC: a log's UTC cannot stop".into()),
+                None => Ok(None),
+            };
+        };
+        let given = self.last.and_then(|s| {
+            let since_us = i64::try_from(t_us.checked_sub(s.t_us)?).ok()?;
+            let us = i64::try_from(s.unix_ms).ok()?.checked_mul(1000)? + since_us;
+            Some(us.div_euclid(1000))
+        });
+        if given == Some(ms) {
+            return Ok(None);
+        }
+        let sync = UtcSync {
+            t_us,
+            unix_ms: u64::try_from(ms).unwrap_or(u64::MAX),
+        };
+        if !sync.is_valid() {
+            return Err("is outside the years a GPS states (2000 to 2099)".into());
+        }
+        self.last = Some(sync);
+        Ok(Some(sync))
+    }
+}
+
+/// Encodes CSV rows from `input` into a log written to `output`; with
+/// `resample`, rows at any rate are interpolated onto the log's frames.
 pub fn encode(
     input: impl std::io::Read,
     in_name: &Path,
-    mut output: impl Write,
+    output: impl Write,
     out_name: &Path,
+    resample: bool,
 ) -> Result<(), CliError> {
     let mut reader = csv::ReaderBuilder::new()
         .trim(csv::Trim::All)
@@ -73,16 +137,24 @@ pub fn encode(
             "no `t_s` column in the header line",
         ));
     }
-    let mut encoder = BlockEncoder::new();
-    let mut write = |block: Option<&[u8; 512]>| -> Result<(), CliError> {
-        block.map_or(Ok(()), |b| {
-            output.write_all(b).map_err(|e| CliError::file(out_name, e))
-        })
+    let mut log = LogWriter {
+        encoder: BlockEncoder::new(),
+        output,
+        out_name,
+        in_name,
+        columns: &columns,
+        syncs: SyncWriter::default(),
+        last_gps: None,
+        frames: 0,
+        line: 0,
     };
-    let mut last_gps: Option<(u64, GpsFix)> = None;
     let mut record = csv::StringRecord::new();
-    let mut rows = 0u64;
-    let mut steps = TimeSteps::new(f64::from(SAMPLE_RATE_HZ));
+    let mut steps = if resample {
+        TimeSteps::any_rate()
+    } else {
+        TimeSteps::new(f64::from(SAMPLE_RATE_HZ))
+    };
+    let mut resampler = Resampler::new(1_000_000 / u64::from(SAMPLE_RATE_HZ));
     while reader
         .read_record(&mut record)
         .map_err(|e| CliError::file(in_name, e))?
@@ -98,7 +170,44 @@ pub fn encode(
             };
             cell.error(in_name, e)
         })?;
-        if rows == 0 {
+        log.line = line;
+        if resample {
+            resampler.push(row, &mut |r: &CsvRow| log.store(r))?;
+        } else {
+            log.store(&row)?;
+        }
+    }
+    resampler.finish(&mut |r: &CsvRow| log.store(r))?;
+    log.finish()
+}
+
+/// Writes frames, GPS fixes and sync pairs into a log.
+struct LogWriter<'a, W> {
+    encoder: BlockEncoder,
+    output: W,
+    out_name: &'a Path,
+    in_name: &'a Path,
+    columns: &'a Columns,
+    syncs: SyncWriter,
+    last_gps: Option<(u64, GpsFix)>,
+    frames: u64,
+    /// The CSV line being read, for messages.
+    line: u64,
+}
+
+impl<W: Write> LogWriter<'_, W> {
+    /// Writes `record`, and the block it completes if any.
+    fn push(&mut self, record: &Record<'_>) -> Result<(), CliError> {
+        let block = self
+            .encoder
+            .push(record)
+            .map_err(|e| CliError::file(self.in_name, e))?;
+        write_block(&mut self.output, self.out_name, block)
+    }
+
+    /// Stores one frame of the log, with the header before the first.
+    fn store(&mut self, row: &CsvRow) -> Result<(), CliError> {
+        if self.frames == 0 {
             let info = LogInfo {
                 t_us: row.frame.t_us,
                 firmware: concat!("wobblog-encode ", env!("CARGO_PKG_VERSION")),
@@ -107,35 +216,47 @@ pub fn encode(
                 run: 0,
             };
             for rec in header_records(info, []) {
-                write(encoder.push(&rec).map_err(|e| CliError::file(in_name, e))?)?;
+                self.push(&rec)?;
             }
         }
-        rows += 1;
-        write(
-            encoder
-                .push(&Record::Frame(row.frame))
-                .map_err(|e| CliError::file(in_name, e))?,
-        )?;
-        if let Some(fix) = gps_update(&last_gps, row.gps, row.frame.t_us) {
-            write(
-                encoder
-                    .push(&Record::Gps(fix))
-                    .map_err(|e| CliError::file(in_name, e))?,
-            )?;
-            last_gps = Some((row.frame.t_us, fix));
+        self.frames += 1;
+        // Before the frame, so the pair is in force for it.
+        let sync = self
+            .syncs
+            .update(row.frame.t_us, row.utc_ms)
+            .map_err(|e| self.columns.utc_cell(self.line).error(self.in_name, e))?;
+        if let Some(sync) = sync {
+            self.push(&Record::UtcSync(sync))?;
         }
+        self.push(&Record::Frame(row.frame))?;
+        if let Some(fix) = gps_update(&self.last_gps, row.gps, row.frame.t_us) {
+            self.push(&Record::Gps(fix))?;
+            self.last_gps = Some((row.frame.t_us, fix));
+        }
+        Ok(())
     }
-    if rows == 0 {
-        return Err(CliError::file(in_name, "no data rows"));
+
+    /// Writes the last block and flushes; a CSV without rows is an error.
+    fn finish(mut self) -> Result<(), CliError> {
+        if self.frames == 0 {
+            return Err(CliError::file(self.in_name, "no data rows"));
+        }
+        let block = self.encoder.finish();
+        write_block(&mut self.output, self.out_name, block)?;
+        self.output
+            .flush()
+            .map_err(|e| CliError::file(self.out_name, e))
     }
-    write(encoder.finish())?;
-    output.flush().map_err(|e| CliError::file(out_name, e))
 }
 
-/// One parsed CSV row.
-struct Row {
-    frame: Frame,
-    gps: Option<GpsFix>,
+fn write_block(
+    output: &mut impl Write,
+    name: &Path,
+    block: Option<&[u8; 512]>,
+) -> Result<(), CliError> {
+    block.map_or(Ok(()), |b| {
+        output.write_all(b).map_err(|e| CliError::file(name, e))
+    })
 }
 
 fn parse_row(
@@ -143,7 +264,7 @@ fn parse_row(
     record: &csv::StringRecord,
     path: &Path,
     line: u64,
-) -> Result<Row, CliError> {
+) -> Result<CsvRow, CliError> {
     let cell = |i: usize, c: usize| Cell {
         line,
         column: c + 1,
@@ -231,7 +352,16 @@ fn parse_row(
             ));
         }
     };
-    Ok(Row { frame, gps })
+    let utc_ms = match columns.1.and_then(|c| record.get(c)) {
+        Some("") | None => None,
+        Some(text) => Some(parse_iso8601(text).ok_or_else(|| {
+            columns.utc_cell(line).error(
+                path,
+                format!("is not a UTC time like 2020-03-18T13:28:20.600Z: {text:?}"),
+            )
+        })?),
+    };
+    Ok(CsvRow { frame, gps, utc_ms })
 }
 
 /// The GPS record to write at `t_us`, if any: when the fix changes, when it

@@ -15,15 +15,16 @@ use mcap::McapError;
 use serde::Serialize;
 use wobble_core::format::GpsFix;
 
-use super::LogMetadata;
+use super::columns::Column;
+use super::{json_object, LogMetadata};
 use crate::events::LogEvent;
 use crate::rows::{GpsColumns, Row};
 
 /// The JSON Schema of a message of plain numbers with units in their names.
-fn numbers_schema(title: &str, fields: &[&str]) -> String {
+fn numbers_schema(title: &str, fields: &[Column]) -> String {
     let properties: Vec<String> = fields
         .iter()
-        .map(|f| format!("\"{f}\":{{\"type\":\"number\"}}"))
+        .map(|f| format!("\"{}\":{{\"type\":\"number\"}}", f.name))
         .collect();
     format!(
         "{{\"title\":\"{title}\",\"type\":\"object\",\"properties\":{{{}}}}}",
@@ -48,35 +49,36 @@ pub const GPS_TOPIC: &str = "/gps";
 /// Alerts, markers, faults, dropouts and damage.
 pub const EVENTS_TOPIC: &str = "/events";
 
+/// The sensor groups of a row: topic, schema name and the columns a
+/// message may carry.
+const SENSOR_GROUPS: [(&str, &str, &[&str]); 3] = [
+    (
+        IMU_TOPIC,
+        "wobblog.Imu",
+        &["ax_g", "ay_g", "az_g", "gx_dps", "gy_dps", "gz_dps"],
+    ),
+    (STEERING_TOPIC, "wobblog.Steering", &["steer_deg"]),
+    (WHEEL_TOPIC, "wobblog.Wheel", &["speed_mps"]),
+];
+
+/// A channel of row messages: its id and the chosen columns it carries.
+struct RowChannel {
+    id: u16,
+    columns: Vec<Column>,
+}
+
 /// Writes an MCAP file front to back on any writer.
 pub struct McapWriter<W: Write> {
     writer: Writer<NoSeek<W>>,
-    imu: u16,
-    steering: u16,
-    wheel: u16,
-    gps: u16,
+    rows: Vec<RowChannel>,
+    /// Absent when no GPS column is chosen.
+    gps: Option<u16>,
     events: u16,
     sequence: u32,
-}
-
-#[derive(Serialize)]
-struct Imu {
-    ax_g: f64,
-    ay_g: f64,
-    az_g: f64,
-    gx_dps: f64,
-    gy_dps: f64,
-    gz_dps: f64,
-}
-
-#[derive(Serialize)]
-struct Steering {
-    steer_deg: f64,
-}
-
-#[derive(Serialize)]
-struct Wheel {
-    speed_mps: f64,
+    /// The chosen columns, for the metadata's units.
+    columns: Vec<Column>,
+    /// A message being built, kept to reuse its allocation.
+    body: String,
 }
 
 #[derive(Serialize)]
@@ -98,11 +100,14 @@ struct LocationFix {
 }
 
 impl<W: Write> McapWriter<W> {
-    /// A writer on `out`; the header and channel definitions go out at once.
+    /// A writer of `columns` on `out`; the header and channel definitions
+    /// go out at once. Each sensor group's channel carries the chosen
+    /// columns of its group, in the order chosen, and is left out when none
+    /// is chosen; `/gps` is there when a GPS column is; `/events` always.
     ///
     /// # Errors
     /// When `out` fails.
-    pub fn new(out: W) -> Result<Self, McapError> {
+    pub fn new(out: W, columns: &[Column]) -> Result<Self, McapError> {
         let mut writer = WriteOptions::new()
             .disable_seeking(true)
             .compression(None)
@@ -113,34 +118,40 @@ impl<W: Write> McapWriter<W> {
             let id = writer.add_schema(schema_name, "jsonschema", schema.as_bytes())?;
             writer.add_channel(id, topic, "json", &no_meta)
         };
-        let imu = channel(
-            IMU_TOPIC,
-            "wobblog.Imu",
-            &numbers_schema(
-                "wobblog.Imu",
-                &["ax_g", "ay_g", "az_g", "gx_dps", "gy_dps", "gz_dps"],
-            ),
-        )?;
-        let steering = channel(
-            STEERING_TOPIC,
-            "wobblog.Steering",
-            &numbers_schema("wobblog.Steering", &["steer_deg"]),
-        )?;
-        let wheel = channel(
-            WHEEL_TOPIC,
-            "wobblog.Wheel",
-            &numbers_schema("wobblog.Wheel", &["speed_mps"]),
-        )?;
-        let gps = channel(GPS_TOPIC, "foxglove.LocationFix", LOCATION_FIX_SCHEMA)?;
+        let mut rows = Vec::new();
+        for (topic, schema_name, names) in SENSOR_GROUPS {
+            let chosen: Vec<Column> = columns
+                .iter()
+                .filter(|c| names.contains(&c.name))
+                .copied()
+                .collect();
+            if !chosen.is_empty() {
+                let schema = numbers_schema(schema_name, &chosen);
+                let id = channel(topic, schema_name, &schema)?;
+                rows.push(RowChannel {
+                    id,
+                    columns: chosen,
+                });
+            }
+        }
+        let gps = if columns.iter().any(|c| c.name.starts_with("gps_")) {
+            Some(channel(
+                GPS_TOPIC,
+                "foxglove.LocationFix",
+                LOCATION_FIX_SCHEMA,
+            )?)
+        } else {
+            None
+        };
         let events = channel(EVENTS_TOPIC, "wobblog.Event", EVENT_SCHEMA)?;
         Ok(Self {
             writer,
-            imu,
-            steering,
-            wheel,
+            rows,
             gps,
             events,
             sequence: 0,
+            columns: columns.to_vec(),
+            body: String::new(),
         })
     }
 
@@ -151,6 +162,10 @@ impl<W: Write> McapWriter<W> {
         body: &impl Serialize,
     ) -> Result<(), McapError> {
         let data = serde_json::to_vec(body).map_err(std::io::Error::other)?;
+        self.message_data(channel_id, t_s, &data)
+    }
+
+    fn message_data(&mut self, channel_id: u16, t_s: f64, data: &[u8]) -> Result<(), McapError> {
         let ns = (t_s.max(0.0) * 1e9).round() as u64;
         self.sequence = self.sequence.wrapping_add(1);
         self.writer.write_to_known_channel(
@@ -160,7 +175,7 @@ impl<W: Write> McapWriter<W> {
                 log_time: ns,
                 publish_time: ns,
             },
-            &data,
+            data,
         )
     }
 
@@ -169,31 +184,14 @@ impl<W: Write> McapWriter<W> {
     /// # Errors
     /// When the output fails.
     pub fn row(&mut self, row: &Row) -> Result<(), McapError> {
-        let [ax_g, ay_g, az_g] = row.accel_g;
-        let [gx_dps, gy_dps, gz_dps] = row.gyro_dps;
-        let imu = Imu {
-            ax_g,
-            ay_g,
-            az_g,
-            gx_dps,
-            gy_dps,
-            gz_dps,
-        };
-        self.message(self.imu, row.t_s, &imu)?;
-        self.message(
-            self.steering,
-            row.t_s,
-            &Steering {
-                steer_deg: row.steer_deg,
-            },
-        )?;
-        self.message(
-            self.wheel,
-            row.t_s,
-            &Wheel {
-                speed_mps: row.speed_mps,
-            },
-        )
+        let mut body = std::mem::take(&mut self.body);
+        for k in 0..self.rows.len() {
+            body.clear();
+            json_object(&mut body, &self.rows[k].columns, row);
+            self.message_data(self.rows[k].id, row.t_s, body.as_bytes())?;
+        }
+        self.body = body;
+        Ok(())
     }
 
     /// Writes a GPS fix with a position (others have nothing for a map).
@@ -201,7 +199,7 @@ impl<W: Write> McapWriter<W> {
     /// # Errors
     /// When the output fails.
     pub fn gps(&mut self, fix: &GpsFix) -> Result<(), McapError> {
-        let Some(pos) = GpsColumns::from_fix(fix) else {
+        let (Some(gps), Some(pos)) = (self.gps, GpsColumns::from_fix(fix)) else {
             return Ok(());
         };
         let unix_ms = fix.utc.map_or(0, |u| u.unix_ms());
@@ -217,7 +215,7 @@ impl<W: Write> McapWriter<W> {
             position_covariance: [0.0; 9],
             position_covariance_type: 0,
         };
-        self.message(self.gps, fix.t_us as f64 / 1e6, &location)
+        self.message(gps, fix.t_us as f64 / 1e6, &location)
     }
 
     /// Writes one event.
@@ -236,7 +234,7 @@ impl<W: Write> McapWriter<W> {
     pub fn finish(&mut self, meta: &LogMetadata) -> Result<(), McapError> {
         let metadata = Metadata {
             name: "wobblog".into(),
-            metadata: meta.pairs(&super::columns::COLUMNS).into_iter().collect(),
+            metadata: meta.pairs(&self.columns).into_iter().collect(),
         };
         self.writer.write_metadata(&metadata)?;
         // The output flushes itself when committed.

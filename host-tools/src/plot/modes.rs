@@ -21,6 +21,21 @@ pub const DOT_PX: i32 = 5;
 /// hollow whatever their run.
 pub const CENSORED_COLOUR: RGBColor = RGBColor(0xa0, 0xa0, 0xa0);
 
+/// Colour of the zero lines of sigma: the boundary between stable (left,
+/// below) and unstable (right, above) wobble.
+pub const ZERO_LINE_COLOUR: RGBColor = RGBColor(0x30, 0x30, 0x30);
+
+/// An episode's value on a panel's axis.
+type Coordinate = fn(&Episode) -> f64;
+
+/// Which axis of a panel is sigma, so its zero line is drawn.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum SigmaAxis {
+    X,
+    Y,
+    None,
+}
+
 /// One colour per run, in turn: dark enough on white to tell apart.
 const RUN_COLOURS: [RGBColor; 8] = [
     RGBColor(0x1f, 0x4e, 0x9a),
@@ -120,19 +135,29 @@ impl ModePlot {
         (shape, style)
     }
 
-    /// Draws every episode as (`x`, `y`) on `area`.
+    /// Draws every episode as (`x(e)`, `y(e)`) on `area`, with the line where
+    /// sigma is zero when sigma is on an axis.
     fn panel<DB: DrawingBackend>(
         &self,
         area: &DrawingArea<DB, Shift>,
         labels: (&str, &str),
-        x: fn(&Episode) -> f64,
-        y: fn(&Episode) -> f64,
-        zero_line: bool,
+        (x, y): (Coordinate, Coordinate),
+        sigma_on: SigmaAxis,
     ) -> Result<(), String> {
         let err = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
-        let xs = self.all().map(x).chain(zero_line.then_some(0.0));
-        let x_range = padded_range(xs, if zero_line { 2.0 } else { 1.0 });
-        let y_range = padded_range(self.all().map(y), if zero_line { 10.0 } else { 1.0 });
+        let on_x = sigma_on == SigmaAxis::X;
+        let on_y = sigma_on == SigmaAxis::Y;
+        // The zero line is always in view, even when every episode is on
+        // one side of it.
+        let xs = self.all().map(x).chain(on_x.then_some(0.0));
+        let ys = self.all().map(y).chain(on_y.then_some(0.0));
+        let x_range = padded_range(xs, if on_x { 2.0 } else { 1.0 });
+        let y_span = match sigma_on {
+            SigmaAxis::X => 10.0,
+            SigmaAxis::Y => 2.0,
+            SigmaAxis::None => 1.0,
+        };
+        let y_range = padded_range(ys, y_span);
         let mut chart = ChartBuilder::on(area)
             .margin(12)
             .x_label_area_size(44)
@@ -149,11 +174,16 @@ impl ModePlot {
             .axis_desc_style((FONT, 15))
             .draw()
             .map_err(err)?;
-        if zero_line {
+        let zero_line = match sigma_on {
+            SigmaAxis::X => Some(vec![(0.0, y_range.start), (0.0, y_range.end)]),
+            SigmaAxis::Y => Some(vec![(x_range.start, 0.0), (x_range.end, 0.0)]),
+            SigmaAxis::None => None,
+        };
+        if let Some(line) = zero_line {
             chart
                 .draw_series(std::iter::once(PathElement::new(
-                    vec![(0.0, y_range.start), (0.0, y_range.end)],
-                    BLACK.stroke_width(1),
+                    line,
+                    ZERO_LINE_COLOUR.stroke_width(1),
                 )))
                 .map_err(err)?;
         }
@@ -210,23 +240,20 @@ impl Figure for ModePlot {
         self.panel(
             &plane,
             (X_LABEL, Y_LABEL),
-            |e| e.sigma_per_s,
-            Episode::omega_rad_s,
-            true,
+            (|e| e.sigma_per_s, Episode::omega_rad_s),
+            SigmaAxis::X,
         )?;
         self.panel(
             &sigma,
             (SPEED_LABEL, "sigma (1/s)"),
-            |e| e.speed_at_onset_mps,
-            |e| e.sigma_per_s,
-            false,
+            (|e| e.speed_at_onset_mps, |e| e.sigma_per_s),
+            SigmaAxis::Y,
         )?;
         self.panel(
             &freq,
             (SPEED_LABEL, "frequency (Hz)"),
-            |e| e.speed_at_onset_mps,
-            |e| e.freq_hz,
-            false,
+            (|e| e.speed_at_onset_mps, |e| e.freq_hz),
+            SigmaAxis::None,
         )?;
         self.key(&key)
     }

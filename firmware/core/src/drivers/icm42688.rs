@@ -21,7 +21,9 @@
 //! reads 0x00 or 0xFF ([`Error::NoResponse`]), another part reads something
 //! else ([`Error::WrongId`]). [`Icm42688::read`] reports a sensor whose
 //! registers hold the "no data" marker ([`Error::NotReady`]: it reset or
-//! powered down). A sensor that answers with frozen values is found one level
+//! powered down), and one that went away after `init` ([`Error::NoResponse`]:
+//! the burst reads all 0xFF or all 0x00, the floating bus; a live sensor
+//! always has gravity on some axis). A sensor that answers with frozen values is found one level
 //! up, by [`crate::imu::Imu`]. Each error maps to the sampler's
 //! [`SensorError`] ([`Error::sensor_error`]), which records it as an IMU
 //! fault; the caller re-runs `init` to recover.
@@ -181,7 +183,8 @@ impl Default for Config {
 pub enum Error<E> {
     /// The SPI bus failed.
     Comm(E),
-    /// `WHO_AM_I` read 0x00 or 0xFF: no sensor on the bus (or no power).
+    /// `WHO_AM_I` read 0x00 or 0xFF, or a data burst read nothing else: no
+    /// sensor on the bus (or no power).
     NoResponse,
     /// `WHO_AM_I` read this instead of 0x47: another part.
     WrongId(u8),
@@ -282,9 +285,7 @@ impl<SPI: SpiDevice> Icm42688<SPI> {
     /// [`Error::WrongId`] when the sensor is not there.
     pub async fn init(&mut self, delay: &mut impl DelayNs) -> Result<(), Error<SPI::Error>> {
         use reg::*;
-        // The MCU may have reset while the sensor was left in another bank.
-        self.write(REG_BANK_SEL, 0).await?;
-        match self.read_reg(WHO_AM_I).await? {
+        match self.who_am_i().await? {
             WHO_AM_I_VALUE => {}
             0x00 | 0xFF => return Err(Error::NoResponse),
             other => return Err(Error::WrongId(other)),
@@ -302,15 +303,30 @@ impl<SPI: SpiDevice> Icm42688<SPI> {
         Ok(())
     }
 
+    /// Reads the identity register as it is, whatever part answers (the
+    /// self-test reports the raw value). Works before [`Self::init`].
+    ///
+    /// # Errors
+    /// [`Error::Comm`] on a bus error.
+    pub async fn who_am_i(&mut self) -> Result<u8, Error<SPI::Error>> {
+        // The MCU may have reset while the sensor was left in another bank.
+        self.write(reg::REG_BANK_SEL, 0).await?;
+        self.read_reg(reg::WHO_AM_I).await
+    }
+
     /// Reads the latest accel and gyro sample (one 12-byte burst), in the
     /// sensor's axes and counts: scale with [`Config::imu_config`].
     ///
     /// # Errors
     /// [`Error::Comm`] on a bus error, [`Error::NotReady`] when the sensor
-    /// has no data.
+    /// has no data, [`Error::NoResponse`] when the bus reads as if nothing
+    /// were on it.
     pub async fn read(&mut self) -> Result<RawImu, Error<SPI::Error>> {
         let mut raw = [0u8; DATA_LEN];
         self.read_regs(reg::ACCEL_DATA_X1, &mut raw).await?;
+        if raw.iter().all(|&b| b == 0xFF) || raw.iter().all(|&b| b == 0x00) {
+            return Err(Error::NoResponse);
+        }
         let word = |i: usize| i16::from_be_bytes([raw[2 * i], raw[2 * i + 1]]);
         let sample = RawImu {
             accel: [word(0), word(1), word(2)],
