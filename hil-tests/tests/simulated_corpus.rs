@@ -38,7 +38,7 @@ fn load(fixture: &Fixture, dir: &Path) -> Run {
     std::fs::write(&csv, &fixture.csv).unwrap();
     let log = dir.join(format!("{}.wbl", fixture.truth.name));
     let output = std::io::BufWriter::new(std::fs::File::create(&log).unwrap());
-    wobblog::cmd::encode::encode(fixture.csv.as_bytes(), &csv, output, &log).unwrap();
+    wobblog::cmd::encode::encode(fixture.csv.as_bytes(), &csv, output, &log, false).unwrap();
     Run::load(&log).unwrap()
 }
 
