@@ -6,7 +6,7 @@ mod analysis_support;
 
 use std::f64::consts::TAU;
 
-use analysis_support::{wobble, Ride, FS_HZ};
+use analysis_support::{assert_same_episode as assert_same, wobble, Ride, FS_HZ};
 use wobblog::analysis::roll::RollStream;
 use wobblog::analysis::search::EpisodeSearch;
 use wobblog::analysis::{Cut, Episode, Run, Stability};
@@ -35,26 +35,6 @@ fn episodes(run: &Run, chunk: usize) -> (Vec<Episode>, usize) {
     }
     let held = search.most_held();
     (search.finish(&Losses::default()), held)
-}
-
-fn assert_same(a: &Episode, b: &Episode) {
-    let pairs = [
-        (a.onset_s, b.onset_s),
-        (a.end_s, b.end_s),
-        (a.peak_s, b.peak_s),
-        (a.freq_hz, b.freq_hz),
-        (a.sigma_per_s, b.sigma_per_s),
-        (a.peak_amp_deg, b.peak_amp_deg),
-        (a.speed_at_onset_mps, b.speed_at_onset_mps),
-    ];
-    for (x, y) in pairs {
-        assert!((x - y).abs() <= 1e-9 * x.abs().max(1.0), "{a:?}\n{b:?}");
-    }
-    assert_eq!(a.stability, b.stability);
-    assert_eq!(
-        (a.cut_at_start, a.cut_at_end),
-        (b.cut_at_start, b.cut_at_end)
-    );
 }
 
 #[test]

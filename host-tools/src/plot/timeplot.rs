@@ -61,12 +61,42 @@ const PANEL_HEIGHT_PX: u32 = 220;
 /// column of the figure, and the roll estimate streams (see
 /// [`RollStream`]).
 pub struct TimePlotBuilder {
+    roll: RollStream,
+    panels: Panels,
+}
+
+/// The figure being drawn, frame by frame.
+struct Panels {
     plot: TimePlot,
     period_s: f64,
-    roll: RollStream,
-    panels: [Decimator; 4],
+    lines: [Decimator; 4],
     /// Time of the last frame drawn.
     last_s: Option<f64>,
+}
+
+impl Panels {
+    /// Adds frame `j` of `frames`, whose roll is `roll_deg`, if it falls in
+    /// the figure's window.
+    fn draw(&mut self, frames: &Run, j: usize, roll_deg: f64) {
+        let t = frames.t_s[j];
+        let window = &self.plot.window_s;
+        if !(window.contains(&t) || t == window.end) {
+            return;
+        }
+        let joins = self
+            .last_s
+            .is_some_and(|prev| follows(prev, t, self.period_s));
+        self.last_s = Some(t);
+        let values = [
+            frames.steer_deg[j],
+            roll_deg,
+            frames.gyro_dps[j][2],
+            frames.speed_mps[j],
+        ];
+        for (line, y) in self.lines.iter_mut().zip(values) {
+            line.push(t, y, joins);
+        }
+    }
 }
 
 impl TimePlotBuilder {
@@ -120,95 +150,46 @@ impl TimePlotBuilder {
             .collect();
         let columns = 2 * WIDTH_PX as usize;
         Some(Self {
-            panels: std::array::from_fn(|_| Decimator::new(&window_s, columns)),
-            plot: TimePlot {
-                title: format!("{name}: {:.1} to {:.1} s", window_s.start, window_s.end),
-                window_s,
-                series: Default::default(),
-                alerts_s,
-                markers_s,
-                lost_s,
-                jumps_s,
-                utc: None,
+            panels: Panels {
+                lines: std::array::from_fn(|_| Decimator::new(&window_s, columns)),
+                plot: TimePlot {
+                    title: format!("{name}: {:.1} to {:.1} s", window_s.start, window_s.end),
+                    window_s,
+                    series: Default::default(),
+                    alerts_s,
+                    markers_s,
+                    lost_s,
+                    jumps_s,
+                    utc: None,
+                },
+                period_s: 1.0 / fs_hz,
+                last_s: None,
             },
-            period_s: 1.0 / fs_hz,
             roll: RollStream::new(fs_hz),
-            last_s: None,
         })
     }
 
     /// Takes frame `i` of `source` (frames in file order).
     pub fn push(&mut self, source: &Run, i: usize) {
-        let Self {
-            plot,
-            period_s,
-            roll,
-            panels,
-            last_s,
-        } = self;
-        roll.push(source, i, &mut |frames, j, roll_deg| {
-            draw_frame(plot, *period_s, panels, last_s, frames, j, roll_deg);
-        });
+        let panels = &mut self.panels;
+        self.roll
+            .push(source, i, &mut |f, j, r| panels.draw(f, j, r));
     }
 
     /// Takes one frame as a row (frames in file order).
     pub fn push_row(&mut self, row: &Row) {
-        let Self {
-            plot,
-            period_s,
-            roll,
-            panels,
-            last_s,
-        } = self;
-        roll.push_row(row, &mut |frames, j, roll_deg| {
-            draw_frame(plot, *period_s, panels, last_s, frames, j, roll_deg);
-        });
+        let panels = &mut self.panels;
+        self.roll.push_row(row, &mut |f, j, r| panels.draw(f, j, r));
     }
 
     /// The figure.
     #[must_use]
     pub fn finish(mut self) -> TimePlot {
-        let Self {
-            plot,
-            period_s,
-            roll,
-            panels,
-            last_s,
-        } = &mut self;
-        roll.finish(&mut |frames, j, roll_deg| {
-            draw_frame(plot, *period_s, panels, last_s, frames, j, roll_deg);
-        });
-        self.plot.series = self.panels.each_ref().map(Decimator::lines);
-        self.plot
-    }
-}
-
-/// Adds frame `j` of `frames`, whose roll is `roll_deg`, to the panels if
-/// it falls in the figure's window.
-fn draw_frame(
-    plot: &TimePlot,
-    period_s: f64,
-    panels: &mut [Decimator; 4],
-    last_s: &mut Option<f64>,
-    frames: &Run,
-    j: usize,
-    roll_deg: f64,
-) {
-    let t = frames.t_s[j];
-    let window = &plot.window_s;
-    if !(window.contains(&t) || t == window.end) {
-        return;
-    }
-    let joins = last_s.is_some_and(|prev| follows(prev, t, period_s));
-    *last_s = Some(t);
-    let values = [
-        frames.steer_deg[j],
-        roll_deg,
-        frames.gyro_dps[j][2],
-        frames.speed_mps[j],
-    ];
-    for (panel, y) in panels.iter_mut().zip(values) {
-        panel.push(t, y, joins);
+        let panels = &mut self.panels;
+        self.roll.finish(&mut |f, j, r| panels.draw(f, j, r));
+        let mut plot = self.panels.plot;
+        plot.series = self.panels.lines.each_ref().map(Decimator::lines);
+        plot
     }
 }
 
