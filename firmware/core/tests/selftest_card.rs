@@ -54,3 +54,28 @@ fn free_space_matches_the_file_systems_own_count() {
 fn no_fat32_no_figure() {
     assert_eq!(fat32_free_mib(&MockCard::new(vec![0u8; 1 << 20])), None);
 }
+
+/// Each part of the FAT32 layout the figure rests on must be there: a
+/// 512-byte sector, a cluster size, both FSInfo signatures and a known free
+/// count (FAT32's "unknown" is 0xFFFFFFFF). Damaging any one of them
+/// gives no figure.
+#[test]
+fn a_damaged_layout_gives_no_figure() {
+    let (image, _) = card(128, 0);
+    let boot = (PART_START_BLOCKS * 512) as usize;
+    let fsinfo_sector = u16::from_le_bytes([image[boot + 48], image[boot + 49]]) as usize;
+    let fsinfo = boot + fsinfo_sector * 512;
+    let damages: [(&str, usize, &[u8]); 5] = [
+        ("1024-byte sectors", boot + 11, &1024u16.to_le_bytes()),
+        ("no cluster size", boot + 13, &[0]),
+        ("FSInfo lead signature", fsinfo, &[0; 4]),
+        ("FSInfo structure signature", fsinfo + 484, &[0; 4]),
+        ("unknown free count", fsinfo + 488, &[0xFF; 4]),
+    ];
+    for (what, at, bytes) in damages {
+        let mut damaged = image.clone();
+        damaged[at..at + bytes.len()].copy_from_slice(bytes);
+        assert_eq!(fat32_free_mib(&MockCard::new(damaged)), None, "{what}");
+    }
+    assert!(fat32_free_mib(&MockCard::new(image)).is_some());
+}
