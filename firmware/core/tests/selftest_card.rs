@@ -9,13 +9,16 @@ use wobble_core::selftest::fat32_free_mib;
 
 const PART_START_BLOCKS: u64 = 2048;
 
-/// A card of `mib` MiB with one FAT32 partition, and `fatfs`'s free count.
-fn card(mib: u64, used_bytes: usize) -> (Vec<u8>, u64) {
+/// A card of `mib` MiB with one FAT32 partition of `cluster_bytes`
+/// clusters, and `fatfs`'s free count.
+fn card(mib: u64, used_bytes: usize, cluster_bytes: u32) -> (Vec<u8>, u64) {
     let bytes = mib << 20;
     let mut image = vec![0u8; bytes as usize];
     let start = (PART_START_BLOCKS * 512) as usize;
     let blocks = (bytes / 512 - PART_START_BLOCKS) as u32;
-    let opts = fatfs::FormatVolumeOptions::new().fat_type(fatfs::FatType::Fat32);
+    let opts = fatfs::FormatVolumeOptions::new()
+        .fat_type(fatfs::FatType::Fat32)
+        .bytes_per_cluster(cluster_bytes);
     fatfs::format_volume(std::io::Cursor::new(&mut image[start..]), opts).expect("format");
     let free = {
         let fs = fatfs::FileSystem::new(
@@ -42,10 +45,16 @@ fn card(mib: u64, used_bytes: usize) -> (Vec<u8>, u64) {
 
 #[test]
 fn free_space_matches_the_file_systems_own_count() {
-    for used in [0, 5 << 20] {
-        let (image, free_bytes) = card(128, used);
+    // One sector a cluster and two (FAT32 needs 65 525 clusters, so larger
+    // ones would need a larger image): the count is in clusters.
+    for (used, cluster_bytes) in [(0, 512), (5 << 20, 512), (5 << 20, 1024)] {
+        let (image, free_bytes) = card(128, used, cluster_bytes);
         let mib = fat32_free_mib(&MockCard::new(image)).expect("FAT32 count");
-        assert_eq!(u64::from(mib), free_bytes >> 20, "used {used}");
+        assert_eq!(
+            u64::from(mib),
+            free_bytes >> 20,
+            "used {used}, {cluster_bytes} B clusters"
+        );
         assert!(mib > 100);
     }
 }
@@ -61,7 +70,7 @@ fn no_fat32_no_figure() {
 /// gives no figure.
 #[test]
 fn a_damaged_layout_gives_no_figure() {
-    let (image, _) = card(128, 0);
+    let (image, _) = card(128, 0, 512);
     let boot = (PART_START_BLOCKS * 512) as usize;
     let fsinfo_sector = u16::from_le_bytes([image[boot + 48], image[boot + 49]]) as usize;
     let fsinfo = boot + fsinfo_sector * 512;
