@@ -409,10 +409,10 @@ mod tests {
     /// lines counted), and the message says which.
     #[test]
     fn a_line_without_a_verdict_is_named_by_its_number() {
-        let text = "wobble self-test 1\nimu PASS x\n\nsteering\n";
+        let text = "wobble self-test 1\nimu PASS x\n\nwheel PASS y\nsteering\n";
         let err = read_report(text, &mut |_| {}).unwrap_err();
-        assert_eq!(err, ReportError::BadLine(4));
-        assert_eq!(err.to_string(), "line 4 is not `check PASS|FAIL detail`");
+        assert_eq!(err, ReportError::BadLine(5));
+        assert_eq!(err.to_string(), "line 5 is not `check PASS|FAIL detail`");
         assert!(ReportError::NotAReport.to_string().contains(HEADER));
     }
 
