@@ -202,8 +202,13 @@ fn without_speed_the_goals_hold_except_under_strong_ripple() {
 fn metrics_file_is_current() {
     let path = corpus::corpus_dir().join("METRICS.md");
     let on_disk = std::fs::read_to_string(&path).unwrap_or_default();
+    let simulated = corpus::simulated::generate()
+        .and_then(|f| metrics::evaluate(&f, &Config::default(), true))
+        .expect("simulated family evaluates");
+    let want =
+        metrics::markdown(report(true), report(false)) + &metrics::simulated_markdown(&simulated);
     assert!(
-        on_disk == metrics::markdown(report(true), report(false)),
+        on_disk == want,
         "{} is stale: run `cargo run -p wobble-hil --release --bin detector-metrics`",
         path.display()
     );

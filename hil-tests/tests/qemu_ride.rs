@@ -2,13 +2,23 @@
 //! Figure-6 ride for 30 s of virtual time while replaying a real 5 Hz NMEA
 //! capture; the card image must hold every frame on time, the capture's
 //! fixes, the alert where the ground truth has the wobble, and a clean FAT.
+//! The sensors are mounted and calibrated as the card's `CONFIG.TXT` says
+//! (a rotated IMU, a three-point steering calibration turning the other
+//! way): the raw register bytes and ADC counts become the ride's values
+//! only through the core's driver, axis map, averaging and calibration.
 
 use std::path::Path;
 
-use wobble_core::format::FrameStatus;
+use wobble_core::drivers::icm42688;
+use wobble_core::format::{FrameStatus, ACCEL_COUNTS_PER_G, GYRO_COUNTS_PER_DPS};
 use wobble_hil::qemu::{self, decode, fixture, Scenario};
 
 const FRAMES: u32 = 3000;
+/// The card's configuration: the IMU's x to the left and its y backwards;
+/// the potentiometer reading fewer counts to the left, not quite linear.
+const CONFIG_TXT: &str = "imu.axis_map = -y, +x, +z
+steering.three_point = 620:42, 2100:0, 3480:-38
+";
 /// Frame spacing tolerance: the sampler runs on 1 ms SysTick alarms with
 /// 1 µs time stamps; a tick may be late by the card writes it preempts.
 const SPACING_TOLERANCE_US: u64 = 1000;
@@ -17,7 +27,12 @@ const SPACING_TOLERANCE_US: u64 = 1000;
 fn bundled_ride_logs_every_frame_fix_and_alert() {
     let bundle = qemu::bundle(FRAMES).expect("fixtures");
     let dir = qemu::work_dir(Path::new(env!("CARGO_TARGET_TMPDIR")), "ride").expect("dir");
-    let setup = bundle.setup(dir.clone(), Scenario::ride(FRAMES));
+    let setup = qemu::Setup {
+        config: Some(CONFIG_TXT),
+        ..bundle.setup(dir.clone(), Scenario::ride(FRAMES))
+    };
+    let config = setup.config().expect("configuration");
+    assert_ne!(config, wobble_core::config::Config::default());
     let out = qemu::run(&setup, |_| Ok(()), |_| {}).expect("qemu run");
     assert_eq!(out.code, 0, "{:?}", out.lines);
     assert_eq!(
@@ -35,7 +50,7 @@ fn bundled_ride_logs_every_frame_fix_and_alert() {
     // The header holds the configuration in force, complete and exact.
     let in_force = wobble_core::config::Config::parse(log.summary.config.join("\n").as_bytes());
     assert!(in_force.faults.is_empty(), "{:?}", in_force.faults);
-    assert_eq!(in_force.config, wobble_core::config::Config::default());
+    assert_eq!(in_force.config, config, "the card's CONFIG.TXT in force");
 
     // Exactly duration x 100 frames, 10 ms apart, no dropout.
     assert_eq!(log.frames.len(), FRAMES as usize);
@@ -50,15 +65,49 @@ fn bundled_ride_logs_every_frame_fix_and_alert() {
         worst_us <= SPACING_TOLERANCE_US,
         "spacing off by {worst_us} µs"
     );
-    // The frames carry the replayed signals: steering exactly, speed once
-    // the wheel estimator has a revolution of edges.
+    // The frames carry the ride's values: steering to the averaged ADC
+    // resolution (the steepest calibration segment over half a count per
+    // conversion) plus the card's 0.01 deg; the IMU to its noise and the
+    // sensor's and the card's quantisation; speed once the wheel estimator
+    // has a revolution of edges.
+    let [a, b, c] = config.steering.three_point.expect("three points");
+    let steepest = [(a, b), (b, c)]
+        .map(|(p, q)| ((q.deg - p.deg) / (q.counts - p.counts)).abs())
+        .into_iter()
+        .fold(0.0f32, f32::max);
+    let steer_tol = f64::from(steepest) * 0.5 / fixture::ADC_PER_FRAME as f64 + 0.005 + 1e-4;
+    let sensor = icm42688::Config::default().imu_config(config.imu);
+    let accel_tol = (fixture::IMU_NOISE_LSB + 0.5) * f64::from(sensor.accel_g_per_lsb)
+        + 0.5 / f64::from(ACCEL_COUNTS_PER_G)
+        + 1e-6;
+    let gyro_tol = (fixture::IMU_NOISE_LSB + 0.5) * f64::from(sensor.gyro_dps_per_lsb)
+        + 0.5 / f64::from(GYRO_COUNTS_PER_DPS)
+        + 1e-6;
+    let mut worst = [0.0f64; 3];
     for (k, f) in log.frames.iter().enumerate() {
         let row = bundle.ride.rows[k];
-        assert_eq!(
-            f.steer_cdeg,
-            (f64::from(row.steer_deg) * 100.0).round() as i16,
-            "frame {k}"
+        let steer_err = (f64::from(f.steer_deg()) - f64::from(row.steer_deg)).abs();
+        assert!(
+            steer_err <= steer_tol,
+            "frame {k}: steering off by {steer_err} deg"
         );
+        let (accel_g, gyro_dps) = fixture::imu_truth(&row);
+        for i in 0..3 {
+            let accel_err = (f64::from(f.accel_g()[i]) - accel_g[i]).abs();
+            let gyro_err = (f64::from(f.gyro_dps()[i]) - gyro_dps[i]).abs();
+            assert!(
+                accel_err <= accel_tol,
+                "frame {k}: accel axis {i} off by {accel_err} g"
+            );
+            assert!(
+                gyro_err <= gyro_tol,
+                "frame {k}: gyro axis {i} off by {gyro_err} deg/s"
+            );
+            worst[1] = worst[1].max(accel_err);
+            worst[2] = worst[2].max(gyro_err);
+        }
+        worst[0] = worst[0].max(steer_err);
+        assert!(f.status.0 & (FrameStatus::IMU_FAULT | FrameStatus::STEER_SATURATED) == 0);
         if k >= 200 {
             assert!(
                 (f.speed_mps() - row.speed_mps).abs() < 0.1,
@@ -149,10 +198,14 @@ fn bundled_ride_logs_every_frame_fix_and_alert() {
     let virtual_s = f64::from(FRAMES) / 100.0;
     println!(
         "FIGURES ride: virtual {virtual_s:.1} s in {:.2} s wall ({:.1}x), worst frame spacing error {worst_us} µs, \
-         max tick lateness {} µs, queue high water {}",
+         max tick lateness {} µs, queue high water {}; worst error against the ride: steering {:.4} deg, \
+         accel {:.5} g, gyro {:.4} deg/s",
         out.wall.as_secs_f64(),
         virtual_s / out.wall.as_secs_f64(),
         out.number("END", "max_late_us").unwrap_or(0),
         out.number("END", "queue_high_water").unwrap_or(0),
+        worst[0],
+        worst[1],
+        worst[2],
     );
 }

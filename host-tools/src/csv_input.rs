@@ -71,7 +71,8 @@ const SLOW_RATE_RUN: u32 = 3;
 /// Follows the time column of a CSV that claims the log's sample rate.
 #[derive(Debug)]
 pub struct TimeSteps {
-    rate_hz: f64,
+    /// The rate the steps must show; `None` takes any steps that advance.
+    rate_hz: Option<f64>,
     last: Option<(f64, u64)>,
     /// Consecutive gaps so far and the first one's length.
     gap_run: (u32, f64),
@@ -82,9 +83,19 @@ impl TimeSteps {
     #[must_use]
     pub fn new(rate_hz: f64) -> Self {
         Self {
-            rate_hz,
+            rate_hz: Some(rate_hz),
             last: None,
             gap_run: (0, 0.0),
+        }
+    }
+
+    /// A checker that only asks the time to advance (a CSV to be
+    /// resampled).
+    #[must_use]
+    pub fn any_rate() -> Self {
+        Self {
+            rate_hz: None,
+            ..Self::new(1.0)
         }
     }
 
@@ -107,13 +118,16 @@ impl TimeSteps {
                 "{t_s} does not come after {prev} (line {prev_line}): time {how}"
             ));
         }
-        let period = 1.0 / self.rate_hz;
+        let Some(rate_hz) = self.rate_hz else {
+            return Ok(Step::Regular);
+        };
+        let period = 1.0 / rate_hz;
         let rate = |dt: f64| format!("{:.0} Hz", 1.0 / dt);
         if dt < MIN_STEP * period {
             return Err(format!(
-                "steps by {dt} s, about {}, but a log is sampled at {} Hz",
+                "steps by {dt} s, about {}, but a log is sampled at {rate_hz} Hz \
+                 (`encode --resample` resamples it)",
                 rate(dt),
-                self.rate_hz
             ));
         }
         if dt <= MAX_STEP * period {
@@ -129,9 +143,8 @@ impl TimeSteps {
         if self.gap_run.0 >= SLOW_RATE_RUN {
             return Err(format!(
                 "steps by {dt} s {SLOW_RATE_RUN} times in a row, about {}, but a log \
-                 is sampled at {} Hz",
+                 is sampled at {rate_hz} Hz (`encode --resample` resamples it)",
                 rate(dt),
-                self.rate_hz
             ));
         }
         Ok(Step::Gap(dt))

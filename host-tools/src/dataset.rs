@@ -6,7 +6,7 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::analysis::{find_episodes, Episode, Run, Stability};
+use crate::analysis::{Episode, Ride, Stability};
 use crate::cmd::summary::{logs_in, RunRow};
 use crate::export::columns::{Column, Kind, Value};
 use crate::export::parquet::ParquetWriter;
@@ -239,7 +239,7 @@ fn write_table<R>(path: &Path, columns: &[Column<R>], rows: &[R]) -> Result<(), 
 pub fn write_dataset(
     entries: &[LogEntry],
     dir: &Path,
-    mut progress: impl FnMut(&LogEntry, &Run),
+    mut progress: impl FnMut(&LogEntry, &Ride),
 ) -> Result<(), CliError> {
     let mut runs = Vec::new();
     let mut episodes = Vec::new();
@@ -251,17 +251,17 @@ pub fn write_dataset(
         let export = crate::cmd::decode::Export::all(crate::export::Format::Parquet);
         crate::cmd::decode::decode_to(&entry.path, &export, &mut out, &part)?;
         out.commit()?;
-        let run = Run::load(&entry.path)?;
-        progress(entry, &run);
-        episodes.extend(find_episodes(&run).into_iter().map(|episode| EpisodesRow {
+        let ride = Ride::load(&entry.path)?;
+        progress(entry, &ride);
+        episodes.extend(ride.episodes.iter().cloned().map(|episode| EpisodesRow {
             entry: entry.clone(),
             episode,
         }));
         runs.push(RunsRow {
             entry: entry.clone(),
-            row: RunRow::of(&run),
-            first_utc_us: run.summary.utc_syncs.first().map(|p| p.1 * 1000),
-            firmware: run.summary.firmware.clone(),
+            row: RunRow::of(&ride),
+            first_utc_us: ride.summary.utc_syncs.first().map(|p| p.1 * 1000),
+            firmware: ride.summary.firmware.clone(),
         });
     }
     write_table(&dir.join("runs.parquet"), &runs_columns(), &runs)?;
@@ -281,7 +281,7 @@ pub fn write_dataset(
 pub fn build(
     entries: &[LogEntry],
     target: &Path,
-    progress: impl FnMut(&LogEntry, &Run),
+    progress: impl FnMut(&LogEntry, &Ride),
 ) -> Result<(), CliError> {
     if target.exists() {
         return Err(CliError::file(

@@ -15,6 +15,7 @@ pub mod losses;
 pub mod output;
 pub mod plot;
 pub mod reader;
+pub mod resample;
 pub mod rows;
 pub mod summary;
 pub mod text;

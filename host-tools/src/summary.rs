@@ -91,6 +91,15 @@ pub struct Summary {
     pub utc_syncs: Vec<crate::time::SyncPair>,
 }
 
+impl Summary {
+    /// Nominal frame rate, Hz: the header's, or the documented default of
+    /// 100 Hz.
+    #[must_use]
+    pub fn frame_rate_hz(&self) -> f64 {
+        f64::from(self.sample_rate_hz.unwrap_or(100).max(1))
+    }
+}
+
 /// Builds a [`Summary`] from decoder events.
 #[derive(Default)]
 pub struct SummaryBuilder {
@@ -170,6 +179,13 @@ impl SummaryBuilder {
         self.rows.push(record, &mut |row: &Row| {
             *with_gps += u64::from(row.gps.is_some())
         });
+    }
+
+    /// The frame rate the log has given so far (see
+    /// [`Summary::frame_rate_hz`]).
+    #[must_use]
+    pub fn frame_rate_hz(&self) -> f64 {
+        self.summary.frame_rate_hz()
     }
 
     fn period_us(&self) -> u64 {

@@ -50,7 +50,7 @@ fn load(fixture: &Value, tmp: &Path) -> Run {
     let log = tmp.join(format!("{}.wbl", fixture["name"].as_str().unwrap()));
     let input = std::fs::File::open(&csv).unwrap();
     let output = std::io::BufWriter::new(std::fs::File::create(&log).unwrap());
-    wobblog::cmd::encode::encode(input, &csv, output, &log).unwrap();
+    wobblog::cmd::encode::encode(input, &csv, output, &log, false).unwrap();
     Run::load(&log).unwrap()
 }
 

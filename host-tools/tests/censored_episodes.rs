@@ -49,19 +49,7 @@ fn first_wobble(episodes: &[Episode]) -> &Episode {
 }
 
 fn assert_same(a: &Episode, b: &Episode) {
-    let pairs = [
-        (a.onset_s, b.onset_s),
-        (a.end_s, b.end_s),
-        (a.peak_s, b.peak_s),
-        (a.freq_hz, b.freq_hz),
-        (a.sigma_per_s, b.sigma_per_s),
-        (a.peak_amp_deg, b.peak_amp_deg),
-        (a.speed_at_onset_mps, b.speed_at_onset_mps),
-    ];
-    for (x, y) in pairs {
-        assert!((x - y).abs() <= 1e-9 * x.abs().max(1.0), "{a:?}\n{b:?}");
-    }
-    assert_eq!(a.stability, b.stability);
+    analysis_support::assert_same_episode(a, b);
     assert!(!a.censored && !b.censored);
 }
 

@@ -28,27 +28,27 @@ fn csv_text(rows: &[String]) -> String {
 /// message holding `expected`; no log may appear.
 fn assert_both_refuse(dir: &Path, text: &str, expected: &str) {
     for command in ["encode", "detect"] {
-        assert_refuses(dir, command, text, expected);
+        assert_refuses(dir, &[command], text, expected);
     }
 }
 
-/// Runs `wobblog COMMAND --csv` on `text`: it must fail with exit 1 and one
-/// line naming the file, the line and `expected`; no log may appear.
-fn assert_refuses(dir: &Path, command: &str, text: &str, expected: &str) {
+/// Runs `wobblog COMMAND... --csv` on `text`: it must fail with exit 1 and
+/// one line naming the file, the line and `expected`; no log may appear.
+fn assert_refuses(dir: &Path, command: &[&str], text: &str, expected: &str) {
     let csv = dir.join("in.csv");
     std::fs::write(&csv, text).unwrap();
     let log = dir.join("out.wbl");
     let mut cmd = wobblog();
-    cmd.args([command, "--csv"]).arg(&csv);
-    if command == "encode" {
+    cmd.args(command).arg("--csv").arg(&csv);
+    if command[0] == "encode" {
         cmd.arg("-o").arg(&log);
     }
     let out = cmd.output().unwrap();
     let stderr = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(1), "{command}: {stderr}");
-    assert!(stderr.contains(expected), "{command}: {stderr}");
-    assert!(stderr.contains("in.csv: line "), "{command}: {stderr}");
-    assert_eq!(stderr.lines().count(), 1, "{command}: {stderr}");
+    assert_eq!(out.status.code(), Some(1), "{command:?}: {stderr}");
+    assert!(stderr.contains(expected), "{command:?}: {stderr}");
+    assert!(stderr.contains("in.csv: line "), "{command:?}: {stderr}");
+    assert_eq!(stderr.lines().count(), 1, "{command:?}: {stderr}");
     assert!(!log.exists());
 }
 
@@ -71,7 +71,7 @@ fn utc_that_cannot_be_stored_names_the_cell() {
         ),
     ] {
         let text = format!("t_s,steer_deg,utc\n{rows}");
-        assert_refuses(dir.path(), "encode", &text, expected);
+        assert_refuses(dir.path(), &["encode"], &text, expected);
     }
 }
 
@@ -204,4 +204,99 @@ fn a_gap_between_frames_is_kept_not_refused() {
         stderr.contains("line 12: time gap; detector restarted"),
         "{stderr}"
     );
+}
+
+/// `t_s,steer_deg` rows of the decoded log `encode --resample` makes of
+/// `text`.
+fn resampled(dir: &Path, text: &str) -> Vec<(f64, f64)> {
+    let csv = dir.join("fast.csv");
+    std::fs::write(&csv, text).unwrap();
+    let log = dir.join("fast.wbl");
+    wobblog()
+        .args(["encode", "--resample", "--csv"])
+        .arg(&csv)
+        .arg("-o")
+        .arg(&log)
+        .assert()
+        .success();
+    let out = wobblog()
+        .arg("decode")
+        .arg(&log)
+        .args(["--columns", "t_s,steer_deg"])
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    String::from_utf8(out.stdout)
+        .unwrap()
+        .lines()
+        .skip(1)
+        .map(|l| {
+            let (t, s) = l.split_once(',').unwrap();
+            (t.parse().unwrap(), s.parse().unwrap())
+        })
+        .collect()
+}
+
+/// A 7 Hz steering sine of 1 degree at `rate_hz` from 0 to `end_s`.
+fn sine_rows(rate_hz: f64, end_s: f64) -> Vec<String> {
+    let n = (end_s * rate_hz).round() as usize;
+    (0..=n)
+        .map(|i| {
+            let t = i as f64 / rate_hz;
+            format!("{t},{:.2},4.0", (std::f64::consts::TAU * 7.0 * t).sin())
+        })
+        .collect()
+}
+
+/// With `--resample`, a CSV at 200 Hz or 50 Hz becomes 100 Hz frames on the
+/// grid of its first row, each within quantisation and interpolation error
+/// of the signal.
+#[test]
+fn resample_takes_other_rates_onto_the_log_rate() {
+    let dir = tempfile::tempdir().unwrap();
+    // Linear interpolation of a 7 Hz sine misses by at most
+    // (dt^2 / 8) (2 pi 7)^2: 0.006 deg at 200 Hz, 0.1 deg at 50 Hz.
+    for (rate_hz, tolerance) in [(200.0, 0.015), (50.0, 0.11)] {
+        let frames = resampled(dir.path(), &csv_text(&sine_rows(rate_hz, 3.0)));
+        assert_eq!(frames.len(), 301, "{rate_hz} Hz");
+        for (k, &(t, steer)) in frames.iter().enumerate() {
+            assert!((t - k as f64 / 100.0).abs() < 1e-9, "{rate_hz} Hz: {t}");
+            let truth = (std::f64::consts::TAU * 7.0 * t).sin();
+            assert!(
+                (steer - truth).abs() <= tolerance,
+                "{rate_hz} Hz at {t}: {steer}"
+            );
+        }
+    }
+}
+
+/// Rows more than 0.1 s apart are a gap: `--resample` makes no frame in it.
+#[test]
+fn resample_leaves_gaps_empty() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut rows = sine_rows(200.0, 1.0);
+    rows.extend(sine_rows(200.0, 1.0).iter().map(|r| {
+        let (t, rest) = r.split_once(',').unwrap();
+        format!("{},{rest}", 3.0 + t.parse::<f64>().unwrap())
+    }));
+    let frames = resampled(dir.path(), &csv_text(&rows));
+    assert_eq!(frames.len(), 2 * 101);
+    assert!(frames.iter().all(|&(t, _)| !(1.001..2.999).contains(&t)));
+    assert!(frames.iter().any(|&(t, _)| (t - 3.0).abs() < 1e-9));
+}
+
+/// `--resample` takes any rate, never time that stands still or goes back,
+/// nor values the log cannot store.
+#[test]
+fn resample_still_refuses_what_cannot_be_a_log() {
+    let dir = tempfile::tempdir().unwrap();
+    for (text, expected) in [
+        (
+            "t_s,steer_deg\n0,0\n0.005,1\n0.004,2\n",
+            "line 4, column 1: `t_s` 0.004 does not come after 0.005 (line 3): time goes backwards",
+        ),
+        ("t_s,steer_deg\n0,0\n0.005,NaN\n", "line 3, column 2"),
+    ] {
+        assert_refuses(dir.path(), &["encode", "--resample"], text, expected);
+    }
 }

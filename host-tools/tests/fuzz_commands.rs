@@ -27,7 +27,7 @@ use wobble_core::format::{
     Block, BlockEncoder, ChannelDef, ConfigLine, FixMode, Frame, GpsFix, LogInfo, Record, UtcSync,
     UtcTime, BLOCK_LEN,
 };
-use wobblog::analysis::{find_episodes, Run};
+use wobblog::analysis::{Ride, Run};
 use wobblog::cmd::{decode, detect, encode, gpx, nmea};
 use wobblog::export::Format;
 use wobblog::plot::modes::ModePlot;
@@ -204,12 +204,12 @@ fn every_log_command(path: &Path, dir: &Path) {
         gpx::write_gpx(std::io::sink(), "fuzz", &track).unwrap();
     }
     let _ = wobblog::cmd::config::read_header(path);
-    if let Ok(run) = Run::load(path) {
-        let episodes = find_episodes(&run);
+    if let (Ok(run), Ok(ride)) = (Run::load(path), Ride::load(path)) {
+        let episodes = ride.episodes.clone();
         for e in &episodes {
             assert!(e.sigma_per_s.is_finite() && e.freq_hz.is_finite(), "{e:?}");
         }
-        let row = wobblog::cmd::summary::RunRow::of(&run);
+        let row = wobblog::cmd::summary::RunRow::of(&ride);
         assert!(row.distance_m.is_finite(), "{row:?}");
         draw(
             &ModePlot::new(vec![("fuzz".into(), episodes)]),
@@ -317,12 +317,15 @@ fn arbitrary_csv_through_encode_and_detect() {
                 }
                 text.push('\n');
             }
-            let _ = encode::encode(
-                text.as_bytes(),
-                Path::new("in.csv"),
-                std::io::sink(),
-                Path::new("out"),
-            );
+            for resample in [false, true] {
+                let _ = encode::encode(
+                    text.as_bytes(),
+                    Path::new("in.csv"),
+                    std::io::sink(),
+                    Path::new("out"),
+                    resample,
+                );
+            }
             let _ = detect::replay(
                 Path::new("in.csv"),
                 text.as_bytes(),

@@ -67,7 +67,7 @@ fn round_trip(csv: &str, format: Format) -> String {
     let dir = tempfile::tempdir().unwrap();
     let log = dir.path().join("run.wbl");
     let out = std::fs::File::create(&log).unwrap();
-    encode::encode(csv.as_bytes(), Path::new("in.csv"), out, &log).unwrap();
+    encode::encode(csv.as_bytes(), Path::new("in.csv"), out, &log, false).unwrap();
     let mut decoded = Vec::new();
     let losses = decode::decode_to(
         &log,

@@ -290,3 +290,37 @@ fn bursts_shorter_and_longer_than_the_confirmation() {
     );
     assert!(long_alerted, "no burst was long enough to alert");
 }
+
+/// An oscillation on a wheel harmonic, growing too slowly to count as a
+/// wobble while it could still be ripple, alerts once it is above the
+/// ripple ceiling, where the wheel-harmonic guard no longer applies.
+#[test]
+fn above_the_ripple_ceiling_a_harmonic_oscillation_alerts() {
+    let cfg = DetectorConfig {
+        // No canceller: the oscillation reaches the analysis as it is.
+        harmonic_tau_s: 0.0,
+        ..Config::default().detector
+    };
+    let ceiling_deg = RIPPLE_CEILING * cfg.amp_on_deg;
+    let f = 7.0;
+    // The wheel's 4th harmonic at 7 Hz.
+    let speed = f / 4.0 * WheelConfig::DEFAULT.circumference_m;
+    // Growth over the look-back between the two ratios: enough for a
+    // wobble, too little for ripple.
+    let rate_per_s =
+        0.5 * (cfg.min_growth_ratio.max(1.0) * cfg.harmonic_growth_ratio).ln() / cfg.lookback_s;
+    let amp = |t: f32| (0.5 * cfg.amp_on_deg * (rate_per_s * t).exp()).min(1.5 * ceiling_deg);
+    let signal: Vec<f32> = (0..3000)
+        .map(|i| {
+            let t = i as f32 / FS;
+            amp(t) * (TAU * f * t).sin()
+        })
+        .collect();
+    let (_, changes) = replay(cfg, Some(speed), &signal).expect("agrees with the rules");
+    let (on_at, _) = changes.first().copied().expect("an alert");
+    let envelope = amp(on_at as f32 / FS);
+    assert!(
+        envelope > ceiling_deg && envelope < 1.2 * ceiling_deg,
+        "alert at {envelope} deg, ceiling {ceiling_deg} deg"
+    );
+}

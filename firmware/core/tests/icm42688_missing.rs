@@ -1,13 +1,14 @@
 //! A sensor that does not answer, or another part in its place, is reported
 //! after the identity check and nothing is written to it; the identity
-//! itself can be read raw.
+//! itself can be read raw; one that goes away after its set-up reads as the
+//! floating bus, which is no sample.
 
 mod icm42688_support;
 
 use embassy_futures::block_on;
 use embedded_hal_mock::eh1::delay::NoopDelay;
 use embedded_hal_mock::eh1::spi::Mock;
-use icm42688_support::{read_regs, write_reg};
+use icm42688_support::{data_read, read_regs, write_reg};
 use wobble_core::app::ports::SensorError;
 use wobble_core::drivers::icm42688::{reg::*, Config, Error, Icm42688};
 
@@ -36,6 +37,23 @@ fn another_part_is_named_by_its_id() {
     let err = init_with_who_am_i(0x12);
     assert_eq!(err, Error::WrongId(0x12));
     assert_eq!(err.sensor_error(), SensorError::NoResponse);
+}
+
+#[test]
+fn a_sensor_gone_after_init_is_no_response_not_a_sample() {
+    for word in [-1i16, 0] {
+        let mut spi = Mock::new(&data_read([word; 6]));
+        let mut imu = Icm42688::new(spi.clone(), Config::default());
+        let err = block_on(imu.read()).expect_err("floating bus");
+        spi.done();
+        assert_eq!(err, Error::NoResponse);
+        assert_eq!(err.sensor_error(), SensorError::NoResponse);
+    }
+    // One live word among the floating ones is a sample.
+    let mut spi = Mock::new(&data_read([-1, -1, 2048, -1, -1, -1]));
+    let mut imu = Icm42688::new(spi.clone(), Config::default());
+    assert!(block_on(imu.read()).is_ok());
+    spi.done();
 }
 
 #[test]

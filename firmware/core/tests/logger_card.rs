@@ -206,6 +206,13 @@ fn flushes_keep_the_file_size_within_one_flush_period() {
             "{on_card} of {end} frames on card"
         );
         assert_eq!(on_card, u64::from(log.stats().frames_on_card));
+        // ...and no more often than that: each flush costs block writes.
+        let periods = end / period_frames;
+        let flushes = u64::from(log.stats().flushes);
+        assert!(
+            (periods..=periods + 1).contains(&flushes),
+            "{flushes} flushes in {periods} flush periods"
+        );
     }
 }
 
@@ -228,6 +235,31 @@ fn card_absent_at_boot_is_reported_with_the_exact_loss() {
     assert_eq!(d.dropouts[0].frames_lost, 400);
     assert_eq!(d.frames.len(), 200);
     assert_eq!(d.frames[0], 400 * FRAME_PERIOD_US);
+}
+
+#[test]
+fn queue_dropouts_while_the_card_is_absent_join_the_count() {
+    // The queue dropped 37 frames while the writer was busy with a card
+    // that then went away: its dropout record must not vanish with them.
+    let card = MockCard::new(fat32_image());
+    card.set_removed(true);
+    let mut log = logger(card);
+    run(&mut log, 0, 100);
+    let dropout = Record::Dropout(Dropout {
+        t_us: 100 * FRAME_PERIOD_US,
+        frames_lost: 37,
+        reason: DropoutReason::QueueFull,
+    });
+    log.push(&dropout, 137 * FRAME_PERIOD_US);
+    run(&mut log, 137, 150);
+    assert_eq!(log.stats().frames_lost, 100 + 37 + 13);
+    log.with_device(|c| c.set_removed(false));
+    run(&mut log, 150, 300);
+    log.close(300 * FRAME_PERIOD_US).expect("close");
+    let image = log.with_device(|c| c.image());
+    let d = decode(&read_file(&image, "RUN00001.WBL").expect("file"));
+    let lost: u32 = d.dropouts.iter().map(|x| x.frames_lost).sum();
+    assert_eq!(d.frames.len() as u32 + lost, 300, "{:?}", d.dropouts);
 }
 
 #[test]
@@ -294,6 +326,30 @@ fn full_card_keeps_logging_and_counts_the_loss() {
         1,
         "{names:?}"
     );
+}
+
+/// A card whose run numbers are used up (`RUN99999.WBL` is there) is a full
+/// card, not a missing one: each attempt to open it counts as the full-card
+/// fault, and every frame meanwhile as lost.
+#[test]
+fn a_card_out_of_run_numbers_counts_as_full() {
+    let mut image = fat32_image();
+    with_fs(&mut image, |fs| {
+        fs.root_dir().create_file("RUN99999.WBL").expect("create");
+    });
+    let mut log = logger(MockCard::new(image));
+    // Three attempts, one per retry period.
+    run(&mut log, 0, 250);
+    assert_eq!(log.state(), LoggerState::NoCard);
+    let stats = log.stats();
+    assert_eq!(
+        (
+            stats.faults[usize::from(FAULT_CARD_FULL) - 1],
+            stats.faults[usize::from(FAULT_CARD_ABSENT) - 1]
+        ),
+        (3, 0)
+    );
+    assert_eq!(stats.frames_lost, 250);
 }
 
 proptest! {

@@ -246,7 +246,7 @@ fn sampler_parts(
     let driver_config = icm42688::Config::default();
     // `Config::parse` only lets through what the core's modules accept.
     let channel = defmt::unwrap!(Imu::try_new(driver_config.imu_config(config.imu)).ok());
-    let imu = ImuAdapter::new(Icm42688::new(device, driver_config), channel);
+    let imu = ImuAdapter::new(Icm42688::new(device, driver_config), channel, Delay);
 
     let steering = SteeringAdapter::new(
         steering_adc(steering.adc, steering.wiper, steering.dma),
@@ -296,6 +296,7 @@ fn steering_adc(
 
 #[embassy_executor::task]
 async fn sampler_task(mut sampler: Sampler, mut ports: Ports) {
+    ports.imu.start().await;
     sampler::run(
         &mut sampler,
         &mut ports,

@@ -1,5 +1,6 @@
 //! The SD card: a FAT32 image file on the host, reached through ARM
-//! semihosting, with the scenario's faults injected on the way.
+//! semihosting, taking the virtual time a card on the board's bus takes
+//! (`sd_timing.rs`), with the scenario's faults injected on the way.
 
 use core::cell::{Cell, RefCell};
 
@@ -10,6 +11,7 @@ use semihosting::io::{Read, Seek, SeekFrom, Write};
 
 use crate::report;
 use crate::scenario::{within, Scenario};
+use crate::sd_timing::{busy_until, CutPoint, SdTiming};
 
 /// Why the emulated card refused an operation.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -37,6 +39,7 @@ pub struct SemihostingCard {
     blocks: u32,
     scenario: &'static Scenario,
     writes: Cell<u32>,
+    timing: SdTiming,
 }
 
 impl SemihostingCard {
@@ -58,6 +61,7 @@ impl SemihostingCard {
             blocks,
             scenario,
             writes: Cell::new(0),
+            timing: SdTiming::new(scenario.card_seed),
         }
     }
 
@@ -75,20 +79,36 @@ impl SemihostingCard {
         Ok(())
     }
 
-    /// The scenario's injections for one block write: a power cut ends the
-    /// run here; a stall busy-waits in thread mode, as a card holding the
-    /// bus would, while the sampler keeps preempting.
-    fn before_write(&self) {
+    /// Writes one block as a card does: the transfer, then the busy time
+    /// (the model's, plus a scenario stall: thread mode waits, as the
+    /// board's writer holding the bus does, while the sampler and the GPS
+    /// task keep preempting). A power cut before the block ends the run
+    /// here; one inside it leaves the block torn.
+    fn write_one(&self, file: &mut File, block: &Block) -> Result<(), CardError> {
         let n = self.writes.get() + 1;
         self.writes.set(n);
         if self.scenario.cut_at_write == Some(n) {
-            report::power_cut(n);
+            report::power_cut(n, 0);
         }
+        let (transfer, mut busy) = self.timing.write();
         if let Some(&(_, ms)) = self.scenario.stalls.iter().find(|(w, _)| *w == n) {
-            let until = Instant::now() + Duration::from_millis(u64::from(ms));
             report::stall(n, ms);
-            while Instant::now() < until {}
+            busy += Duration::from_millis(u64::from(ms));
         }
+        let start = Instant::now();
+        if let Some((_, permille)) = self.scenario.cut_in_write.filter(|(w, _)| *w == n) {
+            let cut = CutPoint::new(transfer, busy, permille);
+            busy_until(start + cut.after);
+            // The cells programmed before the cut hold the new bytes, the
+            // rest the old ones: the block reads back torn.
+            let torn = cut.programmed_bytes(Block::LEN);
+            if torn > 0 {
+                let _ = file.write_all(&block.contents[..torn]);
+            }
+            report::power_cut(n, torn)
+        }
+        busy_until(start + transfer + busy);
+        file.write_all(&block.contents).map_err(|_| CardError::Io)
     }
 }
 
@@ -101,6 +121,7 @@ impl BlockDevice for SemihostingCard {
         let file = file.as_mut().ok_or(CardError::Absent)?;
         Self::seek(file, start)?;
         for block in blocks {
+            busy_until(Instant::now() + self.timing.read());
             file.read_exact(&mut block.contents)
                 .map_err(|_| CardError::Io)?;
         }
@@ -113,8 +134,7 @@ impl BlockDevice for SemihostingCard {
         let file = file.as_mut().ok_or(CardError::Absent)?;
         Self::seek(file, start)?;
         for block in blocks {
-            self.before_write();
-            file.write_all(&block.contents).map_err(|_| CardError::Io)?;
+            self.write_one(file, block)?;
         }
         Ok(())
     }

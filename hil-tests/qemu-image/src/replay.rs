@@ -1,14 +1,17 @@
 //! Sensors replayed from the harness's fixture files in QEMU's working
 //! directory, through semihosting:
 //!
-//! - `ride.bin`, one row per 10 ms frame: `steer_cdeg` i16, `accel` i16 ×3
-//!   (1/2048 g), `gyro` i16 ×3 (1/32 deg/s), `edges` u8, then `edges` × u16:
-//!   each wheel edge's age in µs before the frame's time; little-endian;
+//! - `ride.bin`, one row per 10 ms frame, as the sensors produce it: the
+//!   IMU's 12 data registers (accel x/y/z then gyro x/y/z in the sensor's
+//!   axes, big-endian words, as `ACCEL_DATA_X1` onwards reads), `adc` u8,
+//!   then `adc` × u16: the steering ADC's conversions in the frame (counts),
+//!   `edges` u8, then `edges` × u16: each wheel edge's age in µs before the
+//!   frame's time; little-endian unless said;
 //! - `gps.bin`, the NMEA capture's bytes as they arrived: records of
 //!   `t_ms` u32 (since boot), `len` u16, `len` bytes.
 //!
 //! The wheel port is drained first in every tick, so it advances the row
-//! the IMU and steering ports then read.
+//! the IMU (`imu_bus.rs`) and steering ports then read.
 
 use core::cell::RefCell;
 
@@ -16,9 +19,9 @@ use embassy_time::{Instant, Timer};
 use semihosting::fs::File;
 use semihosting::io::Read;
 use wobble_core::app::ports::{
-    GpsPort, ImuPort, ImuSample, MarkerInput, SensorError, SteeringPort, SteeringSample, WheelPort,
+    GpsPort, MarkerInput, SensorError, SteeringPort, SteeringSample, WheelPort,
 };
-use wobble_core::format::{ACCEL_COUNTS_PER_G, GYRO_COUNTS_PER_DPS, STEER_COUNTS_PER_DEG};
+use wobble_core::steering::Steering;
 
 use crate::scenario::{within, Scenario};
 
@@ -57,10 +60,6 @@ impl Buffered {
         Some(u16::from_le_bytes([self.byte()?, self.byte()?]))
     }
 
-    fn i16(&mut self) -> Option<i16> {
-        self.u16().map(|v| v as i16)
-    }
-
     fn u32(&mut self) -> Option<u32> {
         Some(u32::from(self.u16()?) | u32::from(self.u16()?) << 16)
     }
@@ -68,38 +67,36 @@ impl Buffered {
 
 /// Most wheel edges in one 10 ms row (240 pulses/s at 10 m/s is 2.4).
 const MAX_EDGES: usize = 16;
+/// Most ADC conversions in one row.
+pub const MAX_ADC: usize = 32;
+/// Bytes of the IMU's data registers (ACCEL_DATA_X1 .. GYRO_DATA_Z0).
+pub const IMU_DATA_LEN: usize = 12;
 
-/// One row as the sensor channels would deliver it. The fixture's counts
-/// are the card's units, which are powers of two (IMU) or 100 (steering):
-/// frame assembly quantises these values back to exactly the same counts.
+/// One row as the sensors produce it.
 struct Row {
-    steering: SteeringSample,
-    imu: ImuSample,
+    imu_regs: [u8; IMU_DATA_LEN],
+    adc: heapless::Vec<u16, MAX_ADC>,
     edges_age_us: heapless::Vec<u16, MAX_EDGES>,
 }
 
 fn read_row(f: &mut Buffered) -> Option<Row> {
-    let steering = SteeringSample {
-        deg: f32::from(f.i16()?) / STEER_COUNTS_PER_DEG,
-        saturated: false,
-    };
-    let mut imu = ImuSample::default();
-    for g in &mut imu.accel_g {
-        *g = f32::from(f.i16()?) / ACCEL_COUNTS_PER_G;
+    let mut imu_regs = [0; IMU_DATA_LEN];
+    for b in &mut imu_regs {
+        *b = f.byte()?;
     }
-    for dps in &mut imu.gyro_dps {
-        *dps = f32::from(f.i16()?) / GYRO_COUNTS_PER_DPS;
+    let mut adc = heapless::Vec::new();
+    for _ in 0..f.byte()? {
+        // More conversions than the buffer holds: keep the first ones.
+        let _ = adc.push(f.u16()?);
     }
-    let n = f.byte()?;
     let mut edges_age_us = heapless::Vec::new();
-    for _ in 0..n {
-        let age = f.u16()?;
+    for _ in 0..f.byte()? {
         // More edges than a wheel can make in 10 ms: keep the first ones.
-        let _ = edges_age_us.push(age);
+        let _ = edges_age_us.push(f.u16()?);
     }
     Some(Row {
-        steering,
-        imu,
+        imu_regs,
+        adc,
         edges_age_us,
     })
 }
@@ -108,27 +105,31 @@ fn read_row(f: &mut Buffered) -> Option<Row> {
 pub struct Ride {
     file: Buffered,
     row: Option<Row>,
-    scenario: &'static Scenario,
 }
 
 impl Ride {
-    pub fn open(scenario: &'static Scenario) -> Self {
+    pub fn open() -> Self {
         Self {
             file: Buffered::open(c"ride.bin"),
             row: None,
-            scenario,
         }
     }
-}
 
-impl Ride {
-    /// The next frame's steering angle, degrees; `None` at the end.
-    pub fn next_steer_deg(&mut self) -> Option<f32> {
-        read_row(&mut self.file).map(|row| row.steering.deg)
+    /// The next row's steering angle through `channel`, degrees; `None` at
+    /// the end.
+    pub fn next_steer_deg(&mut self, channel: &mut Steering) -> Option<f32> {
+        let row = read_row(&mut self.file)?;
+        channel.push_all(&row.adc);
+        channel.take().map(|s| s.deg)
+    }
+
+    /// The current row's IMU data registers.
+    pub fn imu_regs(&self) -> Option<[u8; IMU_DATA_LEN]> {
+        self.row.as_ref().map(|r| r.imu_regs)
     }
 }
 
-/// One sensor's view of the shared ride.
+/// The wheel sensor and the marker button over the shared ride.
 #[derive(Clone, Copy)]
 pub struct Port(pub &'static RefCell<Ride>);
 
@@ -148,33 +149,49 @@ impl WheelPort for Port {
     }
 }
 
-impl ImuPort for Port {
-    async fn read(&mut self) -> Result<ImuSample, SensorError> {
-        let ride = self.0.borrow();
-        if ride
-            .scenario
-            .imu_dead_from_ms
-            .is_some_and(|t| Instant::now().as_millis() >= u64::from(t))
-        {
-            return Err(SensorError::NoResponse);
-        }
-        ride.row.as_ref().map(|r| r.imu).ok_or(SensorError::Stale)
-    }
-}
-
-impl SteeringPort for Port {
-    async fn read(&mut self) -> Result<SteeringSample, SensorError> {
-        let ride = self.0.borrow();
-        ride.row
-            .as_ref()
-            .map(|r| r.steering)
-            .ok_or(SensorError::Stale)
-    }
-}
-
 impl MarkerInput for Port {
     fn is_pressed(&mut self) -> bool {
         false
+    }
+}
+
+/// The steering potentiometer's ADC: the row's conversions into the core's
+/// steering channel (averaging, calibration, saturation), as the board's
+/// DMA ring hands them over. An open wiper (the scenario's window) reads
+/// full scale, as the board's pull-up makes it.
+pub struct ReplayedAdc {
+    ride: &'static RefCell<Ride>,
+    channel: Steering,
+    scenario: &'static Scenario,
+}
+
+impl ReplayedAdc {
+    pub fn new(
+        ride: &'static RefCell<Ride>,
+        channel: Steering,
+        scenario: &'static Scenario,
+    ) -> Self {
+        Self {
+            ride,
+            channel,
+            scenario,
+        }
+    }
+}
+
+impl SteeringPort for ReplayedAdc {
+    async fn read(&mut self) -> Result<SteeringSample, SensorError> {
+        let ride = self.ride.borrow();
+        let row = ride.row.as_ref().ok_or(SensorError::Stale)?;
+        if within(self.scenario.steer_open_ms, Instant::now().as_millis()) {
+            let full = self.channel.calibration().adc_max;
+            for _ in &row.adc {
+                self.channel.push(full);
+            }
+        } else {
+            self.channel.push_all(&row.adc);
+        }
+        self.channel.take().ok_or(SensorError::Stale)
     }
 }
 

@@ -8,7 +8,7 @@ use wobble_core::detector::AlertEvent;
 
 /// Writes one line.
 pub fn line(args: core::fmt::Arguments<'_>) {
-    let mut text = heapless::String::<192>::new();
+    let mut text = heapless::String::<256>::new();
     let _ = text.write_fmt(args);
     let _ = text.push('\n');
     semihosting::print!("{text}");
@@ -32,10 +32,12 @@ pub fn stall(write: u32, ms: u32) {
     ));
 }
 
-/// The power goes: nothing more is written; QEMU exits with code 3.
-pub fn power_cut(write: u32) -> ! {
+/// The power goes during block write `write` (`torn` of its bytes
+/// programmed; 0 also for a cut before it): nothing more is written; QEMU
+/// exits with code 3.
+pub fn power_cut(write: u32, torn: usize) -> ! {
     line(format_args!(
-        "CUT write={write} frames={} t_us={}",
+        "CUT write={write} torn={torn} frames={} t_us={}",
         crate::FRAMES_SAMPLED.load(core::sync::atomic::Ordering::Relaxed),
         embassy_time::Instant::now().as_micros()
     ));

@@ -15,6 +15,7 @@
 pub mod catalog;
 pub mod rng;
 pub mod signal;
+pub mod simulated;
 pub mod truth;
 
 pub use truth::{Episode, Event, FixtureTruth, Manifest};

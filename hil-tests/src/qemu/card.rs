@@ -138,6 +138,26 @@ fn partition_start(bytes: &[u8]) -> Option<usize> {
     Some(lba as usize * 512)
 }
 
+/// Puts a file `name` holding `data` in the card's root directory (a
+/// `CONFIG.TXT`, as a person would copy it on).
+///
+/// # Errors
+/// The image is not a FAT volume or the file cannot be written.
+pub fn put_file(image: &Path, name: &str, data: &[u8]) -> Result<(), String> {
+    use std::io::Write;
+    let mut bytes = read_image(image)?;
+    with_volume(&mut bytes, |fs| {
+        let mut file = fs
+            .root_dir()
+            .create_file(name)
+            .map_err(|e| format!("{name}: {e}"))?;
+        file.write_all(data)
+            .and_then(|()| file.flush())
+            .map_err(|e| format!("{name}: {e}"))
+    })?;
+    std::fs::write(image, bytes).map_err(|e| format!("{}: {e}", image.display()))
+}
+
 /// Fills the card so that only about `free_bytes` stay free (the card-full
 /// scenario).
 ///

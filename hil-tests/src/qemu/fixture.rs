@@ -1,13 +1,18 @@
-//! The files a QEMU run replays: `ride.bin` (steering, IMU and wheel edges
-//! per 10 ms frame) from a corpus ride, and `gps.bin` (NMEA bytes with their
-//! arrival times) from a real receiver capture. Layouts are documented in
-//! `qemu-image/src/replay.rs`.
+//! The files a QEMU run replays: `ride.bin` (per 10 ms frame the IMU's
+//! data registers, the steering ADC's conversions and the wheel edges, as
+//! the sensors produce them) from a corpus ride, and `gps.bin` (NMEA bytes
+//! with their arrival times) from a real receiver capture. Layouts are
+//! documented in `qemu-image/src/replay.rs`.
 
 use std::path::{Path, PathBuf};
 
-use wobble_core::format::{ACCEL_COUNTS_PER_G, GYRO_COUNTS_PER_DPS};
+use wobble_core::config::Config;
+use wobble_core::drivers::icm42688;
+use wobble_core::imu::AxisMap;
+use wobble_core::steering::SteeringCalibration;
 use wobble_core::wheel::WheelConfig;
 
+use crate::corpus::rng::Rng;
 use crate::corpus::{self, FixtureTruth, Row};
 
 /// Frame period, µs.
@@ -55,22 +60,118 @@ pub fn corpus_ride(name: &str) -> Result<CorpusRide, String> {
     })
 }
 
+/// Steering ADC conversions per frame in `ride.bin` (the board makes about
+/// 427; eight already show the averaging resolving a fraction of a count).
+pub const ADC_PER_FRAME: usize = 8;
+/// The IMU's offsets in the bicycle frame (zero-g and zero-rate errors),
+/// different on every axis so that a wrong axis map shows.
+pub const ACCEL_BIAS_G: [f64; 3] = [0.02, -0.015, 0.01];
+/// See [`ACCEL_BIAS_G`].
+pub const GYRO_BIAS_DPS: [f64; 3] = [0.4, -0.25, 0.15];
+/// The IMU's noise, peak, LSB (uniform): real MEMS output changes on
+/// every sample, which the stuck check relies on.
+pub const IMU_NOISE_LSB: f64 = 2.0;
+const WHEELBASE_M: f64 = 1.1;
+
+/// What the IMU measures in the bicycle frame for `row` (g, deg/s):
+/// gravity on z, a lateral acceleration and a yaw rate that follow the
+/// steering (v²·δ/L and v·δ/L of a 1.1 m wheelbase), plus the offsets.
+#[must_use]
+pub fn imu_truth(row: &Row) -> ([f64; 3], [f64; 3]) {
+    let steer_rad = f64::from(row.steer_deg).to_radians();
+    let v = f64::from(row.speed_mps);
+    let lat_g = v * v * steer_rad / WHEELBASE_M / 9.81;
+    let yaw_dps = (v * steer_rad / WHEELBASE_M).to_degrees();
+    let accel = [0.0, lat_g, 1.0];
+    let gyro = [0.0, 0.0, yaw_dps];
+    (
+        std::array::from_fn(|i| accel[i] + ACCEL_BIAS_G[i]),
+        std::array::from_fn(|i| gyro[i] + GYRO_BIAS_DPS[i]),
+    )
+}
+
+/// A bicycle-frame vector in the sensor's axes: the inverse of `map`
+/// (a signed permutation, whose inverse is its transpose).
+fn to_sensor(map: &AxisMap, bicycle: [f64; 3]) -> [f64; 3] {
+    std::array::from_fn(|j| {
+        let mut unit = [0.0f32; 3];
+        unit[j] = 1.0;
+        let column = map.apply(unit);
+        (0..3).map(|i| f64::from(column[i]) * bicycle[i]).sum()
+    })
+}
+
+/// The ADC reading (fractional counts) for `deg` under `cal`: the inverse
+/// of its two- or three-point line.
+#[must_use]
+pub fn counts_for(cal: &SteeringCalibration, deg: f64) -> f64 {
+    match cal.three_point {
+        None => f64::from(cal.center_counts) + deg / f64::from(cal.deg_per_count),
+        Some(points) => {
+            let [a, b, c] = points.map(|p| (f64::from(p.counts), f64::from(p.deg)));
+            // The segment on `deg`'s side of the middle point, extended
+            // beyond the ends as the calibration extrapolates.
+            let (p, q) = if (deg - b.1) * (a.1 - b.1) > 0.0 {
+                (a, b)
+            } else {
+                (b, c)
+            };
+            p.0 + (deg - p.1) * (q.0 - p.0) / (q.1 - p.1)
+        }
+    }
+}
+
+/// The twelve data registers for one sample (big-endian words, accel then
+/// gyro, sensor axes), from the bicycle-frame truth.
+fn imu_registers(config: &Config, row: &Row, rng: &mut Rng) -> Vec<u8> {
+    let scale = icm42688::Config::default().imu_config(config.imu);
+    let (accel_g, gyro_dps) = imu_truth(row);
+    let accel =
+        to_sensor(&config.imu.axis_map, accel_g).map(|g| g / f64::from(scale.accel_g_per_lsb));
+    let gyro =
+        to_sensor(&config.imu.axis_map, gyro_dps).map(|d| d / f64::from(scale.gyro_dps_per_lsb));
+    accel
+        .iter()
+        .chain(&gyro)
+        .flat_map(|&lsb| {
+            let noisy = (lsb + rng.range(-IMU_NOISE_LSB, IMU_NOISE_LSB)).round();
+            (noisy.clamp(-32767.0, 32767.0) as i16).to_be_bytes()
+        })
+        .collect()
+}
+
+/// The frame's ADC conversions for `deg`: the reading dithered evenly
+/// across one count, so their mean is within 1/(2·[`ADC_PER_FRAME`]) count
+/// of the exact reading.
+fn adc_conversions(cal: &SteeringCalibration, deg: f64) -> Vec<u16> {
+    let exact = counts_for(cal, deg);
+    (0..ADC_PER_FRAME)
+        .map(|k| {
+            let dither = (k as f64 + 0.5) / ADC_PER_FRAME as f64 - 0.5;
+            (exact + dither).round().clamp(0.0, f64::from(cal.adc_max)) as u16
+        })
+        .collect()
+}
+
 /// Writes `ride.bin` for the first `frames` rows of `rows` (the last row
-/// repeats if the ride is shorter).
-///
-/// The IMU is synthesised: gravity on z, a lateral acceleration and a yaw
-/// rate that follow the steering (v²·δ/L and v·δ/L of a 1.1 m wheelbase),
-/// so the frames carry plausible values that the test can recognise.
-/// Wheel edges come from integrating the speed over the firmware's wheel
-/// (its default circumference and hole count).
+/// repeats if the ride is shorter), as a sensor mounted and calibrated as
+/// `config` says produces it: IMU registers from [`imu_truth`] through the
+/// inverse axis map with noise, ADC counts through the inverse steering
+/// calibration. Wheel edges come from integrating the speed over the
+/// firmware's wheel (its circumference and hole count).
 ///
 /// # Errors
 /// The file could not be written.
-pub fn write_ride(path: &Path, rows: &[Row], frames: usize) -> std::io::Result<()> {
-    const WHEELBASE_M: f64 = 1.1;
+pub fn write_ride(
+    path: &Path,
+    rows: &[Row],
+    frames: usize,
+    config: &Config,
+) -> std::io::Result<()> {
     let wheel = WheelConfig::DEFAULT;
     let pitch_m = f64::from(wheel.circumference_m) / f64::from(wheel.holes);
-    let mut out = Vec::with_capacity(frames * 20);
+    let mut out = Vec::with_capacity(frames * 32);
+    let mut rng = Rng::new(0x1A0);
     let mut distance_m = 0.0f64;
     let mut next_edge_m = pitch_m;
     let last = rows.last().copied().unwrap_or(Row {
@@ -80,19 +181,14 @@ pub fn write_ride(path: &Path, rows: &[Row], frames: usize) -> std::io::Result<(
     });
     for k in 0..frames {
         let row = rows.get(k).copied().unwrap_or(last);
-        let steer_rad = f64::from(row.steer_deg).to_radians();
-        let v = f64::from(row.speed_mps);
-        let lat_g = v * v * steer_rad / WHEELBASE_M / 9.81;
-        let yaw_dps = (v * steer_rad / WHEELBASE_M).to_degrees();
-        let steer_cdeg = (f64::from(row.steer_deg) * 100.0).round() as i16;
-        let accel = [0.0, lat_g, 1.0].map(|g| (g * f64::from(ACCEL_COUNTS_PER_G)).round() as i16);
-        let gyro = [0.0, 0.0, yaw_dps].map(|d| (d * f64::from(GYRO_COUNTS_PER_DPS)).round() as i16);
-        out.extend_from_slice(&steer_cdeg.to_le_bytes());
-        for v in accel.iter().chain(&gyro) {
-            out.extend_from_slice(&v.to_le_bytes());
+        out.extend(imu_registers(config, &row, &mut rng));
+        let adc = adc_conversions(&config.steering, f64::from(row.steer_deg));
+        out.push(adc.len() as u8);
+        for c in adc {
+            out.extend_from_slice(&c.to_le_bytes());
         }
         // Edges within this frame's 10 ms, as ages before the frame's end.
-        let step_m = v * FRAME_US as f64 / 1e6;
+        let step_m = f64::from(row.speed_mps) * FRAME_US as f64 / 1e6;
         let mut ages = Vec::new();
         while next_edge_m <= distance_m + step_m && step_m > 0.0 {
             let frac = (next_edge_m - distance_m) / step_m;

@@ -98,6 +98,7 @@ impl Bundle {
             scenario,
             rows: &self.ride.rows,
             gps: &self.gps,
+            config: None,
         }
     }
 }

@@ -7,6 +7,8 @@ use std::process::{Command, Stdio};
 use std::sync::OnceLock;
 use std::time::{Duration, Instant};
 
+use wobble_core::config::Config;
+
 use super::card;
 use super::fixture::{self, GpsChunk};
 use crate::corpus::Row;
@@ -61,10 +63,19 @@ pub struct Scenario {
     pub stalls: Vec<(u32, u32)>,
     /// Power cut before this block write.
     pub cut_at_write: Option<u32>,
+    /// Power cut inside a block write: (write number, thousandths of its
+    /// transfer and busy time).
+    pub cut_in_write: Option<(u32, u32)>,
+    /// Seed of the card's timing (the image's default when `None`).
+    pub card_seed: Option<u32>,
     /// Card absent from/to, ms.
     pub card_absent_ms: Option<(u32, u32)>,
     /// IMU dead from, ms.
     pub imu_dead_from_ms: Option<u32>,
+    /// IMU data registers frozen from/to, ms.
+    pub imu_stuck_ms: Option<(u32, u32)>,
+    /// Steering potentiometer's wiper open from/to, ms.
+    pub steer_open_ms: Option<(u32, u32)>,
     /// GPS noise from/to, ms.
     pub gps_garbage_ms: Option<(u32, u32)>,
     /// Instead of riding, time the wobble detector over the ride's steering
@@ -90,17 +101,29 @@ impl Scenario {
         if let Some(w) = self.cut_at_write {
             s += &format!("cut={w}\n");
         }
+        if let Some((w, permille)) = self.cut_in_write {
+            s += &format!("cut_in_write={w}:{permille}\n");
+        }
+        if let Some(seed) = self.card_seed {
+            s += &format!("card_seed={seed}\n");
+        }
         if let Some((a, b)) = self.card_absent_ms {
             s += &format!("card_absent_ms={a}:{b}\n");
         }
         if let Some(t) = self.imu_dead_from_ms {
             s += &format!("imu_dead_ms={t}\n");
         }
+        for (key, window) in [
+            ("imu_stuck_ms", self.imu_stuck_ms),
+            ("steer_open_ms", self.steer_open_ms),
+            ("gps_garbage_ms", self.gps_garbage_ms),
+        ] {
+            if let Some((a, b)) = window {
+                s += &format!("{key}={a}:{b}\n");
+            }
+        }
         if self.bench_detector {
             s += "bench=detector\n";
-        }
-        if let Some((a, b)) = self.gps_garbage_ms {
-            s += &format!("gps_garbage_ms={a}:{b}\n");
         }
         s
     }
@@ -116,6 +139,25 @@ pub struct Setup<'a> {
     pub rows: &'a [Row],
     /// GPS bytes to replay.
     pub gps: &'a [GpsChunk],
+    /// `CONFIG.TXT` to put on the card (none: the defaults), which the
+    /// image reads as the board does; the sensors are mounted and
+    /// calibrated as it says.
+    pub config: Option<&'a str>,
+}
+
+impl Setup<'_> {
+    /// The configuration the image will run with.
+    ///
+    /// # Errors
+    /// The text has faults: a test's configuration must be taken whole.
+    pub fn config(&self) -> Result<Config, String> {
+        let loaded = Config::parse(self.config.unwrap_or_default().as_bytes());
+        if loaded.faults.is_empty() {
+            Ok(loaded.config)
+        } else {
+            Err(format!("CONFIG.TXT has faults: {:?}", loaded.faults))
+        }
+    }
 }
 
 /// How a run went.
@@ -211,12 +253,16 @@ pub fn run(
     let io = |e: std::io::Error| format!("{}: {e}", dir.display());
     let card = dir.join("card.img");
     card::mkfs(&card)?;
+    if let Some(text) = setup.config {
+        card::put_file(&card, wobble_core::config::FILE_NAME, text.as_bytes())?;
+    }
     prepare_card(&card)?;
     std::fs::write(dir.join("scenario.txt"), setup.scenario.text()).map_err(io)?;
     fixture::write_ride(
         &dir.join("ride.bin"),
         setup.rows,
         setup.scenario.frames as usize,
+        &setup.config()?,
     )
     .map_err(io)?;
     fixture::write_gps(&dir.join("gps.bin"), setup.gps).map_err(io)?;

@@ -4,7 +4,7 @@
 
 use serde::Serialize;
 
-use super::run::Run;
+use crate::losses::Losses;
 
 /// Why the data stop (or start) at a point.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
@@ -21,6 +21,10 @@ pub enum Cut {
     Dropout,
     /// The frame times jump (backwards, or forwards beyond missing frames).
     TimeJump,
+    /// The steering stays above the quiet level for longer than the
+    /// analysis holds at once ([`super::search::MAX_WINDOW_FRAMES`] frames):
+    /// the stretch is measured in pieces, each cut here.
+    Overlong,
 }
 
 impl Cut {
@@ -33,6 +37,7 @@ impl Cut {
             Self::LostBlocks => "lost_blocks",
             Self::Dropout => "dropout",
             Self::TimeJump => "time_jump",
+            Self::Overlong => "overlong",
         }
     }
 }
@@ -41,12 +46,38 @@ impl Cut {
 /// microseconds on both sides).
 const SAME_TIME_S: f64 = 1e-6;
 
-/// What lies between frames `i` and `i + 1` of `run`, which are not one
+/// Where a stretch of frames starts or stops, as seen while the frames
+/// stream by; which [`Cut`] it is follows from the losses of the whole log.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Edge {
+    /// The first frame of the log.
+    DataStart,
+    /// The last frame of the log.
+    DataEnd,
+    /// Between frames at these two times, s, which are not one frame period
+    /// apart.
+    Between(f64, f64),
+    /// Where the analysis window was full (see [`Cut::Overlong`]).
+    Overlong,
+}
+
+impl Edge {
+    /// What the edge is, given the log's `losses`.
+    #[must_use]
+    pub fn cut(self, losses: &Losses) -> Cut {
+        match self {
+            Self::DataStart => Cut::DataStart,
+            Self::DataEnd => Cut::DataEnd,
+            Self::Overlong => Cut::Overlong,
+            Self::Between(before, after) => cut_between(losses, before, after),
+        }
+    }
+}
+
+/// What lies between frames at `before` and `after`, s, which are not one
 /// frame period apart.
 #[must_use]
-pub fn cut_after(run: &Run, i: usize) -> Cut {
-    let (before, after) = (run.t_s[i], run.t_s[i + 1]);
-    let losses = &run.summary.losses;
+pub fn cut_between(losses: &Losses, before: f64, after: f64) -> Cut {
     let same = |a: f64, b: f64| (a - b).abs() <= SAME_TIME_S;
     if losses
         .time_jumps
@@ -63,20 +94,4 @@ pub fn cut_after(run: &Run, i: usize) -> Cut {
     } else {
         Cut::Dropout
     }
-}
-
-/// What cuts the stretch `span` of `run` at its start and at its end.
-#[must_use]
-pub fn span_cuts(run: &Run, span: &std::ops::Range<usize>) -> (Cut, Cut) {
-    let start = if span.start == 0 {
-        Cut::DataStart
-    } else {
-        cut_after(run, span.start - 1)
-    };
-    let end = if span.end >= run.len() {
-        Cut::DataEnd
-    } else {
-        cut_after(run, span.end - 1)
-    };
-    (start, end)
 }

@@ -35,10 +35,12 @@ use std::ops::Range;
 
 use serde::Serialize;
 
-use super::censor::{span_cuts, Cut};
-use super::filter::{contiguous_spans, wobble_band, Biquad, Pass};
+use super::censor::{Cut, Edge};
+use super::filter::{wobble_band, Biquad, Pass};
 use super::run::Run;
+use super::search::EpisodeSearch;
 use super::sinefit::{fit_mode, SineFit};
+use crate::losses::Losses;
 
 /// Envelope at which an unstable wobble is said to start, degrees: below
 /// every sensor's noise, so onsets compare across runs and bicycles.
@@ -77,7 +79,7 @@ const TONE_SEARCH_HZ: f64 = 1.5;
 /// Speed at onset is the mean over onset ± this, s.
 const SPEED_HALF_WIDTH_S: f64 = 0.25;
 /// Spans shorter than this (between gaps in the data) are not analysed, s.
-const MIN_SPAN_S: f64 = 2.0;
+pub(super) const MIN_SPAN_S: f64 = 2.0;
 
 /// Whether the wobble mode grew or decayed.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
@@ -153,42 +155,77 @@ pub fn wobble_speed_mps(episodes: &[Episode]) -> Option<f64> {
 /// Every episode of `run`, in time order.
 #[must_use]
 pub fn find_episodes(run: &Run) -> Vec<Episode> {
-    let fs_hz = run.sample_rate_hz();
-    contiguous_spans(&run.t_s, 1.0 / fs_hz)
-        .into_iter()
-        .filter(|span| span.len() as f64 >= MIN_SPAN_S * fs_hz)
-        .flat_map(|span| {
-            let cuts = span_cuts(run, &span);
-            Span::new(run, span, cuts).episodes()
-        })
-        .collect()
+    let mut search = EpisodeSearch::new(run.sample_rate_hz());
+    for i in 0..run.len() {
+        search.push(run.t_s[i], run.steer_deg[i], run.speed_mps[i]);
+    }
+    search.finish(&run.summary.losses)
+}
+
+/// An episode as found while the frames stream by: what cuts it is known
+/// once the whole log has been read.
+pub(super) struct Found {
+    pub episode: Episode,
+    pub start: Option<Edge>,
+    pub end: Option<Edge>,
+}
+
+impl Found {
+    /// The episode, its cuts named from the log's `losses`.
+    pub fn resolve(self, losses: &Losses) -> Episode {
+        let cut_at_start = self.start.map(|e| e.cut(losses));
+        let cut_at_end = self.end.map(|e| e.cut(losses));
+        Episode {
+            censored: cut_at_start.is_some() || cut_at_end.is_some(),
+            cut_at_start,
+            cut_at_end,
+            ..self.episode
+        }
+    }
+}
+
+/// Frames of one evenly sampled stretch (all of it or a window onto it).
+pub(super) struct Frames<'a> {
+    pub t_s: &'a [f64],
+    pub steer_deg: &'a [f64],
+    pub speed_mps: &'a [f64],
+}
+
+/// Where a window of frames lies in its stretch.
+#[derive(Clone, Copy)]
+pub(super) struct Place {
+    /// Time of the stretch's first frame, s.
+    pub first_s: f64,
+    /// What cuts the stretch at its start.
+    pub stretch_start: Edge,
+    /// What cuts the window at its first frame: the stretch's start, or
+    /// the analysis window's limit; `None` if frames before it were seen.
+    pub window_start: Option<Edge>,
 }
 
 /// One evenly sampled stretch of a run, band-passed.
-struct Span<'a> {
-    run: &'a Run,
+pub(super) struct Span<'a> {
+    frames: Frames<'a>,
     t_s: &'a [f64],
     band: Vec<f64>,
-    energy: Vec<f64>,
+    pub energy: Vec<f64>,
     fs_hz: f64,
-    /// What cuts the stretch at its start and end.
-    cuts: (Cut, Cut),
+    place: Place,
 }
 
 impl<'a> Span<'a> {
-    fn new(run: &'a Run, span: Range<usize>, cuts: (Cut, Cut)) -> Self {
-        let fs_hz = run.sample_rate_hz();
-        let band = wobble_band(&run.steer_deg[span.clone()], fs_hz);
+    pub fn new(frames: Frames<'a>, fs_hz: f64, place: Place) -> Self {
+        let band = wobble_band(frames.steer_deg, fs_hz);
         let mut energy: Vec<f64> = band.iter().map(|v| 2.0 * v * v).collect();
         Biquad::butterworth(Pass::Low, ENERGY_SMOOTHING_HZ, fs_hz).filtfilt(&mut energy);
         let energy = energy.into_iter().map(|e| e.max(0.0).sqrt()).collect();
         Self {
-            run,
-            t_s: &run.t_s[span],
+            t_s: frames.t_s,
+            frames,
             band,
             energy,
             fs_hz,
-            cuts,
+            place,
         }
     }
 
@@ -196,28 +233,42 @@ impl<'a> Span<'a> {
         (s * self.fs_hz).round() as usize
     }
 
-    fn episodes(&self) -> Vec<Episode> {
-        let mut out = Vec::new();
-        let mut i = 0;
-        while let Some(hit) = self.energy[i..].iter().position(|&e| e > DETECT_AMP_DEG) {
-            let hit = i + hit;
-            let quiet = |&e: &f64| e <= QUIET_AMP_DEG;
-            let start = self.energy[..hit]
-                .iter()
-                .rposition(quiet)
-                .map_or(0, |q| q + 1);
-            let end = self.energy[hit..]
-                .iter()
-                .position(quiet)
-                .map_or(self.energy.len(), |q| hit + q);
-            out.extend(self.measure(start..end));
-            i = end;
-        }
-        out
+    /// The first frame at or after `from` (and before `to`) whose
+    /// envelope makes an episode.
+    pub fn next_hit(&self, from: usize, to: usize) -> Option<usize> {
+        let to = to.min(self.energy.len());
+        let from = from.min(to);
+        self.energy[from..to]
+            .iter()
+            .position(|&e| e > DETECT_AMP_DEG)
+            .map(|i| from + i)
     }
 
-    /// Measures the episode whose energy envelope is above quiet over `region`.
-    fn measure(&self, region: Range<usize>) -> Option<Episode> {
+    /// The frames around `hit` where the envelope is above quiet: from the
+    /// first after the last quiet one before it, to the first quiet one
+    /// after it (or the end of the frames).
+    pub fn region(&self, hit: usize) -> Range<usize> {
+        let start = self.energy[..hit]
+            .iter()
+            .rposition(is_quiet)
+            .map_or(0, |q| q + 1);
+        let end = self.energy[hit..]
+            .iter()
+            .position(is_quiet)
+            .map_or(self.energy.len(), |q| hit + q);
+        start..end
+    }
+
+    /// The last frame at or before `i` whose envelope is quiet: no episode
+    /// found later can start before it.
+    pub fn last_quiet(&self, i: usize) -> Option<usize> {
+        let end = (i + 1).min(self.energy.len());
+        self.energy[..end].iter().rposition(is_quiet)
+    }
+
+    /// Measures the episode whose energy envelope is above quiet over
+    /// `region`; `end_cut` is what cuts the frames where it ends, if they do.
+    pub fn measure(&self, region: Range<usize>, end_cut: Option<Edge>) -> Option<Found> {
         let peak = region.start + argmax(&self.energy[region.clone()])?;
         let half_s = self.samples(0.5);
         let around = peak.saturating_sub(half_s).max(region.start)..(peak + half_s).min(region.end);
@@ -302,23 +353,31 @@ impl<'a> Span<'a> {
         };
         // An onset before the stretch began would be extrapolated across
         // the cut: the first frame after it is all the data say.
-        let cut_at_start = (starts_at_cut || onset_s < self.t_s[0]).then_some(self.cuts.0);
-        let onset_s = onset_s.max(self.t_s[0]);
-        let cut_at_end = (region.end >= self.t_s.len()).then_some(self.cuts.1);
+        let start = if starts_at_cut {
+            Some(self.place.window_start.unwrap_or(Edge::Overlong))
+        } else {
+            (onset_s < self.place.first_s).then_some(self.place.stretch_start)
+        };
+        let onset_s = onset_s.max(self.place.first_s);
         let end = region.end.min(self.t_s.len() - 1);
-        Some(Episode {
+        let episode = Episode {
             onset_s,
             end_s: self.t_s[end],
             peak_s: t[top],
             freq_hz,
             sigma_per_s: mode.sigma_per_s,
             peak_amp_deg,
-            speed_at_onset_mps: self.run.speed_around(onset_s, SPEED_HALF_WIDTH_S),
+            speed_at_onset_mps: speed_around(&self.frames, onset_s, SPEED_HALF_WIDTH_S),
             stability,
             fit_s: [t[range.start], t[range.end - 1]],
-            censored: cut_at_start.is_some() || cut_at_end.is_some(),
-            cut_at_start,
-            cut_at_end,
+            censored: false,
+            cut_at_start: None,
+            cut_at_end: None,
+        };
+        Some(Found {
+            episode,
+            start,
+            end: end_cut,
         })
     }
 
@@ -345,6 +404,22 @@ impl<'a> Span<'a> {
         )
         .map_or(0.0, |f| f.log_amp - mode.log_amp)
     }
+}
+
+fn is_quiet(e: &f64) -> bool {
+    *e <= QUIET_AMP_DEG
+}
+
+/// Mean wheel speed of `frames` over `t_s ± half_width_s`, m/s (the
+/// nearest frame's speed if none falls inside).
+fn speed_around(frames: &Frames<'_>, t_s: f64, half_width_s: f64) -> f64 {
+    let lo = frames.t_s.partition_point(|&t| t < t_s - half_width_s);
+    let hi = frames.t_s.partition_point(|&t| t <= t_s + half_width_s);
+    if hi > lo {
+        return frames.speed_mps[lo..hi].iter().sum::<f64>() / (hi - lo) as f64;
+    }
+    let i = lo.min(frames.t_s.len().saturating_sub(1));
+    frames.speed_mps.get(i).copied().unwrap_or(0.0)
 }
 
 /// Within `region`, the climb to the first time the envelope reaches

@@ -91,8 +91,7 @@ pub fn contiguous_spans(t_s: &[f64], period_s: f64) -> Vec<std::ops::Range<usize
     let mut spans = Vec::new();
     let mut start = 0;
     for i in 1..t_s.len() {
-        let dt = t_s[i] - t_s[i - 1];
-        if !(dt > 0.5 * period_s && dt < 1.5 * period_s) {
+        if !follows(t_s[i - 1], t_s[i], period_s) {
             spans.push(start..i);
             start = i;
         }
@@ -101,6 +100,15 @@ pub fn contiguous_spans(t_s: &[f64], period_s: f64) -> Vec<std::ops::Range<usize
         spans.push(start..t_s.len());
     }
     spans
+}
+
+/// Whether a frame at `t_s` is the one after a frame at `prev_s`, for
+/// frames `period_s` apart: later by more than half a period and less than
+/// one and a half.
+#[must_use]
+pub fn follows(prev_s: f64, t_s: f64, period_s: f64) -> bool {
+    let dt = t_s - prev_s;
+    dt > 0.5 * period_s && dt < 1.5 * period_s
 }
 
 #[cfg(test)]

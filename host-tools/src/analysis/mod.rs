@@ -4,11 +4,14 @@
 pub mod censor;
 pub mod episodes;
 pub mod filter;
+pub mod ride;
 pub mod roll;
 pub mod run;
+pub mod search;
 pub mod sinefit;
 
 pub use censor::Cut;
 pub use episodes::{find_episodes, wobble_speed_mps, Episode, Stability};
+pub use ride::Ride;
 pub use roll::estimate_roll_deg;
 pub use run::Run;

@@ -1,9 +1,10 @@
-//! A whole run in memory, one column per channel: what the offline analyses
-//! and plots work on (they look both ways in time, so they cannot stream).
+//! A run's frames, one column per channel, and reading them from a log.
+//! The commands stream the frames through the analyses (which hold a
+//! window of them); a whole run in memory is for tests and small logs.
 
 use std::path::{Path, PathBuf};
 
-use wobble_core::format::Event;
+use wobble_core::format::{DecodeStats, Event};
 
 use crate::reader::read_log;
 use crate::rows::{Row, RowAssembler};
@@ -42,7 +43,8 @@ impl Run {
         run
     }
 
-    fn push(&mut self, row: &Row) {
+    /// Appends one frame.
+    pub fn push(&mut self, row: &Row) {
         self.t_s.push(row.t_s);
         self.steer_deg.push(row.steer_deg);
         self.speed_mps.push(row.speed_mps);
@@ -50,27 +52,34 @@ impl Run {
         self.accel_g.push(row.accel_g);
     }
 
+    /// Appends frame `i` of `other`.
+    pub fn push_from(&mut self, other: &Self, i: usize) {
+        self.t_s.push(other.t_s[i]);
+        self.steer_deg.push(other.steer_deg[i]);
+        self.speed_mps.push(other.speed_mps[i]);
+        self.gyro_dps.push(other.gyro_dps[i]);
+        self.accel_g.push(other.accel_g[i]);
+    }
+
+    /// Forgets the first `n` frames (a window moving through a stream).
+    pub fn drop_front(&mut self, n: usize) {
+        self.t_s.drain(..n);
+        self.steer_deg.drain(..n);
+        self.speed_mps.drain(..n);
+        self.gyro_dps.drain(..n);
+        self.accel_g.drain(..n);
+    }
+
     /// Reads the log at `path`. A log damaged in places loads what survived:
     /// its losses are in `summary.losses`, and the analyses split the run at
     /// the gaps.
     pub fn load(path: &Path) -> Result<Self, CliError> {
-        let mut builder = SummaryBuilder::new();
-        let mut rows = RowAssembler::new();
-        let mut run = Self {
+        let empty = |_| Self {
             path: path.to_path_buf(),
             ..Self::default()
         };
-        let stats = read_log(path, |event| {
-            builder.observe(&event);
-            if let Event::Record(record) = event {
-                rows.push(&record, &mut |row: &Row| run.push(row));
-            }
-        })?;
-        rows.finish(&mut |row: &Row| run.push(row));
-        run.summary = builder.finish(&stats);
-        if run.t_s.is_empty() {
-            return Err(CliError::file(path, "no frames in the log"));
-        }
+        let (summary, mut run) = stream_rows(path, empty, |run, row| run.push(row))?;
+        run.summary = summary;
         Ok(run)
     }
 
@@ -89,28 +98,70 @@ impl Run {
     /// Nominal frame rate, Hz.
     #[must_use]
     pub fn sample_rate_hz(&self) -> f64 {
-        f64::from(self.summary.sample_rate_hz.unwrap_or(100).max(1))
+        self.summary.frame_rate_hz()
     }
 
     /// The run's name for reports: the file name.
     #[must_use]
     pub fn name(&self) -> String {
-        self.path.file_name().map_or_else(
-            || self.path.display().to_string(),
-            |n| n.to_string_lossy().into_owned(),
-        )
+        log_name(&self.path)
     }
+}
 
-    /// Mean wheel speed over `t_s ± half_width_s`, m/s (the nearest frame's
-    /// speed if none falls inside).
-    #[must_use]
-    pub fn speed_around(&self, t_s: f64, half_width_s: f64) -> f64 {
-        let lo = self.t_s.partition_point(|&t| t < t_s - half_width_s);
-        let hi = self.t_s.partition_point(|&t| t <= t_s + half_width_s);
-        if hi > lo {
-            return self.speed_mps[lo..hi].iter().sum::<f64>() / (hi - lo) as f64;
+/// Reads the log at `path` in one pass, in bounded memory, into an analysis
+/// that `make` creates at the first frame from the frame rate known then
+/// (the header is the log's first record): `visit` gets every frame as a
+/// row, in file order. Returns what `wobblog info` says about the log, and
+/// the analysis. A log without a frame is an error.
+pub fn stream_rows<A>(
+    path: &Path,
+    make: impl Fn(f64) -> A,
+    mut visit: impl FnMut(&mut A, &Row),
+) -> Result<(Summary, A), CliError> {
+    let mut builder = SummaryBuilder::new();
+    let mut rows = RowAssembler::new();
+    let mut analysis = None;
+    let stats = read_log(path, |event| {
+        builder.observe(&event);
+        if let Event::Record(record) = event {
+            let rate_hz = builder.frame_rate_hz();
+            rows.push(&record, &mut |row: &Row| {
+                visit(analysis.get_or_insert_with(|| make(rate_hz)), row);
+            });
         }
-        let i = lo.min(self.len().saturating_sub(1));
-        self.speed_mps.get(i).copied().unwrap_or(0.0)
+    })?;
+    let rate_hz = builder.frame_rate_hz();
+    rows.finish(&mut |row: &Row| visit(analysis.get_or_insert_with(|| make(rate_hz)), row));
+    let summary = builder.finish(&stats);
+    match analysis {
+        Some(analysis) => Ok((summary, analysis)),
+        None => Err(CliError::file(path, "no frames in the log")),
     }
+}
+
+/// Reads the log at `path` in one pass, calling `observe` with every
+/// decoder event and `visit` with every frame as a row, in file order.
+pub fn read_rows(
+    path: &Path,
+    mut observe: impl FnMut(&Event<'_>),
+    mut visit: impl FnMut(&Row),
+) -> Result<DecodeStats, CliError> {
+    let mut rows = RowAssembler::new();
+    let stats = read_log(path, |event| {
+        observe(&event);
+        if let Event::Record(record) = event {
+            rows.push(&record, &mut visit);
+        }
+    })?;
+    rows.finish(&mut visit);
+    Ok(stats)
+}
+
+/// A log's name for reports: its file name.
+#[must_use]
+pub fn log_name(path: &Path) -> String {
+    path.file_name().map_or_else(
+        || path.display().to_string(),
+        |n| n.to_string_lossy().into_owned(),
+    )
 }

@@ -14,6 +14,7 @@ use wobble_core::format::{
 use crate::csv_input::{number_in, Cell, TimeSteps};
 use crate::export::CSV_COLUMNS;
 use crate::output::Output;
+use crate::resample::{CsvRow, Resampler};
 use crate::time::parse_iso8601;
 use crate::CliError;
 
@@ -29,6 +30,12 @@ pub struct Args {
     /// The card log to write.
     #[arg(short, long)]
     pub output: PathBuf,
+    /// Accept a CSV at another rate than the log's 100 Hz (or an uneven
+    /// one) and interpolate it linearly onto 100 Hz frames. Rows more than
+    /// 0.1 s apart are a gap (no frame is made in it); GPS and UTC come from
+    /// the row before each frame. Without this, such a CSV is an error.
+    #[arg(long)]
+    pub resample: bool,
 }
 
 /// The frame rate of the logs `encode` writes, as the firmware's.
@@ -42,7 +49,7 @@ const GPS_REPEAT_US: u64 = 500_000;
 pub fn run(args: &Args) -> Result<(), CliError> {
     let mut output = Output::create(&args.output, &[&args.csv])?;
     let input = File::open(&args.csv).map_err(|e| CliError::file(&args.csv, e))?;
-    encode(input, &args.csv, &mut output, &args.output)?;
+    encode(input, &args.csv, &mut output, &args.output, args.resample)?;
     output.commit()
 }
 
@@ -107,12 +114,14 @@ impl SyncWriter {
     }
 }
 
-/// Encodes CSV rows from `input` into a log written to `output`.
+/// Encodes CSV rows from `input` into a log written to `output`; with
+/// `resample`, rows at any rate are interpolated onto the log's frames.
 pub fn encode(
     input: impl std::io::Read,
     in_name: &Path,
-    mut output: impl Write,
+    output: impl Write,
     out_name: &Path,
+    resample: bool,
 ) -> Result<(), CliError> {
     let mut reader = csv::ReaderBuilder::new()
         .trim(csv::Trim::All)
@@ -128,17 +137,24 @@ pub fn encode(
             "no `t_s` column in the header line",
         ));
     }
-    let mut encoder = BlockEncoder::new();
-    let mut write = |block: Option<&[u8; 512]>| -> Result<(), CliError> {
-        block.map_or(Ok(()), |b| {
-            output.write_all(b).map_err(|e| CliError::file(out_name, e))
-        })
+    let mut log = LogWriter {
+        encoder: BlockEncoder::new(),
+        output,
+        out_name,
+        in_name,
+        columns: &columns,
+        syncs: SyncWriter::default(),
+        last_gps: None,
+        frames: 0,
+        line: 0,
     };
-    let mut last_gps: Option<(u64, GpsFix)> = None;
-    let mut syncs = SyncWriter::default();
     let mut record = csv::StringRecord::new();
-    let mut rows = 0u64;
-    let mut steps = TimeSteps::new(f64::from(SAMPLE_RATE_HZ));
+    let mut steps = if resample {
+        TimeSteps::any_rate()
+    } else {
+        TimeSteps::new(f64::from(SAMPLE_RATE_HZ))
+    };
+    let mut resampler = Resampler::new(1_000_000 / u64::from(SAMPLE_RATE_HZ));
     while reader
         .read_record(&mut record)
         .map_err(|e| CliError::file(in_name, e))?
@@ -154,7 +170,44 @@ pub fn encode(
             };
             cell.error(in_name, e)
         })?;
-        if rows == 0 {
+        log.line = line;
+        if resample {
+            resampler.push(row, &mut |r: &CsvRow| log.store(r))?;
+        } else {
+            log.store(&row)?;
+        }
+    }
+    resampler.finish(&mut |r: &CsvRow| log.store(r))?;
+    log.finish()
+}
+
+/// Writes frames, GPS fixes and sync pairs into a log.
+struct LogWriter<'a, W> {
+    encoder: BlockEncoder,
+    output: W,
+    out_name: &'a Path,
+    in_name: &'a Path,
+    columns: &'a Columns,
+    syncs: SyncWriter,
+    last_gps: Option<(u64, GpsFix)>,
+    frames: u64,
+    /// The CSV line being read, for messages.
+    line: u64,
+}
+
+impl<W: Write> LogWriter<'_, W> {
+    /// Writes `record`, and the block it completes if any.
+    fn push(&mut self, record: &Record<'_>) -> Result<(), CliError> {
+        let block = self
+            .encoder
+            .push(record)
+            .map_err(|e| CliError::file(self.in_name, e))?;
+        write_block(&mut self.output, self.out_name, block)
+    }
+
+    /// Stores one frame of the log, with the header before the first.
+    fn store(&mut self, row: &CsvRow) -> Result<(), CliError> {
+        if self.frames == 0 {
             let info = LogInfo {
                 t_us: row.frame.t_us,
                 firmware: concat!("wobblog-encode ", env!("CARGO_PKG_VERSION")),
@@ -163,48 +216,47 @@ pub fn encode(
                 run: 0,
             };
             for rec in header_records(info, []) {
-                write(encoder.push(&rec).map_err(|e| CliError::file(in_name, e))?)?;
+                self.push(&rec)?;
             }
         }
-        rows += 1;
+        self.frames += 1;
         // Before the frame, so the pair is in force for it.
-        let sync = syncs
+        let sync = self
+            .syncs
             .update(row.frame.t_us, row.utc_ms)
-            .map_err(|e| columns.utc_cell(line).error(in_name, e))?;
+            .map_err(|e| self.columns.utc_cell(self.line).error(self.in_name, e))?;
         if let Some(sync) = sync {
-            write(
-                encoder
-                    .push(&Record::UtcSync(sync))
-                    .map_err(|e| CliError::file(in_name, e))?,
-            )?;
+            self.push(&Record::UtcSync(sync))?;
         }
-        write(
-            encoder
-                .push(&Record::Frame(row.frame))
-                .map_err(|e| CliError::file(in_name, e))?,
-        )?;
-        if let Some(fix) = gps_update(&last_gps, row.gps, row.frame.t_us) {
-            write(
-                encoder
-                    .push(&Record::Gps(fix))
-                    .map_err(|e| CliError::file(in_name, e))?,
-            )?;
-            last_gps = Some((row.frame.t_us, fix));
+        self.push(&Record::Frame(row.frame))?;
+        if let Some(fix) = gps_update(&self.last_gps, row.gps, row.frame.t_us) {
+            self.push(&Record::Gps(fix))?;
+            self.last_gps = Some((row.frame.t_us, fix));
         }
+        Ok(())
     }
-    if rows == 0 {
-        return Err(CliError::file(in_name, "no data rows"));
+
+    /// Writes the last block and flushes; a CSV without rows is an error.
+    fn finish(mut self) -> Result<(), CliError> {
+        if self.frames == 0 {
+            return Err(CliError::file(self.in_name, "no data rows"));
+        }
+        let block = self.encoder.finish();
+        write_block(&mut self.output, self.out_name, block)?;
+        self.output
+            .flush()
+            .map_err(|e| CliError::file(self.out_name, e))
     }
-    write(encoder.finish())?;
-    output.flush().map_err(|e| CliError::file(out_name, e))
 }
 
-/// One parsed CSV row.
-struct Row {
-    frame: Frame,
-    gps: Option<GpsFix>,
-    /// UTC, ms since 1970.
-    utc_ms: Option<i64>,
+fn write_block(
+    output: &mut impl Write,
+    name: &Path,
+    block: Option<&[u8; 512]>,
+) -> Result<(), CliError> {
+    block.map_or(Ok(()), |b| {
+        output.write_all(b).map_err(|e| CliError::file(name, e))
+    })
 }
 
 fn parse_row(
@@ -212,7 +264,7 @@ fn parse_row(
     record: &csv::StringRecord,
     path: &Path,
     line: u64,
-) -> Result<Row, CliError> {
+) -> Result<CsvRow, CliError> {
     let cell = |i: usize, c: usize| Cell {
         line,
         column: c + 1,
@@ -309,7 +361,7 @@ fn parse_row(
             )
         })?),
     };
-    Ok(Row { frame, gps, utc_ms })
+    Ok(CsvRow { frame, gps, utc_ms })
 }
 
 /// The GPS record to write at `t_us`, if any: when the fix changes, when it

@@ -40,7 +40,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         ProgressBar::hidden()
     };
     build(&entries, &args.output, |_, run| {
-        bar.suspend(|| warn_losses(run));
+        bar.suspend(|| warn_losses(&run.path, &run.summary));
         bar.inc(1);
     })?;
     bar.finish_and_clear();

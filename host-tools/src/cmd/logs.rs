@@ -6,8 +6,8 @@ use std::path::{Path, PathBuf};
 
 use indicatif::{ProgressBar, ProgressStyle};
 
-use crate::analysis::Run;
 use crate::output::Output;
+use crate::summary::Summary;
 use crate::CliError;
 
 /// Calls `visit` for every log in turn behind a progress bar (drawn only on
@@ -48,9 +48,9 @@ pub fn for_each_log(
 
 /// Prints what a partly readable run lost, so results from it are read
 /// with care.
-pub fn warn_losses(run: &Run) {
-    for line in run.summary.losses.describe() {
-        eprintln!("wobblog: {}: warning: {line}", run.path.display());
+pub fn warn_losses(log: &Path, summary: &Summary) {
+    for line in summary.losses.describe() {
+        eprintln!("wobblog: {}: warning: {line}", log.display());
     }
 }
 

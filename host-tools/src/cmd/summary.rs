@@ -4,8 +4,7 @@ use std::path::{Path, PathBuf};
 
 use serde::Serialize;
 
-use crate::analysis::filter::contiguous_spans;
-use crate::analysis::{find_episodes, wobble_speed_mps, Run, Stability};
+use crate::analysis::{wobble_speed_mps, Ride, Stability};
 use crate::cmd::logs::{for_each_log, print_stdout, warn_losses};
 use crate::CliError;
 
@@ -58,36 +57,23 @@ pub struct RunRow {
 }
 
 impl RunRow {
-    /// The row of `run`.
+    /// The row of `ride`.
     #[must_use]
-    pub fn of(run: &Run) -> Self {
-        let episodes = find_episodes(run);
-        let period_s = 1.0 / run.sample_rate_hz();
-        let distance_m = contiguous_spans(&run.t_s, period_s)
-            .into_iter()
-            .map(|span| {
-                span.clone()
-                    .skip(1)
-                    .map(|i| {
-                        0.5 * (run.speed_mps[i] + run.speed_mps[i - 1])
-                            * (run.t_s[i] - run.t_s[i - 1])
-                    })
-                    .sum::<f64>()
-            })
-            .sum();
-        let s = &run.summary;
+    pub fn of(ride: &Ride) -> Self {
+        let episodes = &ride.episodes;
+        let s = &ride.summary;
         Self {
-            log: run.name(),
+            log: ride.name(),
             duration_s: s.duration_s,
-            distance_m,
-            max_speed_mps: run.speed_mps.iter().copied().fold(0.0, f64::max),
+            distance_m: ride.distance_m,
+            max_speed_mps: ride.max_speed_mps,
             episodes: episodes.len(),
             unstable_episodes: episodes
                 .iter()
                 .filter(|e| e.stability == Stability::Unstable)
                 .count(),
             censored_episodes: episodes.iter().filter(|e| e.censored).count(),
-            wobble_speed_mps: wobble_speed_mps(&episodes),
+            wobble_speed_mps: wobble_speed_mps(episodes),
             frames_lost: s.frames_dropped + s.frames_lost,
             lost_blocks: s.lost_blocks,
         }
@@ -119,9 +105,9 @@ pub fn run(args: &Args) -> Result<(), CliError> {
     }
     let mut rows = Vec::new();
     let result = for_each_log(&logs, "summarising", |log| {
-        let run = Run::load(log)?;
-        warn_losses(&run);
-        rows.push(RunRow::of(&run));
+        let ride = Ride::load(log)?;
+        warn_losses(log, &ride.summary);
+        rows.push(RunRow::of(&ride));
         Ok(())
     });
     let printed = print_stdout(&render(&rows, args.format));

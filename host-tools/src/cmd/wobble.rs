@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 
 use serde::Serialize;
 
-use crate::analysis::{find_episodes, wobble_speed_mps, Episode, Run, Stability};
+use crate::analysis::{wobble_speed_mps, Episode, Ride, Stability};
 use crate::cmd::logs::{for_each_log, print_stdout, warn_losses};
 use crate::output::Output;
 use crate::plot::modes::ModePlot;
@@ -57,10 +57,10 @@ pub fn run(args: &Args) -> Result<(), CliError> {
     let mut reports = Vec::new();
     let mut names = Vec::new();
     let result = for_each_log(&args.logs, "analysing", |log| {
-        let run = Run::load(log)?;
-        warn_losses(&run);
-        let (from, to) = args.window.window().boot_s(&run.summary.utc_syncs, log)?;
-        let mut episodes = find_episodes(&run);
+        let ride = Ride::load(log)?;
+        warn_losses(log, &ride.summary);
+        let (from, to) = args.window.window().boot_s(&ride.summary.utc_syncs, log)?;
+        let mut episodes = ride.episodes.clone();
         episodes
             .retain(|e| from.is_none_or(|a| e.onset_s >= a) && to.is_none_or(|b| e.onset_s <= b));
         reports.push(RunEpisodes {
@@ -68,7 +68,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
             wobble_speed_mps: wobble_speed_mps(&episodes),
             episodes,
         });
-        names.push(run.name());
+        names.push(ride.name());
         Ok(())
     });
     let mut text = String::new();

@@ -119,34 +119,87 @@ fn register_font() {
     });
 }
 
-/// At most two points (the lowest and highest) per bucket of `bucket_s`:
-/// what a line drawn at the figure's resolution shows, in a file that stays
-/// small for hours of data.
-#[must_use]
-pub fn decimate(points: &[(f64, f64)], bucket_s: f64) -> Vec<(f64, f64)> {
-    let mut out = Vec::new();
-    let mut i = 0;
-    while i < points.len() {
-        let bucket = (points[i].0 / bucket_s).floor();
-        let len = points[i..]
-            .iter()
-            .position(|p| (p.0 / bucket_s).floor() != bucket)
-            .unwrap_or(points.len() - i);
-        let chunk = &points[i..i + len];
-        let lo = chunk.iter().min_by(|a, b| a.1.total_cmp(&b.1));
-        let hi = chunk.iter().max_by(|a, b| a.1.total_cmp(&b.1));
-        if let (Some(&lo), Some(&hi)) = (lo, hi) {
+/// A line drawn at the figure's resolution, built in one pass over the
+/// points: the lowest and the highest point of each column of a fixed grid,
+/// so memory and file size depend on the figure's width, never on how many
+/// points there are.
+pub struct Decimator {
+    origin_s: f64,
+    column_s: f64,
+    low: Vec<Option<(f64, f64)>>,
+    high: Vec<Option<(f64, f64)>>,
+    /// Whether the line runs on from this column to the next one drawn.
+    joined: Vec<bool>,
+    /// Column of the last point taken.
+    last: Option<usize>,
+}
+
+impl Decimator {
+    /// A line over `window_s` in `columns` columns (at least one).
+    #[must_use]
+    pub fn new(window_s: &std::ops::Range<f64>, columns: usize) -> Self {
+        let columns = columns.max(1);
+        Self {
+            origin_s: window_s.start,
+            column_s: (window_s.end - window_s.start) / columns as f64,
+            low: vec![None; columns],
+            high: vec![None; columns],
+            joined: vec![false; columns],
+            last: None,
+        }
+    }
+
+    /// Takes the point `(t_s, y)`; `joins` says the line runs to it from
+    /// the point before (no gap between them). Points outside the window
+    /// go to its first or last column.
+    pub fn push(&mut self, t_s: f64, y: f64, joins: bool) {
+        let n = self.low.len();
+        let at = ((t_s - self.origin_s) / self.column_s).floor();
+        // A NaN column (an empty window) is column 0.
+        let column = if at >= 0.0 {
+            (at as usize).min(n - 1)
+        } else {
+            0
+        };
+        if let Some(prev) = self.last.filter(|&p| joins && p < column) {
+            self.joined[prev] = true;
+        }
+        self.last = Some(column);
+        let point = (t_s, y);
+        if self.low[column].is_none_or(|lo| y < lo.1) {
+            self.low[column] = Some(point);
+        }
+        if self.high[column].is_none_or(|hi| y > hi.1) {
+            self.high[column] = Some(point);
+        }
+    }
+
+    /// The lines: one per stretch without a gap, with each column's lowest
+    /// and highest point in time order.
+    #[must_use]
+    pub fn lines(&self) -> Vec<Vec<(f64, f64)>> {
+        let mut lines = Vec::new();
+        let mut line = Vec::new();
+        for ((lo, hi), &joined) in self.low.iter().zip(&self.high).zip(&self.joined) {
+            let (Some(lo), Some(hi)) = (*lo, *hi) else {
+                continue;
+            };
             if lo == hi {
-                out.push(lo);
+                line.push(lo);
             } else if lo.0 <= hi.0 {
-                out.extend([lo, hi]);
+                line.extend([lo, hi]);
             } else {
-                out.extend([hi, lo]);
+                line.extend([hi, lo]);
+            }
+            if !joined {
+                lines.push(std::mem::take(&mut line));
             }
         }
-        i += len;
+        if !line.is_empty() {
+            lines.push(line);
+        }
+        lines
     }
-    out
 }
 
 /// An axis tick: the shortest of up to three decimals that shows the
@@ -193,19 +246,46 @@ mod tests {
     }
 
     proptest! {
-        /// Decimation keeps every bucket's extremes, in time order, and
-        /// never more than two points per bucket.
+        /// Decimation keeps every column's extremes, in time order, never
+        /// more than two points per column, and breaks the line exactly at
+        /// the gaps that span a column boundary.
         #[test]
-        fn decimation_keeps_extremes(ys in proptest::collection::vec(-100.0..100.0f64, 1..500)) {
+        fn decimation_keeps_extremes(
+            ys in proptest::collection::vec(-100.0..100.0f64, 1..500),
+            gap_at in 0usize..500,
+        ) {
             let points: Vec<(f64, f64)> =
                 ys.iter().enumerate().map(|(i, &y)| (i as f64, y)).collect();
-            let out = decimate(&points, 10.0);
+            let columns = points.len().div_ceil(10);
+            let window = 0.0..(10 * columns) as f64;
+            let mut line = Decimator::new(&window, columns);
+            for (i, &(t, y)) in points.iter().enumerate() {
+                line.push(t, y, i != gap_at);
+            }
+            let lines = line.lines();
+            let out: Vec<(f64, f64)> = lines.iter().flatten().copied().collect();
             prop_assert!(out.windows(2).all(|w| w[0].0 <= w[1].0));
-            prop_assert!(out.len() <= 2 * (points.len() / 10 + 2));
+            prop_assert!(out.len() <= 2 * columns);
             for chunk in points.chunks(10) {
                 let max = chunk.iter().map(|p| p.1).fold(f64::MIN, f64::max);
+                let min = chunk.iter().map(|p| p.1).fold(f64::MAX, f64::min);
                 prop_assert!(out.iter().any(|p| p.1 == max));
+                prop_assert!(out.iter().any(|p| p.1 == min));
             }
+            let breaks = gap_at > 0 && gap_at < points.len() && gap_at % 10 == 0;
+            prop_assert_eq!(lines.len(), 1 + usize::from(breaks));
         }
+    }
+
+    #[test]
+    fn a_zoomed_line_joins_columns_it_skips() {
+        let mut line = Decimator::new(&(0.0..1.0), 100);
+        for (t, joins) in [(0.0, false), (0.3, true), (0.6, false), (0.9, true)] {
+            line.push(t, t, joins);
+        }
+        assert_eq!(
+            line.lines(),
+            vec![vec![(0.0, 0.0), (0.3, 0.3)], vec![(0.6, 0.6), (0.9, 0.9)]]
+        );
     }
 }

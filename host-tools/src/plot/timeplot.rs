@@ -5,9 +5,12 @@
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::{decimate, padded_range, tick_label, Figure, FONT};
-use crate::analysis::filter::contiguous_spans;
-use crate::analysis::{estimate_roll_deg, Run};
+use super::{padded_range, tick_label, Decimator, Figure, FONT};
+use crate::analysis::filter::follows;
+use crate::analysis::roll::RollStream;
+use crate::analysis::Run;
+use crate::rows::Row;
+use crate::summary::Summary;
 use crate::time::{iso8601_unix_ms, utc_ms_at, SyncPair};
 
 /// Panel titles (y-axis labels), top to bottom.
@@ -53,89 +56,166 @@ const WIDTH_PX: u32 = 1200;
 /// Height of each panel, px.
 const PANEL_HEIGHT_PX: u32 = 220;
 
-impl TimePlot {
-    /// The figure of `run` between `from_s` and `to_s` (the whole run where
-    /// absent). `None` if no frame falls in the window.
+/// Builds a [`TimePlot`] in one pass over the frames, in memory that does
+/// not grow with the run: each panel keeps its lowest and highest point per
+/// column of the figure, and the roll estimate streams (see
+/// [`RollStream`]).
+pub struct TimePlotBuilder {
+    roll: RollStream,
+    panels: Panels,
+}
+
+/// The figure being drawn, frame by frame.
+struct Panels {
+    plot: TimePlot,
+    period_s: f64,
+    lines: [Decimator; 4],
+    /// Time of the last frame drawn.
+    last_s: Option<f64>,
+}
+
+impl Panels {
+    /// Adds frame `j` of `frames`, whose roll is `roll_deg`, if it falls in
+    /// the figure's window.
+    fn draw(&mut self, frames: &Run, j: usize, roll_deg: f64) {
+        let t = frames.t_s[j];
+        let window = &self.plot.window_s;
+        if !(window.contains(&t) || t == window.end) {
+            return;
+        }
+        let joins = self
+            .last_s
+            .is_some_and(|prev| follows(prev, t, self.period_s));
+        self.last_s = Some(t);
+        let values = [
+            frames.steer_deg[j],
+            roll_deg,
+            frames.gyro_dps[j][2],
+            frames.speed_mps[j],
+        ];
+        for (line, y) in self.lines.iter_mut().zip(values) {
+            line.push(t, y, joins);
+        }
+    }
+}
+
+impl TimePlotBuilder {
+    /// The figure of the run `name`, whose frames span `data_s` (first and
+    /// last in file order) at `fs_hz`, between `from_s` and `to_s` (the whole
+    /// run where absent), shading and marking what `summary` records.
+    /// `None` if no frame can fall in the window.
     #[must_use]
-    pub fn new(run: &Run, from_s: Option<f64>, to_s: Option<f64>) -> Option<Self> {
-        let first = *run.t_s.first()?;
-        let last = *run.t_s.last()?;
+    pub fn new(
+        name: &str,
+        summary: &Summary,
+        data_s: (f64, f64),
+        fs_hz: f64,
+        (from_s, to_s): (Option<f64>, Option<f64>),
+    ) -> Option<Self> {
+        let (first, last) = data_s;
         let window_s = from_s.unwrap_or(first).max(first)..to_s.unwrap_or(last).min(last);
         if window_s.start >= window_s.end {
             return None;
         }
-        let roll_deg = estimate_roll_deg(run);
-        let channels: [Box<dyn Fn(usize) -> f64>; 4] = [
-            Box::new(|i| run.steer_deg[i]),
-            Box::new(|i| roll_deg[i]),
-            Box::new(|i| run.gyro_dps[i][2]),
-            Box::new(|i| run.speed_mps[i]),
-        ];
-        let bucket_s = (window_s.end - window_s.start) / f64::from(2 * WIDTH_PX);
-        let spans = contiguous_spans(&run.t_s, 1.0 / run.sample_rate_hz());
-        let series = channels.map(|value| {
-            spans
-                .iter()
-                .map(|span| {
-                    let points: Vec<(f64, f64)> = span
-                        .clone()
-                        .filter(|&i| window_s.contains(&run.t_s[i]) || run.t_s[i] == window_s.end)
-                        .map(|i| (run.t_s[i], value(i)))
-                        .collect();
-                    decimate(&points, bucket_s)
-                })
-                .filter(|points| !points.is_empty())
-                .collect()
-        });
         let overlaps = |a: f64, b: f64| a < window_s.end && b > window_s.start;
-        let alerts_s = run
-            .summary
+        let clip = |(a, b): (f64, f64)| (a.max(window_s.start), b.min(window_s.end));
+        let alerts_s = summary
             .alerts
             .iter()
             .map(|a| (a.on_s, a.off_s.unwrap_or(last)))
             .filter(|&(a, b)| overlaps(a, b))
-            .map(|(a, b)| (a.max(window_s.start), b.min(window_s.end)))
+            .map(clip)
             .collect();
-        let markers_s = run
-            .summary
+        let markers_s = summary
             .markers
             .iter()
             .copied()
             .filter(|t| window_s.contains(t))
             .collect();
-        let lost_s = run
-            .summary
+        let lost_s = summary
             .losses
             .lost_blocks
             .iter()
             .map(|g| (g.from_s.unwrap_or(first), g.to_s))
             .filter(|&(a, b)| overlaps(a, b))
-            .map(|(a, b)| (a.max(window_s.start), b.min(window_s.end)))
+            .map(clip)
             .collect();
-        let jumps_s = run
-            .summary
+        let jumps_s = summary
             .losses
             .time_jumps
             .iter()
             .copied()
             .filter(|&(a, b)| a < b && overlaps(a, b))
-            .map(|(a, b)| (a.max(window_s.start), b.min(window_s.end)))
+            .map(clip)
             .collect();
+        let columns = 2 * WIDTH_PX as usize;
         Some(Self {
-            title: format!(
-                "{}: {:.1} to {:.1} s",
-                run.name(),
-                window_s.start,
-                window_s.end
-            ),
-            window_s,
-            series,
-            alerts_s,
-            markers_s,
-            lost_s,
-            jumps_s,
-            utc: None,
+            panels: Panels {
+                lines: std::array::from_fn(|_| Decimator::new(&window_s, columns)),
+                plot: TimePlot {
+                    title: format!("{name}: {:.1} to {:.1} s", window_s.start, window_s.end),
+                    window_s,
+                    series: Default::default(),
+                    alerts_s,
+                    markers_s,
+                    lost_s,
+                    jumps_s,
+                    utc: None,
+                },
+                period_s: 1.0 / fs_hz,
+                last_s: None,
+            },
+            roll: RollStream::new(fs_hz),
         })
+    }
+
+    /// Takes frame `i` of `source` (frames in file order).
+    pub fn push(&mut self, source: &Run, i: usize) {
+        let panels = &mut self.panels;
+        self.roll
+            .push(source, i, &mut |f, j, r| panels.draw(f, j, r));
+    }
+
+    /// Takes one frame as a row (frames in file order).
+    pub fn push_row(&mut self, row: &Row) {
+        let panels = &mut self.panels;
+        self.roll.push_row(row, &mut |f, j, r| panels.draw(f, j, r));
+    }
+
+    /// The figure.
+    #[must_use]
+    pub fn finish(mut self) -> TimePlot {
+        let panels = &mut self.panels;
+        self.roll.finish(&mut |f, j, r| panels.draw(f, j, r));
+        let mut plot = self.panels.plot;
+        plot.series = self.panels.lines.each_ref().map(Decimator::lines);
+        plot
+    }
+}
+
+impl TimePlot {
+    /// The figure of `run` (in memory) between `from_s` and `to_s` (the
+    /// whole run where absent). `None` if no frame falls in the window.
+    #[must_use]
+    pub fn new(run: &Run, from_s: Option<f64>, to_s: Option<f64>) -> Option<Self> {
+        let data_s = (*run.t_s.first()?, *run.t_s.last()?);
+        let mut builder = TimePlotBuilder::new(
+            &run.name(),
+            &run.summary,
+            data_s,
+            run.sample_rate_hz(),
+            (from_s, to_s),
+        )?;
+        for i in 0..run.len() {
+            builder.push(run, i);
+        }
+        Some(builder.finish())
+    }
+
+    /// Whether no frame fell in the window.
+    #[must_use]
+    pub fn is_empty(&self) -> bool {
+        self.series.iter().all(Vec::is_empty)
     }
 
     /// Labels the time axis in UTC through the log's sync `pairs`.

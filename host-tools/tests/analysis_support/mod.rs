@@ -13,7 +13,7 @@ use wobble_core::format::{
     Marker, Record, UtcSync, UtcTime, ACCEL_COUNTS_PER_G, EDGE_AGE_NONE, GYRO_COUNTS_PER_DPS,
     STEER_COUNTS_PER_DEG,
 };
-use wobblog::analysis::Run;
+use wobblog::analysis::{Episode, Run};
 
 /// The `wobblog` binary.
 #[must_use]
@@ -382,4 +382,26 @@ pub fn standard_log(path: &Path) -> (Ride, Extras) {
     };
     write_log(path, &ride, &extras);
     (ride, extras)
+}
+
+/// `a` and `b` measure the same episode: every value to 1e-9, the same
+/// stability and cuts.
+pub fn assert_same_episode(a: &Episode, b: &Episode) {
+    let pairs = [
+        (a.onset_s, b.onset_s),
+        (a.end_s, b.end_s),
+        (a.peak_s, b.peak_s),
+        (a.freq_hz, b.freq_hz),
+        (a.sigma_per_s, b.sigma_per_s),
+        (a.peak_amp_deg, b.peak_amp_deg),
+        (a.speed_at_onset_mps, b.speed_at_onset_mps),
+    ];
+    for (x, y) in pairs {
+        assert!((x - y).abs() <= 1e-9 * x.abs().max(1.0), "{a:?}\n{b:?}");
+    }
+    assert_eq!(a.stability, b.stability);
+    assert_eq!(
+        (a.cut_at_start, a.cut_at_end),
+        (b.cut_at_start, b.cut_at_end)
+    );
 }

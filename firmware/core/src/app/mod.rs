@@ -4,11 +4,12 @@
 //! ```text
 //!  sensors ─> sampler::run (100 Hz, high-priority executor) ─┐
 //!                                                            ├─> RecordQueue ─> writer::run (thread mode) ─> card
-//!  GPS UART ─> gps::run (thread mode) ───────────────────────┘
+//!  GPS UART ─> gps::run (medium-priority executor) ──────────┘
 //! ```
 
 pub mod gps;
 pub mod gps_setup;
+pub mod imu_port;
 pub mod ports;
 pub mod sampler;
 pub mod writer;

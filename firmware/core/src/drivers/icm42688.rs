@@ -21,7 +21,9 @@
 //! reads 0x00 or 0xFF ([`Error::NoResponse`]), another part reads something
 //! else ([`Error::WrongId`]). [`Icm42688::read`] reports a sensor whose
 //! registers hold the "no data" marker ([`Error::NotReady`]: it reset or
-//! powered down). A sensor that answers with frozen values is found one level
+//! powered down), and one that went away after `init` ([`Error::NoResponse`]:
+//! the burst reads all 0xFF or all 0x00, the floating bus; a live sensor
+//! always has gravity on some axis). A sensor that answers with frozen values is found one level
 //! up, by [`crate::imu::Imu`]. Each error maps to the sampler's
 //! [`SensorError`] ([`Error::sensor_error`]), which records it as an IMU
 //! fault; the caller re-runs `init` to recover.
@@ -181,7 +183,8 @@ impl Default for Config {
 pub enum Error<E> {
     /// The SPI bus failed.
     Comm(E),
-    /// `WHO_AM_I` read 0x00 or 0xFF: no sensor on the bus (or no power).
+    /// `WHO_AM_I` read 0x00 or 0xFF, or a data burst read nothing else: no
+    /// sensor on the bus (or no power).
     NoResponse,
     /// `WHO_AM_I` read this instead of 0x47: another part.
     WrongId(u8),
@@ -316,10 +319,14 @@ impl<SPI: SpiDevice> Icm42688<SPI> {
     ///
     /// # Errors
     /// [`Error::Comm`] on a bus error, [`Error::NotReady`] when the sensor
-    /// has no data.
+    /// has no data, [`Error::NoResponse`] when the bus reads as if nothing
+    /// were on it.
     pub async fn read(&mut self) -> Result<RawImu, Error<SPI::Error>> {
         let mut raw = [0u8; DATA_LEN];
         self.read_regs(reg::ACCEL_DATA_X1, &mut raw).await?;
+        if raw.iter().all(|&b| b == 0xFF) || raw.iter().all(|&b| b == 0x00) {
+            return Err(Error::NoResponse);
+        }
         let word = |i: usize| i16::from_be_bytes([raw[2 * i], raw[2 * i + 1]]);
         let sample = RawImu {
             accel: [word(0), word(1), word(2)],

@@ -242,11 +242,14 @@ impl<'a, D: BlockDevice, T: TimeSource> CardLogger<'a, D, T> {
     }
 
     /// Logs one record at local time `now_us`. Without a card, frames are
-    /// counted as lost and other records are dropped.
+    /// counted as lost, and so are the frames a dropout record (the queue's)
+    /// reports; other records are dropped.
     pub fn push(&mut self, rec: &Record<'_>, now_us: u64) {
         if self.open.is_none() {
-            if matches!(rec, Record::Frame(_)) {
-                self.count_lost(1);
+            match rec {
+                Record::Frame(_) => self.count_lost(1),
+                Record::Dropout(d) => self.count_lost(d.frames_lost),
+                _ => {}
             }
             return;
         }

@@ -30,3 +30,40 @@ pub fn data_read(words: [i16; 6]) -> Vec<Transaction<u8>> {
     let bytes: Vec<u8> = words.iter().flat_map(|w| w.to_be_bytes()).collect();
     read_regs(reg::ACCEL_DATA_X1, &bytes)
 }
+
+/// Reset values of the two filter-order registers (datasheet section 14).
+const GYRO_CONFIG1_RESET: u8 = 0x16;
+const ACCEL_CONFIG1_RESET: u8 = 0x0D;
+
+/// The bus traffic of `init`: identity check, reset, filters, ranges and
+/// rate (`gyro_config0`, `accel_config0`), power.
+pub fn init_sequence(gyro_config0: u8, accel_config0: u8) -> Vec<Transaction<u8>> {
+    use reg::*;
+    [
+        write_reg(REG_BANK_SEL, 0),
+        read_regs(WHO_AM_I, &[0x47]),
+        write_reg(DEVICE_CONFIG, 0x01),
+        // Bank 1, gyro AAF at 42 Hz: DELT 1, DELTSQR 1, BITSHIFT 15.
+        write_reg(REG_BANK_SEL, 1),
+        write_reg(GYRO_CONFIG_STATIC3, 1),
+        write_reg(GYRO_CONFIG_STATIC4, 1),
+        write_reg(GYRO_CONFIG_STATIC5, 0xF0),
+        // Bank 2, accel AAF: DELT in bits 6:1, enable bit 0 clear.
+        write_reg(REG_BANK_SEL, 2),
+        write_reg(ACCEL_CONFIG_STATIC2, 0x02),
+        write_reg(ACCEL_CONFIG_STATIC3, 1),
+        write_reg(ACCEL_CONFIG_STATIC4, 0xF0),
+        write_reg(REG_BANK_SEL, 0),
+        write_reg(GYRO_CONFIG0, gyro_config0),
+        write_reg(ACCEL_CONFIG0, accel_config0),
+        // UI filter order 3rd (2) in bits 3:2 and 4:3, reserved bits kept.
+        read_regs(GYRO_CONFIG1, &[GYRO_CONFIG1_RESET]),
+        write_reg(GYRO_CONFIG1, 0x1A),
+        read_regs(ACCEL_CONFIG1, &[ACCEL_CONFIG1_RESET]),
+        write_reg(ACCEL_CONFIG1, 0x15),
+        // Both UI bandwidths index 4: 400 Hz / 10.
+        write_reg(GYRO_ACCEL_CONFIG0, 0x44),
+        write_reg(PWR_MGMT0, 0x0F),
+    ]
+    .concat()
+}

@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use wobble_model::fit::Observation;
 
 use super::figure::Measured;
-use crate::analysis::{find_episodes, Episode, Run};
+use crate::analysis::{Episode, Ride};
 use crate::cmd::logs::{for_each_log, warn_losses};
 use crate::CliError;
 
@@ -53,17 +53,13 @@ impl LoggedEpisode {
 pub fn load(logs: &[PathBuf]) -> (Vec<LoggedEpisode>, Result<(), CliError>) {
     let mut out = Vec::new();
     let result = for_each_log(logs, "analysing", |log: &Path| {
-        let run = Run::load(log)?;
-        warn_losses(&run);
-        let name = run.name();
-        out.extend(
-            find_episodes(&run)
-                .into_iter()
-                .map(|episode| LoggedEpisode {
-                    log: name.clone(),
-                    episode,
-                }),
-        );
+        let ride = Ride::load(log)?;
+        warn_losses(log, &ride.summary);
+        let name = ride.name();
+        out.extend(ride.episodes.into_iter().map(|episode| LoggedEpisode {
+            log: name.clone(),
+            episode,
+        }));
         Ok(())
     });
     (out, result)

@@ -1,0 +1,95 @@
+//! What the commands over many logs (`wobble`, `summary`, the model fits
+//! and the data set) take from each: its summary, wobble episodes, distance
+//! and top speed, found in one pass over the log in bounded memory.
+
+use std::path::{Path, PathBuf};
+
+use super::filter::follows;
+use super::run::{log_name, stream_rows};
+use super::search::EpisodeSearch;
+use super::{Episode, Run};
+use crate::summary::Summary;
+use crate::CliError;
+
+/// One run, analysed.
+#[derive(Clone, Debug)]
+pub struct Ride {
+    /// The log it was read from.
+    pub path: PathBuf,
+    /// What `wobblog info` says about it.
+    pub summary: Summary,
+    /// Every wobble episode, in time order.
+    pub episodes: Vec<Episode>,
+    /// Wheel distance over the frames present (trapezoids within each
+    /// stretch without a gap), m.
+    pub distance_m: f64,
+    /// Highest wheel speed, m/s.
+    pub max_speed_mps: f64,
+}
+
+impl Ride {
+    /// Reads and analyses the log at `path`, streaming its frames.
+    pub fn load(path: &Path) -> Result<Self, CliError> {
+        let (summary, analyser) = stream_rows(path, Analyser::new, |a, row| {
+            a.push(row.t_s, row.steer_deg, row.speed_mps);
+        })?;
+        Ok(analyser.finish(path, summary))
+    }
+
+    /// Analyses a run held in memory: the same analysis as [`Self::load`].
+    #[must_use]
+    pub fn of(run: &Run) -> Self {
+        let mut a = Analyser::new(run.sample_rate_hz());
+        for i in 0..run.len() {
+            a.push(run.t_s[i], run.steer_deg[i], run.speed_mps[i]);
+        }
+        a.finish(&run.path, run.summary.clone())
+    }
+
+    /// The run's name for reports: the file name.
+    #[must_use]
+    pub fn name(&self) -> String {
+        log_name(&self.path)
+    }
+}
+
+/// The analysis of a stream of frames.
+struct Analyser {
+    period_s: f64,
+    search: EpisodeSearch,
+    distance_m: f64,
+    max_speed_mps: f64,
+    /// Time and speed of the frame before.
+    last: Option<(f64, f64)>,
+}
+
+impl Analyser {
+    fn new(fs_hz: f64) -> Self {
+        Self {
+            period_s: 1.0 / fs_hz,
+            search: EpisodeSearch::new(fs_hz),
+            distance_m: 0.0,
+            max_speed_mps: 0.0,
+            last: None,
+        }
+    }
+
+    fn push(&mut self, t_s: f64, steer_deg: f64, speed_mps: f64) {
+        if let Some((t0, v0)) = self.last.filter(|&(t0, _)| follows(t0, t_s, self.period_s)) {
+            self.distance_m += 0.5 * (speed_mps + v0) * (t_s - t0);
+        }
+        self.last = Some((t_s, speed_mps));
+        self.max_speed_mps = self.max_speed_mps.max(speed_mps);
+        self.search.push(t_s, steer_deg, speed_mps);
+    }
+
+    fn finish(self, path: &Path, summary: Summary) -> Ride {
+        Ride {
+            path: path.to_path_buf(),
+            episodes: self.search.finish(&summary.losses),
+            summary,
+            distance_m: self.distance_m,
+            max_speed_mps: self.max_speed_mps,
+        }
+    }
+}
