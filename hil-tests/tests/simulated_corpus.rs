@@ -212,24 +212,13 @@ fn the_imu_signals_agree_with_the_motion() {
 
 #[test]
 fn committed_rides_equal_the_generator() {
-    let dir = simulated::dir();
-    let manifest = std::fs::read_to_string(dir.join("manifest.json")).expect("manifest.json");
-    assert!(
-        manifest == simulated::manifest_json(&fixtures()),
-        "simulated/manifest.json differs from the generator: run `cargo run -p wobble-hil --release --bin gen-corpus`"
-    );
-    let mut committed = 0;
-    for f in fixtures().iter().filter(|f| f.truth.committed) {
-        let path = dir.join(&f.truth.file);
-        let on_disk =
-            std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-        assert!(
-            on_disk == f.csv,
-            "{} differs from the generator",
-            path.display()
-        );
-        committed += on_disk.len();
-    }
+    let fixtures = fixtures();
+    let committed = wobble_hil::corpus::check_committed(
+        &simulated::dir(),
+        &simulated::manifest_json(&fixtures),
+        &fixtures,
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
     assert!(
         committed > 0 && committed < 1 << 20,
         "{committed} bytes committed"
