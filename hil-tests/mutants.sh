@@ -35,7 +35,8 @@ export CARGO_PROFILE_DEV_DEBUG=0 CARGO_INCREMENTAL=1
 # writing them into the committed regression files.
 export PROPTEST_DISABLE_FAILURE_PERSISTENCE=1
 # Longest a mutant's tests may run, s: the slowest target's baseline is
-# under 10 s, so a mutant past this has made something loop.
+# under 15 s even on a loaded machine, so a mutant past this has made
+# something loop.
 timeout_s="${MUTANTS_TIMEOUT_S:-60}"
 
 # name | package | file | name filter | test targets (built and run)

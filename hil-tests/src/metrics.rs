@@ -200,6 +200,42 @@ impl Report {
         self.latencies_s().into_iter().reduce(f64::max)
     }
 
+    /// Every way the detector missed the goals with this report: an episode
+    /// without an alert or with chatter, the median or worst latency, the
+    /// frequency error (empty: all goals met).
+    #[must_use]
+    pub fn goal_failures(&self) -> Vec<String> {
+        let mut out = Vec::new();
+        for e in &self.episodes {
+            if e.alert_s.is_none() {
+                out.push(format!("{}: no alert", e.fixture));
+            }
+            if e.extra_alerts > 0 {
+                out.push(format!("{}: {} extra alerts", e.fixture, e.extra_alerts));
+            }
+        }
+        let over = |what: &str, v: Option<f64>, goal: f64| {
+            v.filter(|&v| v > goal)
+                .map(|v| format!("{what} {v:.3} over {goal}"))
+        };
+        out.extend(over(
+            "median latency (s)",
+            self.median_latency_s(),
+            goals::MEDIAN_LATENCY_S,
+        ));
+        out.extend(over(
+            "worst latency (s)",
+            self.worst_latency_s(),
+            goals::WORST_LATENCY_S,
+        ));
+        out.extend(over(
+            "frequency error (Hz)",
+            self.max_freq_error_hz(),
+            goals::FREQ_ERROR_HZ,
+        ));
+        out
+    }
+
     /// Largest frequency error at alert.
     #[must_use]
     pub fn max_freq_error_hz(&self) -> Option<f64> {
@@ -395,6 +431,73 @@ pub fn markdown(with_speed: &Report, without_speed: &Report) -> String {
             f.alerts,
             f.false_alerts.len(),
             f2.false_alerts.len()
+        );
+    }
+    s
+}
+
+/// The section of the metrics file on the simulated family
+/// (`hil-tests/fixtures/corpus/simulated/`, rides simulated from the
+/// bicycle model), the detector given the speed as on the bike.
+#[must_use]
+pub fn simulated_markdown(r: &Report) -> String {
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "\n## Simulated family (bicycle model)\n\n\
+         Rides simulated in time from the linear wobble model of the test bicycle \
+         (`hil-tests/src/corpus/simulated/`; synthetic, but steering, roll rate, yaw rate, lateral \
+         acceleration and the wheel's edges are one motion); truth from the model's wobble \
+         eigenvalue and modal amplitude. Same detector, same goals, no retuning; \
+         `hil-tests/tests/simulated_corpus.rs` asserts them.\n"
+    );
+    let _ = writeln!(
+        s,
+        "| metric | goal | with speed (firmware) |\n|---|---|---|"
+    );
+    let _ = writeln!(
+        s,
+        "| episodes detected | all | {} / {} |",
+        r.episodes.len() - r.missed(),
+        r.episodes.len()
+    );
+    let _ = writeln!(
+        s,
+        "| median / worst alert latency | <= {} / {} s | {} / {} s |",
+        goals::MEDIAN_LATENCY_S,
+        goals::WORST_LATENCY_S,
+        opt(r.median_latency_s(), 2),
+        opt(r.worst_latency_s(), 2)
+    );
+    let _ = writeln!(
+        s,
+        "| worst frequency error at alert | <= {} Hz | {} Hz |",
+        goals::FREQ_ERROR_HZ,
+        opt(r.max_freq_error_hz(), 3)
+    );
+    let _ = writeln!(
+        s,
+        "| false alerts on non-wobble rides ({:.1} min) / in wobble rides | 0 / 0 | {} / {} |",
+        r.non_wobble_s() / 60.0,
+        r.non_wobble_false_alerts(),
+        r.wobble_fixture_false_alerts()
+    );
+    let _ = writeln!(
+        s,
+        "\n| ride | f (Hz) | growth (1/s) | speed (m/s) | 0.5 deg at (s) | alert at (s) | latency (s) | f error (Hz) |\n|---|---|---|---|---|---|---|---|"
+    );
+    for e in &r.episodes {
+        let _ = writeln!(
+            s,
+            "| {} | {:.2} | {:.2} | {:.1} | {:.2} | {} | {} | {} |",
+            e.fixture,
+            e.freq_hz,
+            e.growth_per_s,
+            e.speed_mps,
+            e.t_ref_s,
+            opt(e.alert_s, 2),
+            opt(e.latency_s(), 2),
+            opt(e.freq_error_hz(), 3)
         );
     }
     s

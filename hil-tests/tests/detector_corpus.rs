@@ -24,24 +24,12 @@ fn report(use_speed: bool) -> &'static Report {
 
 #[test]
 fn committed_fixtures_equal_the_generator() {
-    let dir = corpus::corpus_dir();
-    let manifest = std::fs::read_to_string(dir.join("manifest.json")).expect("manifest.json");
-    assert!(
-        manifest == corpus::manifest_json(fixtures()),
-        "manifest.json differs from the generator: run `cargo run -p wobble-hil --release --bin gen-corpus`"
-    );
-    let mut committed = 0;
-    for f in fixtures().iter().filter(|f| f.truth.committed) {
-        let path = corpus::fixture_path(&dir, &f.truth);
-        let on_disk =
-            std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-        assert!(
-            on_disk == f.csv,
-            "{} differs from the generator",
-            path.display()
-        );
-        committed += on_disk.len();
-    }
+    let committed = corpus::check_committed(
+        &corpus::corpus_dir(),
+        &corpus::manifest_json(fixtures()),
+        fixtures(),
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
     // Keep the repository small: the long rides are regenerated, not committed.
     assert!(committed < 3 << 20, "committed corpus is {committed} bytes");
 }
@@ -202,8 +190,13 @@ fn without_speed_the_goals_hold_except_under_strong_ripple() {
 fn metrics_file_is_current() {
     let path = corpus::corpus_dir().join("METRICS.md");
     let on_disk = std::fs::read_to_string(&path).unwrap_or_default();
+    let simulated = corpus::simulated::generate()
+        .and_then(|f| metrics::evaluate(&f, &Config::default(), true))
+        .expect("simulated family evaluates");
+    let want =
+        metrics::markdown(report(true), report(false)) + &metrics::simulated_markdown(&simulated);
     assert!(
-        on_disk == metrics::markdown(report(true), report(false)),
+        on_disk == want,
         "{} is stale: run `cargo run -p wobble-hil --release --bin detector-metrics`",
         path.display()
     );

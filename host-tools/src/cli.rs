@@ -20,7 +20,7 @@ pub struct Cli {
 enum Command {
     /// Summarise a log: duration, samples, dropouts, lost blocks, GPS coverage, alerts.
     Info(cmd::info::Args),
-    /// Decode a log into one row per 100 Hz frame (CSV, JSON lines or Parquet).
+    /// Decode a log into one row per 100 Hz frame (CSV, JSON lines, Parquet) or MCAP channels.
     Decode(cmd::decode::Args),
     /// List a log's alerts, markers, faults, dropouts and damage in time order.
     Events(cmd::events::Args),
@@ -30,7 +30,7 @@ enum Command {
     Export(cmd::export::Args),
     /// Build a log from a CSV through the firmware's encoder (tests and demos).
     Encode(cmd::encode::Args),
-    /// Replay a steering CSV through the on-board wobble detector; print each alert change.
+    /// Replay a log (its own settings) or a steering CSV through the wobble detector.
     Detect(cmd::detect::Args),
     /// Replay a raw NMEA capture through the firmware's GPS path; one JSON fix per line.
     Nmea(cmd::nmea::Args),

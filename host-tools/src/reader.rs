@@ -106,3 +106,89 @@ fn progress_bar(len: u64) -> ProgressBar {
     bar.set_message("decoding");
     bar
 }
+
+#[cfg(test)]
+pub(crate) mod tests {
+    use super::*;
+    use wobble_core::config::Config;
+    use wobble_core::format::header::header_records;
+    use wobble_core::format::{BlockEncoder, Frame, LogInfo, Record, EDGE_AGE_NONE};
+
+    /// A log with the default configuration in its header and `frames`
+    /// frames after it, behind `garbage` bytes of damage.
+    pub(crate) fn log(frames: u64, garbage: usize) -> (tempfile::NamedTempFile, Vec<String>) {
+        let mut text = String::new();
+        Config::default().write_lines(&mut text).unwrap();
+        let lines: Vec<String> = text.lines().map(String::from).collect();
+        let info = LogInfo {
+            t_us: 0,
+            firmware: "test",
+            device_id: [7; 12],
+            sample_rate_hz: 100,
+            run: 12,
+        };
+        let mut bytes = vec![0x5a; garbage];
+        let mut encoder = BlockEncoder::new();
+        let frames = (0..frames).map(|i| {
+            Record::Frame(Frame {
+                t_us: i * 10_000,
+                accel: [0; 3],
+                gyro: [0; 3],
+                steer_cdeg: (i % 100) as i16,
+                wheel_count: 0,
+                wheel_edge_age_us: EDGE_AGE_NONE,
+                speed_mm_s: 4000,
+                status: Default::default(),
+            })
+        });
+        for rec in header_records(info, lines.iter().map(String::as_str)).chain(frames) {
+            if let Some(block) = encoder.push(&rec).unwrap() {
+                bytes.extend_from_slice(block);
+            }
+        }
+        bytes.extend_from_slice(encoder.finish().unwrap());
+        let file = tempfile::NamedTempFile::new().unwrap();
+        std::fs::write(file.path(), &bytes).unwrap();
+        (file, lines)
+    }
+
+    #[test]
+    fn chunks_grow_from_any_first_length_and_cover_the_file() {
+        let (file, _) = log(60_000, 700);
+        let len = std::fs::metadata(file.path()).unwrap().len();
+        // Records passed on, and bytes reported skipped (a skip that spans
+        // chunks is reported in parts).
+        let count = |(records, skipped): &mut (u64, u64), event: Event<'_>| match event {
+            Event::Record(_) => *records += 1,
+            Event::Skipped { len, .. } => *skipped += len,
+            _ => {}
+        };
+        let mut all = (0, 0);
+        let whole = read_log(file.path(), |e| count(&mut all, e)).unwrap();
+        assert_eq!(all, (whole.records, 700));
+        for first_len in [0, 1, 513, BLOCK_LEN * 3 + 7, 1 << 30] {
+            let mut seen = (0, 0);
+            let stats = read_log_until(file.path(), first_len, |e| {
+                count(&mut seen, e);
+                ControlFlow::Continue(())
+            })
+            .unwrap();
+            assert_eq!(stats, whole, "first chunk {first_len}");
+            assert_eq!(stats.blocks * BLOCK_LEN as u64 + 700, len);
+            assert_eq!(seen, all, "first chunk {first_len}");
+        }
+    }
+
+    #[test]
+    fn a_break_ends_the_reading_and_the_events() {
+        let (file, _) = log(60_000, 0);
+        let mut events = 0;
+        let stats = read_log_until(file.path(), 2 * BLOCK_LEN, |_| {
+            events += 1;
+            ControlFlow::Break(())
+        })
+        .unwrap();
+        assert_eq!(events, 1);
+        assert_eq!(stats.blocks, 2);
+    }
+}

@@ -191,7 +191,7 @@ fn compare_prints_residuals_and_fit_writes_the_fitted_file() {
         .collect();
     // measured minus model, as printed
     assert!((cols[2] - cols[3] - cols[4]).abs() < 0.011, "{row}");
-    assert!(text.contains("rms residuals over 1 episodes"));
+    assert!(text.contains("rms residuals over 1 episode:"));
     let fitted = dir.path().join("fitted.toml");
     let out = model("fit", "test-bicycle.toml")
         .arg(&log)

@@ -323,18 +323,21 @@ mod tests {
     }
 
     /// The writer stops once `is_empty` says everything queued is on its
-    /// way: `len` and `is_empty` follow every push and pop, up to full.
+    /// way: `len` and `is_empty` follow every push and pop, up to full; the
+    /// high-water mark (the status report's) is the fullest it has been.
     #[test]
     fn len_and_is_empty_follow_pushes_and_pops() {
         let q = RecordQueue::new();
-        assert_eq!((q.len(), q.is_empty()), (0, true));
+        assert_eq!((q.len(), q.is_empty(), q.high_water()), (0, true, 0));
         for n in 1..=QUEUE_LEN {
             assert!(q.push(frame(n as u64)));
             assert!(!q.is_empty() && q.len() == n);
+            assert_eq!(q.high_water() as usize, n);
         }
         for n in (0..QUEUE_LEN).rev() {
             assert!(q.try_pop().is_some());
             assert_eq!((q.len(), q.is_empty()), (n, n == 0));
+            assert_eq!(q.high_water() as usize, QUEUE_LEN);
         }
     }
 

@@ -404,4 +404,35 @@ mod tests {
             Err(ReportError::BadLine(2))
         );
     }
+
+    /// A line without a verdict is named by its number in the file (blank
+    /// lines counted), and the message says which.
+    #[test]
+    fn a_line_without_a_verdict_is_named_by_its_number() {
+        let text = "wobble self-test 1\nimu PASS x\n\nwheel PASS y\nsteering\n";
+        let err = read_report(text, &mut |_| {}).unwrap_err();
+        assert_eq!(err, ReportError::BadLine(5));
+        assert_eq!(err.to_string(), "line 5 is not `check PASS|FAIL detail`");
+        assert!(ReportError::NotAReport.to_string().contains(HEADER));
+    }
+
+    /// The measured magnitude goes into the report to the hundredth,
+    /// rounded, also far from 1 g.
+    #[test]
+    fn the_report_shows_the_measured_acceleration() {
+        for (g, shown) in [
+            (0.87, "accel_g=0.87"),
+            (1.234, "accel_g=1.23"),
+            (2.006, "accel_g=2.01"),
+        ] {
+            let m = Measurements {
+                accel_g: Some(g),
+                ..good()
+            };
+            let mut text = String::new();
+            write_report(&m, &mut text).unwrap();
+            let imu = text.lines().nth(1).unwrap();
+            assert!(imu.starts_with("imu FAIL") && imu.ends_with(shown), "{imu}");
+        }
+    }
 }

@@ -11,8 +11,9 @@ mod gnss_support;
 use gnss_support::{Family, Receiver};
 use proptest::prelude::*;
 use wobble_core::drivers::gnss_bringup::{
-    Bringup, CommandSet, Outcome, SentenceCounter, Step, FAULT_SETUP_SILENT, FAULT_SETUP_SLOW,
-    FAULT_SETUP_UNCONFIRMED, PROBE_BAUDS, PROBE_ROUNDS,
+    Bringup, CommandSet, Heard, Outcome, SentenceCounter, Step, FAULT_SETUP_SILENT,
+    FAULT_SETUP_SLOW, FAULT_SETUP_UNCONFIRMED, PROBE_BAUDS, PROBE_LISTEN_US, PROBE_ROUNDS,
+    VERIFY_LISTEN_US,
 };
 use wobble_core::drivers::gnss_setup::TARGET_BAUD;
 
@@ -203,4 +204,66 @@ proptest! {
             prop_assert_eq!(outcome.fault().is_none(), outcome.configured.is_some() && full_rate);
         }
     }
+}
+
+/// Drives the bring-up with `answer` deciding what each listening window
+/// holds; returns the outcome and the listening windows' bauds and lengths.
+fn drive(answer: impl Fn(u32, u64) -> Heard) -> (Outcome, Vec<(u32, u64)>) {
+    let mut setup = Bringup::new();
+    let mut step = setup.step();
+    let mut listens = Vec::new();
+    for _ in 0..200 {
+        step = match step {
+            Step::Listen { baud, for_us } => {
+                listens.push((baud, for_us));
+                setup.heard(answer(baud, for_us))
+            }
+            Step::Send { .. } => setup.sent(),
+            Step::Done(outcome) => return (outcome, listens),
+        };
+    }
+    panic!("bring-up did not finish: {step:?}");
+}
+
+/// A receiver that answers every probe at 9600 but falls silent after
+/// every command set: once the sets have failed and the recheck at 9600
+/// hears nothing, the probe starts over once; after the second failure the
+/// bring-up ends unconfirmed at the baud the receiver was found at.
+#[test]
+fn a_receiver_lost_after_its_commands_is_probed_again_once() {
+    let talking = Heard {
+        valid: 20,
+        rmc: 10,
+        ..Heard::default()
+    };
+    let (outcome, listens) = drive(|baud, for_us| {
+        if baud == PROBE_BAUDS[0] && for_us == PROBE_LISTEN_US {
+            talking
+        } else {
+            Heard::default()
+        }
+    });
+    let probes = listens.iter().filter(|l| l.1 == PROBE_LISTEN_US).count();
+    let rechecks = listens
+        .iter()
+        .filter(|&&l| l == (PROBE_BAUDS[0], VERIFY_LISTEN_US))
+        .count();
+    assert_eq!((probes, rechecks), (2, 2), "{listens:?}");
+    assert_eq!(outcome.found_baud, Some(PROBE_BAUDS[0]));
+    assert_eq!(outcome.fault(), Some(FAULT_SETUP_UNCONFIRMED));
+}
+
+/// 15 epochs per second count as the 20 Hz asked for (the bring-up's
+/// `MIN_RATE_HZ`, the rate its verification accepts): not slow; one fewer
+/// is.
+#[test]
+fn fifteen_hz_is_not_slow() {
+    let outcome = |rate_hz| Outcome {
+        baud: TARGET_BAUD,
+        found_baud: Some(9_600),
+        configured: Some(CommandSet::Valset),
+        rate_hz,
+    };
+    assert_eq!(outcome(15).fault(), None);
+    assert_eq!(outcome(14).fault(), Some(FAULT_SETUP_SLOW));
 }

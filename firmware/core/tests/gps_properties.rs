@@ -1,6 +1,7 @@
 //! Property tests of the GPS path: random byte streams, random chunking and
 //! random corruption of the gpsd captures never panic and never stall the
-//! line assembler, and valid sentences after garbage are still parsed.
+//! line assembler, valid sentences after garbage are still parsed, and a
+//! corrupted sentence is rejected.
 
 mod gps_fixtures;
 
@@ -71,6 +72,14 @@ fn fixes(events: &[GpsEvent]) -> Vec<GpsFix> {
 /// checksum fields and sentence addresses.
 fn nmea_byte() -> impl Strategy<Value = u8> {
     prop::sample::select(b"$*,.\r\n-0123456789ABCDEFGNPRMCVTSZLKW".to_vec())
+}
+
+/// Whether `line` (`$body*HH`) carries the XOR of its body.
+fn checksum_holds(line: &str) -> bool {
+    let Some((body, cs)) = line.strip_prefix('$').and_then(|l| l.rsplit_once('*')) else {
+        return false;
+    };
+    u8::from_str_radix(cs, 16).is_ok_and(|cs| cs == body.bytes().fold(0u8, |a, b| a ^ b))
 }
 
 fn checksummed(body: &str) -> String {
@@ -194,7 +203,56 @@ proptest! {
         for line in &expected {
             prop_assert!(it.any(|g| g == line), "lost {}", line);
         }
+        // And no line with a wrong checksum gets through (checked here with
+        // the test's own XOR, not the assembler's).
+        for line in &got {
+            prop_assert!(checksum_holds(line), "accepted with a bad checksum: {}", line);
+        }
         let _ = receive(&corrupted);
+    }
+
+    /// One flipped bit in one valid sentence's body: exactly that sentence
+    /// is rejected, at its time, and every other line comes out as before.
+    /// (A flip changes the XOR of the body by that bit, so the checksum can
+    /// never match; flips that make a `$`, `*` or line end change the
+    /// framing instead and are left to the property above.)
+    #[test]
+    fn a_flipped_bit_rejects_exactly_its_sentence(
+        which in 0..SMALL.len(),
+        line in any::<prop::sample::Index>(),
+        at in any::<prop::sample::Index>(),
+        bit in 0u8..8,
+    ) {
+        let capture = capture(which);
+        let reference = valid_lines(&capture.bytes);
+        let candidates: Vec<&std::ops::Range<usize>> = capture
+            .lines
+            .iter()
+            .filter(|r| reference.iter().any(|(t, s)| *t == r.start as u64 * BYTE_US && !s.starts_with("$P")))
+            .collect();
+        // (`skytraq-err.log` holds no valid sentence.)
+        prop_assume!(!candidates.is_empty());
+        let range = candidates[line.index(candidates.len())];
+        let t_line = range.start as u64 * BYTE_US;
+        let star = capture.bytes[range.clone()].iter().rposition(|&b| b == b'*').unwrap();
+        let pos = range.start + 1 + at.index(star - 1);
+        let mut corrupted = capture.bytes.clone();
+        corrupted[pos] ^= 1 << bit;
+        prop_assume!(!b"$*\r\n".contains(&corrupted[pos]));
+
+        let mut asm = LineAssembler::new();
+        let (mut valid, mut rejected) = (Vec::new(), Vec::new());
+        for (i, &b) in corrupted.iter().enumerate() {
+            match asm.push(b, i as u64 * BYTE_US) {
+                Some(LineEvent::Valid { text, t_us }) => valid.push((t_us, text.to_owned())),
+                Some(LineEvent::Rejected { t_us, .. }) => rejected.push(t_us),
+                None => {}
+            }
+        }
+        let expected: Vec<(u64, String)> =
+            reference.iter().filter(|(t, _)| *t != t_line).cloned().collect();
+        prop_assert_eq!(valid, expected);
+        prop_assert!(rejected.contains(&t_line), "line at {} not rejected", t_line);
     }
 
     #[test]

@@ -40,6 +40,11 @@ fn port(expected: &[Transaction<u8>]) -> (Mock<u8>, Icm42688Port<Mock<u8>, NoopD
 #[test]
 fn stuck_and_vanished_sensors_are_set_up_again_once_per_retry() {
     let clock = MockDriver::get();
+    // `start` alone sets the sensor up, before the sampler's first tick.
+    let (mut spi, mut port_started) = port(&init());
+    block_on(port_started.start());
+    spi.done();
+
     let stuck = usize::from(ImuConfig::DEFAULT.stuck_samples);
     let mut traffic = init();
     traffic.extend(data_read(LIVE));
@@ -58,6 +63,9 @@ fn stuck_and_vanished_sensors_are_set_up_again_once_per_retry() {
     // Back a retry later.
     traffic.extend(init());
     traffic.extend(data_read(LIVE));
+    // The self-test's identity read.
+    traffic.extend(write_reg(reg::REG_BANK_SEL, 0));
+    traffic.extend(read_regs(reg::WHO_AM_I, &[reg::WHO_AM_I_VALUE]));
     let (mut spi, mut port) = port(&traffic);
 
     block_on(port.start());
@@ -89,5 +97,6 @@ fn stuck_and_vanished_sensors_are_set_up_again_once_per_retry() {
         block_on(port.read()).is_ok(),
         "set up again a retry after the failure"
     );
+    assert_eq!(block_on(port.identity()), Some(reg::WHO_AM_I_VALUE));
     spi.done();
 }

@@ -10,7 +10,7 @@ use std::cell::{Cell, RefCell};
 
 use embedded_hal_mock::eh1::delay::NoopDelay;
 use embedded_hal_mock::eh1::digital::Mock as PinMock;
-use embedded_hal_mock::eh1::spi::Mock;
+use embedded_hal_mock::eh1::spi::{Mock, Transaction};
 use embedded_sdmmc::{Block, BlockCount, BlockDevice, BlockIdx, SdCardError};
 use sd_support::*;
 use wobble_core::drivers::sdcard::{
@@ -169,6 +169,53 @@ fn repeated_crc_errors_halve_the_data_clock() {
             DATA_CLOCK_HZ / 2
         ]
     );
+    spi.done();
+    chip_select.done();
+}
+
+/// Bytes written in one transaction of their own.
+fn written(bytes: &[u8]) -> Spi {
+    vec![
+        Transaction::transaction_start(),
+        Transaction::write_vec(bytes.to_vec()),
+        Transaction::transaction_end(),
+    ]
+}
+
+/// A block write reaches the card whole: CMD24 at the block's index (an
+/// SDHC card counts blocks), the start token, the 512 bytes and their
+/// CRC16, then the card's acceptance, its busy time and its status.
+#[test]
+fn a_written_block_reaches_the_card_whole() {
+    let mut block = Block::new();
+    for (i, b) in block.contents.iter_mut().enumerate() {
+        *b = (i * 7) as u8;
+    }
+    let data_accepted = 0x05;
+    let expectations = [
+        identification([sdhc_identification(), csd_read()].concat()),
+        operation(
+            [
+                command(24, 42, R1_READY),
+                byte(0xFE, NOTHING),
+                written(&block.contents),
+                written(&crc16(&block.contents).to_be_bytes()),
+                byte(0xFF, data_accepted),
+                // Busy for a while, then free.
+                byte(0xFF, 0x00),
+                byte(0xFF, 0x00),
+                byte(0xFF, NOTHING),
+                command(13, 0, R1_READY),
+                byte(0xFF, 0x00),
+            ]
+            .concat(),
+        ),
+    ]
+    .concat();
+    let mut spi = Mock::new(&expectations);
+    let mut chip_select = PinMock::new(&cs(&[&IDENTIFY_CS[..], &OPERATION_CS].concat()));
+    let card = card(&spi, &chip_select);
+    card.write(&[block], BlockIdx(42)).expect("written");
     spi.done();
     chip_select.done();
 }

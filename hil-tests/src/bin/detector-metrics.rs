@@ -7,8 +7,9 @@
 //! cargo run -p wobble-hil --release --bin detector-metrics -- --trace NAME  # per-hop estimates as CSV
 //! cargo run -p wobble-hil --release --bin detector-metrics -- --false  # each false alert and its cause
 //! ```
-//! The corpus is generated in memory from the same code as the committed
-//! fixtures (a test asserts they are identical).
+//! Both corpus families (the signal models and the rides simulated from the
+//! bicycle model) are generated in memory from the same code as the
+//! committed fixtures (tests assert they are identical).
 
 use std::process::ExitCode;
 
@@ -72,7 +73,16 @@ fn main() -> ExitCode {
         }
         return ExitCode::SUCCESS;
     }
-    let md = metrics::markdown(&report, &no_speed);
+    let simulated = match corpus::simulated::generate()
+        .and_then(|f| metrics::evaluate(&f, &Config::default(), true))
+    {
+        Ok(r) => r,
+        Err(e) => {
+            eprintln!("detector-metrics: simulated family: {e}");
+            return ExitCode::FAILURE;
+        }
+    };
+    let md = metrics::markdown(&report, &no_speed) + &metrics::simulated_markdown(&simulated);
     if args.iter().any(|a| a == "--stdout") {
         print!("{md}");
         return ExitCode::SUCCESS;

@@ -1,4 +1,5 @@
-//! `gen-corpus`: writes (or checks) the detector corpus.
+//! `gen-corpus`: writes (or checks) the detector corpus: the signal-model
+//! family and, in `simulated/`, the rides simulated from the bicycle model.
 //!
 //! ```text
 //! cargo run -p wobble-hil --release --bin gen-corpus            # committed fixtures + manifest
@@ -33,10 +34,24 @@ fn main() -> ExitCode {
         }
     }
     let fixtures = corpus::generate();
-    let mut files = vec![(dir.join("manifest.json"), corpus::manifest_json(&fixtures))];
-    for f in &fixtures {
-        if f.truth.committed || all {
-            files.push((corpus::fixture_path(&dir, &f.truth), f.csv.clone()));
+    let simulated = match corpus::simulated::generate() {
+        Ok(f) => f,
+        Err(e) => {
+            eprintln!("gen-corpus: simulated family: {e}");
+            return ExitCode::FAILURE;
+        }
+    };
+    let sim_dir = dir.join("simulated");
+    let mut files = vec![
+        (dir.join("manifest.json"), corpus::manifest_json(&fixtures)),
+        (
+            sim_dir.join("manifest.json"),
+            corpus::simulated::manifest_json(&simulated),
+        ),
+    ];
+    for (family, dir) in [(&fixtures, &dir), (&simulated, &sim_dir)] {
+        for f in family.iter().filter(|f| f.truth.committed || all) {
+            files.push((corpus::fixture_path(dir, &f.truth), f.csv.clone()));
         }
     }
     let mut bad = 0;

@@ -15,6 +15,7 @@
 pub mod catalog;
 pub mod rng;
 pub mod signal;
+pub mod simulated;
 pub mod truth;
 
 pub use truth::{Episode, Event, FixtureTruth, Manifest};
@@ -129,4 +130,36 @@ pub fn fixture_path(dir: &Path, truth: &FixtureTruth) -> PathBuf {
     } else {
         dir.join("generated").join(&truth.file)
     }
+}
+
+/// Checks the committed files in `dir` against the generator: `manifest.json`
+/// equal to `manifest` and every committed fixture's CSV equal to its text.
+/// Returns the committed CSV bytes.
+///
+/// # Errors
+/// The first file that differs or cannot be read.
+pub fn check_committed(dir: &Path, manifest: &str, fixtures: &[Fixture]) -> Result<usize, String> {
+    let path = dir.join("manifest.json");
+    let regenerate = "run `cargo run -p wobble-hil --release --bin gen-corpus`";
+    let on_disk = std::fs::read_to_string(&path).map_err(|e| format!("{}: {e}", path.display()))?;
+    if on_disk != manifest {
+        return Err(format!(
+            "{} differs from the generator: {regenerate}",
+            path.display()
+        ));
+    }
+    let mut committed = 0;
+    for f in fixtures.iter().filter(|f| f.truth.committed) {
+        let path = fixture_path(dir, &f.truth);
+        let on_disk =
+            std::fs::read_to_string(&path).map_err(|e| format!("{}: {e}", path.display()))?;
+        if on_disk != f.csv {
+            return Err(format!(
+                "{} differs from the generator: {regenerate}",
+                path.display()
+            ));
+        }
+        committed += on_disk.len();
+    }
+    Ok(committed)
 }

@@ -2,7 +2,7 @@
 //! the Whipple benchmark bicycle (Meijaard et al. 2007) and the extended
 //! wobble model, each a pure function from parameters and forward speed to
 //! a state matrix; on top of it eigenvalues against speed, modes followed
-//! across speed, and critical speeds.
+//! across speed, and critical speeds; and their response in time.
 #![warn(missing_docs)]
 
 pub mod critical;
@@ -11,6 +11,7 @@ pub mod fit;
 pub mod model;
 pub mod multibody;
 pub mod params;
+pub mod simulate;
 pub mod sweep;
 pub mod whipple;
 pub mod wobble;

@@ -111,8 +111,12 @@ impl Sweep {
         )
     }
 
-    /// [`Self::run`] on any state matrix function with states of `roles`.
-    fn run_matrices(
+    /// [`Self::run`] on any state matrix function with states of `roles`
+    /// (a model with a controller or other states added, say).
+    ///
+    /// # Errors
+    /// As [`Self::run`].
+    pub fn run_matrices(
         state_matrix: impl Fn(f64) -> DMatrix<f64>,
         roles: &[StateRole],
         speeds_mps: &[f64],

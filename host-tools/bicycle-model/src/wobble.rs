@@ -79,6 +79,14 @@ pub struct WobbleParams {
     pub rear_tyre: Tyre,
 }
 
+/// The excitations of [`WobbleModel::input_matrix`], in input order.
+pub const INPUTS: [&str; 4] = [
+    "steer_torque",
+    "hip_torque",
+    "front_path_slope",
+    "rear_path_slope",
+];
+
 /// The state names, in state order.
 pub const STATES: [&str; 14] = [
     "phi", "phi_r", "delta", "beta", "v", "r", "dphi", "dphi_r", "ddelta", "dbeta", "alpha1'",
@@ -333,5 +341,28 @@ impl WobbleModel {
         a.view_mut((W0, T0), (N_SPEEDS, 4))
             .copy_from(&(&self.m_inv * ft));
         a
+    }
+
+    /// The 14 x 4 input matrix `B` at `speed_mps` of `x' = A x + B e`, for
+    /// the excitations `e` named by [`INPUTS`]: the rider's steer torque
+    /// (handlebar against the main frame) and hip torque (torso against the
+    /// main frame), N m, and the slope of the road's lateral irregularity
+    /// under the front and the rear tyre, rad (a path that turns by `dy/ds`
+    /// adds that to the tyre's slip angle before relaxation).
+    #[must_use]
+    pub fn input_matrix(&self, speed_mps: f64) -> DMatrix<f64> {
+        let mut forces = DMatrix::zeros(N_SPEEDS, 2);
+        forces[(2 + multibody::DELTA, 0)] = 1.0;
+        forces[(2 + multibody::PHI_R, 1)] = 1.0;
+        let mut b = DMatrix::zeros(STATES.len(), INPUTS.len());
+        b.view_mut((W0, 0), (N_SPEEDS, 2))
+            .copy_from(&(&self.m_inv * forces));
+        for (i, tyre) in [&self.params.front_tyre, &self.params.rear_tyre]
+            .into_iter()
+            .enumerate()
+        {
+            b[(T0 + 2 * i, 2 + i)] = speed_mps / tyre.relaxation_length;
+        }
+        b
     }
 }

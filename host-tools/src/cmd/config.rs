@@ -107,46 +107,7 @@ fn scan_header(path: &Path) -> Result<(Header, DecodeStats), CliError> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use wobble_core::format::header::header_records;
-    use wobble_core::format::{BlockEncoder, Frame, LogInfo, EDGE_AGE_NONE};
-
-    /// A log with the default configuration in its header and `frames`
-    /// frames after it, behind `garbage` bytes of damage.
-    fn log(frames: u64, garbage: usize) -> (tempfile::NamedTempFile, Vec<String>) {
-        let mut text = String::new();
-        Config::default().write_lines(&mut text).unwrap();
-        let lines: Vec<String> = text.lines().map(String::from).collect();
-        let info = LogInfo {
-            t_us: 0,
-            firmware: "test",
-            device_id: [7; 12],
-            sample_rate_hz: 100,
-            run: 12,
-        };
-        let mut bytes = vec![0x5a; garbage];
-        let mut encoder = BlockEncoder::new();
-        let frames = (0..frames).map(|i| {
-            Record::Frame(Frame {
-                t_us: i * 10_000,
-                accel: [0; 3],
-                gyro: [0; 3],
-                steer_cdeg: (i % 100) as i16,
-                wheel_count: 0,
-                wheel_edge_age_us: EDGE_AGE_NONE,
-                speed_mm_s: 4000,
-                status: Default::default(),
-            })
-        });
-        for rec in header_records(info, lines.iter().map(String::as_str)).chain(frames) {
-            if let Some(block) = encoder.push(&rec).unwrap() {
-                bytes.extend_from_slice(block);
-            }
-        }
-        bytes.extend_from_slice(encoder.finish().unwrap());
-        let file = tempfile::NamedTempFile::new().unwrap();
-        std::fs::write(file.path(), &bytes).unwrap();
-        (file, lines)
-    }
+    use crate::reader::tests::log;
 
     #[test]
     fn the_header_is_read_and_the_rest_is_not() {

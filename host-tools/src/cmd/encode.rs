@@ -380,3 +380,49 @@ fn gps_update(last: &Option<(u64, GpsFix)>, now: Option<GpsFix>, t_us: u64) -> O
         _ => None,
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// 2020-03-18T10:00:01.000Z, ms since 1970.
+    const MS: i64 = 1_584_525_601_000;
+
+    #[test]
+    fn a_pair_is_written_only_where_the_last_one_is_wrong() {
+        let mut syncs = SyncWriter::default();
+        assert_eq!(syncs.update(0, None), Ok(None));
+        let first = syncs.update(1_000_000, Some(MS)).unwrap().unwrap();
+        assert_eq!((first.t_us, first.unix_ms), (1_000_000, MS as u64));
+        // 10 ms later the pair gives 10 ms more, to the microsecond.
+        assert_eq!(syncs.update(1_010_000, Some(MS + 10)), Ok(None));
+        // 9.999 ms later it gives 9 ms (decode rounds down).
+        assert_eq!(syncs.update(1_009_999, Some(MS + 9)), Ok(None));
+        // A clock 1 ms off: a new pair at this frame.
+        let next = syncs.update(1_020_000, Some(MS + 21)).unwrap().unwrap();
+        assert_eq!((next.t_us, next.unix_ms), (1_020_000, MS as u64 + 21));
+        assert_eq!(syncs.update(1_030_000, Some(MS + 31)), Ok(None));
+    }
+
+    #[test]
+    fn utc_cannot_stop_or_leave_the_gps_years() {
+        let mut syncs = SyncWriter::default();
+        assert!(syncs
+            .update(0, Some(0))
+            .unwrap_err()
+            .contains("2000 to 2099"));
+        assert!(syncs.update(0, Some(4_102_444_800_000)).is_err());
+        assert!(syncs.update(0, Some(4_102_444_799_999)).unwrap().is_some());
+        assert!(syncs
+            .update(10_000, None)
+            .unwrap_err()
+            .contains("cannot stop"));
+    }
+
+    #[test]
+    fn the_utc_cell_is_named_by_its_column() {
+        let header = csv::StringRecord::from(vec!["t_s", "steer_deg", "utc"]);
+        let cell = Columns::new(&header).utc_cell(7);
+        assert_eq!((cell.line, cell.column, cell.name), (7, 3, "utc"));
+    }
+}

@@ -225,6 +225,32 @@ mod tests {
         assert!(run(&with_crlf(line))[0].is_ok());
     }
 
+    /// Every checksum a line can have, so every digit in either case: the
+    /// XOR of the bytes between `$` and `*` (NMEA 0183; ASCII, so 0 to
+    /// 0x7f), written in upper or lower case, is accepted; one off is not.
+    #[test]
+    fn every_checksum_reads_in_either_case() {
+        let prefix = b"GPTXT,";
+        let c = prefix.iter().fold(0u8, |a, &b| a ^ b);
+        for sum in 0..0x80u8 {
+            // Two digits or letters that make the line's XOR `sum`.
+            let (x, y) = (b'0'..=b'z')
+                .flat_map(|x| (b'0'..=b'z').map(move |y| (x, y)))
+                .find(|&(x, y)| c ^ x ^ y == sum)
+                .expect("a pair");
+            let body = format!("GPTXT,{}{}", char::from(x), char::from(y));
+            for text in [format!("${body}*{sum:02X}"), format!("${body}*{sum:02x}")] {
+                assert!(run(&with_crlf(text.as_bytes()))[0].is_ok(), "{text}");
+            }
+            let wrong = format!("${body}*{:02x}", sum ^ 1);
+            assert_eq!(
+                run(&with_crlf(wrong.as_bytes())),
+                [Err((LineError::Checksum, false, 0))],
+                "{wrong}"
+            );
+        }
+    }
+
     #[test]
     fn checksum_errors() {
         let mut bad = RMC.to_vec();
@@ -254,6 +280,20 @@ mod tests {
         assert_eq!(
             run(b"$POLYN,TIME,RESTART_OCCURRED\r\n"),
             [Err((LineError::NoChecksum, true, 0))]
+        );
+    }
+
+    /// A line that is only its `$` is no proprietary sentence, whatever
+    /// the line before it left in the buffer.
+    #[test]
+    fn a_bare_dollar_is_not_proprietary_after_a_proprietary_line() {
+        let out = run(b"$POLYN,TIME\r\n$\r\n");
+        assert_eq!(
+            out,
+            [
+                Err((LineError::NoChecksum, true, 0)),
+                Err((LineError::NoChecksum, false, 13))
+            ]
         );
     }
 

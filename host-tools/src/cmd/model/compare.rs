@@ -99,7 +99,8 @@ fn residual_table(found: &[LoggedEpisode], wobble: &[wobble_model::Complex<f64>]
     if n > 0 {
         let _ = writeln!(
             o,
-            "rms residuals over {n} episodes: {:.3} Hz, {:.3} 1/s",
+            "rms residuals over {}: {:.3} Hz, {:.3} 1/s",
+            crate::words::plural(n, "episode"),
             (sf / n as f64).sqrt(),
             (ss / n as f64).sqrt()
         );
