@@ -89,6 +89,13 @@ pub struct Summary {
     /// what places a UTC time on the log's clock.
     #[serde(skip)]
     pub utc_syncs: Vec<crate::time::SyncPair>,
+    /// Earliest and latest frame time, s (whatever their order in the file).
+    #[serde(skip)]
+    pub frame_range_s: Option<(f64, f64)>,
+    /// The stretch between time jumps with the most frames: first and last
+    /// frame time, s, and its frames.
+    #[serde(skip)]
+    pub longest_segment: Option<((f64, f64), u64)>,
 }
 
 impl Summary {
@@ -97,6 +104,21 @@ impl Summary {
     #[must_use]
     pub fn frame_rate_hz(&self) -> f64 {
         f64::from(self.sample_rate_hz.unwrap_or(100).max(1))
+    }
+
+    /// The span a plot of the whole run covers: the earliest to the latest
+    /// frame, unless time jumps leave most of that span empty (more than
+    /// twice the time the frames cover: a stray block with absurd times, a
+    /// clock that leapt by days), then the stretch between jumps with the
+    /// most frames. The flag says the span was narrowed so.
+    #[must_use]
+    pub fn plot_span_s(&self) -> Option<((f64, f64), bool)> {
+        let (lo, hi) = self.frame_range_s?;
+        let covered = self.duration_s.max(1.0);
+        match self.longest_segment {
+            Some((stretch, _)) if hi - lo > 2.0 * covered => Some((stretch, true)),
+            _ => Some(((lo, hi), false)),
+        }
     }
 }
 
@@ -108,6 +130,8 @@ pub struct SummaryBuilder {
     span_us: Option<(u64, u64)>,
     /// Time covered by the segments before it, µs.
     closed_us: u64,
+    /// Frames of the current segment.
+    segment_frames: u64,
     rows: RowAssembler,
     rows_with_gps: u64,
 }
@@ -133,6 +157,9 @@ impl SummaryBuilder {
                 s.samples += 1;
                 s.start_s.get_or_insert(t_s);
                 s.end_s = Some(t_s);
+                let (lo, hi) = s.frame_range_s.unwrap_or((t_s, t_s));
+                s.frame_range_s = Some((lo.min(t_s), hi.max(t_s)));
+                self.segment_frames += 1;
                 let first = self.span_us.map_or(f.t_us, |(first, _)| first);
                 self.span_us = Some((first, f.t_us));
             }
@@ -197,6 +224,15 @@ impl SummaryBuilder {
         if let Some((first, last)) = self.span_us.take() {
             self.closed_us += last.saturating_sub(first).saturating_add(self.period_us());
             self.summary.segments += 1;
+            let frames = std::mem::take(&mut self.segment_frames);
+            if self
+                .summary
+                .longest_segment
+                .is_none_or(|(_, most)| frames > most)
+            {
+                let span_s = (first as f64 / 1e6, last as f64 / 1e6);
+                self.summary.longest_segment = Some((span_s, frames));
+            }
         }
     }
 

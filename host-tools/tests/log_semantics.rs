@@ -96,6 +96,77 @@ fn a_block_of_far_future_frames_in_front_holds_nothing_back() {
 }
 
 #[test]
+fn a_clock_that_jumps_at_every_block_warns_in_a_few_lines() {
+    let dir = tempfile::tempdir().unwrap();
+    let log = dir.path().join("jumps.wbl");
+    // A day forward every 50 frames.
+    let frames = (0..5000u64).map(|i| frame((i / 50) * 86_400_000_000 + i * 10_000));
+    write_log(&log, info("fw", 100), &[], frames);
+    assert_eq!(info_json(&log)["forward_time_jumps"], 99);
+    for (command, output) in [("plot", "jumps.png"), ("decode", "jumps.csv")] {
+        let out = wobblog()
+            .arg(command)
+            .arg(&log)
+            .arg("-o")
+            .arg(dir.path().join(output))
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(out.status.success(), "{command}: {stderr}");
+        assert_eq!(
+            stderr.matches("time jumps forward").count(),
+            10,
+            "{command}: {stderr}"
+        );
+        assert!(
+            stderr.contains("more losses not shown here"),
+            "{command}: {stderr}"
+        );
+        assert!(stderr.lines().count() <= 12, "{command}: {stderr}");
+    }
+}
+
+#[test]
+fn a_run_behind_far_future_frames_is_plotted_over_its_own_stretch() {
+    let dir = tempfile::tempdir().unwrap();
+    let log = dir.path().join("front.wbl");
+    let far = 1u64 << 62;
+    let frames = (0..20)
+        .map(|i| frame(far + i * 10_000))
+        .chain((0..3000).map(|i| frame(i * 10_000)));
+    write_log(&log, info("fw", 100), &[], frames);
+    let png = dir.path().join("front.png");
+    let out = wobblog()
+        .arg("plot")
+        .arg(&log)
+        .arg("-o")
+        .arg(&png)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    assert!(
+        stderr.contains("plotting its longest stretch, 0.00 to 29.99 s (3000 of 3020 frames)"),
+        "{stderr}"
+    );
+    assert!(std::fs::metadata(&png).unwrap().len() > 0);
+    // One back jump: one warning of it, and nothing held back.
+    assert_eq!(stderr.matches("time jumps back").count(), 1, "{stderr}");
+    // A window asked for is plotted where it lies, without the warning.
+    let window = dir.path().join("window.png");
+    let out = wobblog()
+        .arg("plot")
+        .arg(&log)
+        .args(["--from", "5", "--to", "10", "-o"])
+        .arg(&window)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    assert!(!stderr.contains("longest stretch"), "{stderr}");
+}
+
+#[test]
 fn an_impossible_sample_rate_is_reported_and_the_default_used() {
     let dir = tempfile::tempdir().unwrap();
     for rate in [0u16, 65_535] {

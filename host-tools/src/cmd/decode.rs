@@ -82,7 +82,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         result => result?,
     };
     out.commit()?;
-    for line in losses.describe() {
+    for line in crate::cmd::logs::warnings(&losses) {
         eprintln!("wobblog: {}: warning: {line}", args.log.display());
     }
     Ok(())

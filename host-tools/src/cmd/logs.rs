@@ -6,6 +6,7 @@ use std::path::{Path, PathBuf};
 
 use indicatif::{ProgressBar, ProgressStyle};
 
+use crate::losses::Losses;
 use crate::output::Output;
 use crate::summary::Summary;
 use crate::CliError;
@@ -46,12 +47,30 @@ pub fn for_each_log(
     }
 }
 
+/// Loss warnings printed per log; `info` and `events` list the rest.
+const WARNINGS_SHOWN: usize = 10;
+
 /// Prints what a partly readable run lost, so results from it are read
 /// with care.
 pub fn warn_losses(log: &Path, summary: &Summary) {
-    for line in summary.losses.describe() {
+    for line in warnings(&summary.losses) {
         eprintln!("wobblog: {}: warning: {line}", log.display());
     }
+}
+
+/// The first [`WARNINGS_SHOWN`] lines of what `losses` describes, then one
+/// line pointing to the rest: a log damaged all through must not flood the
+/// terminal.
+pub fn warnings(losses: &Losses) -> Vec<String> {
+    let mut lines = losses.describe();
+    if lines.len() > WARNINGS_SHOWN {
+        lines.truncate(WARNINGS_SHOWN);
+        lines.push(
+            "more losses not shown here: `wobblog info` counts them all, `wobblog events` lists them"
+                .to_string(),
+        );
+    }
+    lines
 }
 
 /// Writes `text` to standard output. A closed pipe (`| head`) ends the

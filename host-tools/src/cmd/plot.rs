@@ -8,6 +8,7 @@ use crate::cmd::logs::warn_losses;
 use crate::output::Output;
 use crate::plot::timeplot::TimePlotBuilder;
 use crate::plot::{render, ImageKind};
+use crate::summary::Summary;
 use crate::time::WindowArgs;
 use crate::CliError;
 
@@ -46,13 +47,22 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         ));
     }
     let no_frames = || CliError::file(&args.log, "no frames in the requested time window");
-    let (Some(first), Some(last)) = (summary.start_s, summary.end_s) else {
+    let Some((span_s, narrowed)) = summary.plot_span_s() else {
         return Err(CliError::file(&args.log, "no frames in the log"));
+    };
+    let data_s = if window_s.0.is_some() || window_s.1.is_some() {
+        // A window asked for is plotted wherever it lies.
+        summary.frame_range_s.unwrap_or(span_s)
+    } else {
+        if narrowed {
+            warn_narrowed(&args.log, &summary, span_s);
+        }
+        span_s
     };
     let name = log_name(&args.log);
     let fs_hz = summary.frame_rate_hz();
-    let mut builder = TimePlotBuilder::new(&name, &summary, (first, last), fs_hz, window_s)
-        .ok_or_else(no_frames)?;
+    let mut builder =
+        TimePlotBuilder::new(&name, &summary, data_s, fs_hz, window_s).ok_or_else(no_frames)?;
     read_rows(&args.log, |_| {}, |row| builder.push_row(row))?;
     let mut figure = builder.finish();
     if figure.is_empty() {
@@ -62,4 +72,15 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         figure.label_utc(pairs.clone());
     }
     render(&figure, out)
+}
+
+/// Says which stretch a run cut by time jumps is plotted over.
+fn warn_narrowed(log: &std::path::Path, summary: &Summary, (from, to): (f64, f64)) {
+    let frames = summary.longest_segment.map_or(0, |(_, n)| n);
+    eprintln!(
+        "{}: time jumps leave most of the run's time span empty; plotting its longest stretch, \
+         {from:.2} to {to:.2} s ({frames} of {} frames); --from/--to plot another",
+        log.display(),
+        summary.samples
+    );
 }
