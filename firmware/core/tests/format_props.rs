@@ -293,6 +293,37 @@ proptest! {
         prop_assert_eq!(records(&pieces), records(&whole));
     }
 
+    /// Damage, garbage and a cut tail too: every event and every total is
+    /// the same however the file is cut into chunks (one damaged stretch is
+    /// one `Skipped`, even across a chunk's end).
+    #[test]
+    fn damaged_files_decode_the_same_in_any_chunks(
+        specs in ride(),
+        flips in vec((any::<prop::sample::Index>(), 0usize..BLOCK_LEN, 1u8..=255), 0..6),
+        garbage in vec(any::<u8>(), 0..1500),
+        garbage_at in any::<prop::sample::Index>(),
+        cut in 0usize..BLOCK_LEN,
+        chunk in 1usize..3000,
+    ) {
+        let (mut file, blocks) = encode(&specs);
+        for (block, byte, mask) in &flips {
+            file[block.index(blocks.len()) * BLOCK_LEN + byte] ^= mask;
+        }
+        let at = garbage_at.index(blocks.len() + 1) * BLOCK_LEN;
+        file.splice(at..at, garbage);
+        file.truncate(file.len() - cut.min(file.len()));
+        let (whole, whole_stats) = decode(&file);
+        let mut dec = Decoder::new();
+        let mut pieces = Vec::new();
+        let mut start = 0;
+        while start < file.len() {
+            let end = (start + chunk.max(BLOCK_LEN)).min(file.len());
+            start += dec.feed(&file[start..end], end == file.len(), &mut |e| pieces.push(e));
+        }
+        prop_assert_eq!(&pieces, &whole);
+        prop_assert_eq!(dec.stats(), &whole_stats);
+    }
+
     #[test]
     fn damage_loses_exactly_the_damaged_blocks(
         specs in ride(),

@@ -170,6 +170,10 @@ pub struct Decoder {
     period_us: u64,
     /// Offset in the stream of the next byte the decoder will look at.
     offset: u64,
+    /// A stretch of skipped bytes still open when the last chunk ended:
+    /// its first byte's stream offset and why. Reported once it ends, so
+    /// one damaged stretch is one event whatever the chunks.
+    open_skip: Option<(u64, SkipCause)>,
 }
 
 impl Decoder {
@@ -179,7 +183,8 @@ impl Decoder {
         Self::default()
     }
 
-    /// Totals so far.
+    /// Totals so far (a stretch of skipped bytes counts once it ends: at
+    /// the next valid block, or at the end of the stream).
     #[must_use]
     pub fn stats(&self) -> &DecodeStats {
         &self.stats
@@ -196,8 +201,11 @@ impl Decoder {
         visit: &mut impl FnMut(Event<'c>),
     ) -> usize {
         let mut pos = 0;
-        // A stretch of bytes being skipped, reported once it ends.
-        let mut skip: Option<(usize, SkipCause)> = None;
+        // A stretch of bytes being skipped (from this stream offset),
+        // reported once it ends.
+        let mut skip: Option<(u64, SkipCause)> = self.open_skip.take();
+        let base = self.offset;
+        let at = |pos: usize| base + pos as u64;
         while chunk.len() - pos >= BLOCK_LEN {
             let block = as_block(&chunk[pos..]);
             match BlockHeader::parse(block) {
@@ -207,7 +215,7 @@ impl Decoder {
                     if skip.is_some_and(|(_, c)| c != SkipCause::Repeated) {
                         self.flush_skip(&mut skip, chunk, pos, visit);
                     }
-                    skip.get_or_insert((pos, SkipCause::Repeated));
+                    skip.get_or_insert((at(pos), SkipCause::Repeated));
                     pos += BLOCK_LEN;
                 }
                 Ok(header) => {
@@ -220,7 +228,7 @@ impl Decoder {
                         self.flush_skip(&mut skip, chunk, pos, visit);
                     }
                     if skip.is_none() {
-                        skip = Some((pos, cause_of(err)));
+                        skip = Some((at(pos), cause_of(err)));
                         if err == BlockError::BadCrc {
                             self.stats.damaged_blocks += 1;
                         }
@@ -230,17 +238,21 @@ impl Decoder {
             }
         }
         if at_end && pos < chunk.len() {
-            skip.get_or_insert((pos, SkipCause::TruncatedTail));
+            skip.get_or_insert((at(pos), SkipCause::TruncatedTail));
             pos = chunk.len();
         }
-        self.flush_skip(&mut skip, chunk, pos, visit);
+        if at_end {
+            self.flush_skip(&mut skip, chunk, pos, visit);
+        } else {
+            self.open_skip = skip;
+        }
         self.offset += pos as u64;
         pos
     }
 
     fn flush_skip<'c>(
         &mut self,
-        skip: &mut Option<(usize, SkipCause)>,
+        skip: &mut Option<(u64, SkipCause)>,
         chunk: &'c [u8],
         end: usize,
         visit: &mut impl FnMut(Event<'c>),
@@ -248,13 +260,13 @@ impl Decoder {
         let Some((start, cause)) = skip.take() else {
             return;
         };
-        let len = (end.min(chunk.len()) - start) as u64;
+        let len = self.offset + end.min(chunk.len()) as u64 - start;
         if len == 0 {
             return;
         }
         self.stats.bytes_skipped += len;
         visit(Event::Skipped {
-            offset: self.offset + start as u64,
+            offset: start,
             len,
             cause,
         });
