@@ -379,6 +379,73 @@ mod tests {
     }
 
     #[test]
+    fn the_widest_window_keeps_both_of_its_windows() {
+        // Constant acceleration from 3 m/s at 2 m/s^2: the mean over one
+        // 63-edge window lags the speed at its newest edge by about 10 %;
+        // with the window before it the estimate extrapolates to the edge.
+        let config = WheelConfig {
+            window_edges: MAX_WINDOW_EDGES,
+            max_window_us: 5_000_000,
+            ..WheelConfig::DEFAULT
+        };
+        let mut w = WheelSpeed::try_new(config).unwrap();
+        let (v0, a, pitch) = (3.0f64, 2.0f64, f64::from(config.pitch_m()));
+        let t_s = |n: u32| (-v0 + (v0 * v0 + 2.0 * a * f64::from(n) * pitch).sqrt()) / a;
+        for n in 0..400 {
+            assert_eq!(w.on_edge((t_s(n) * 1e6) as u64), Edge::Accepted);
+        }
+        let newest = t_s(399);
+        let truth = v0 + a * newest;
+        let speed = f64::from(w.speed_mps((newest * 1e6) as u64));
+        assert!(
+            (speed - truth).abs() < 0.005 * truth,
+            "{speed} against {truth}"
+        );
+    }
+
+    #[test]
+    fn a_wheel_turning_one_hole_per_timeout_still_has_a_speed() {
+        let d = WheelConfig::DEFAULT;
+        let mut w = WheelSpeed::try_new(d).unwrap();
+        let step = u64::from(d.timeout_us);
+        for i in 0..10 {
+            assert_eq!(w.on_edge(1_000 + i * step), Edge::Accepted);
+        }
+        let newest = 1_000 + 9 * step;
+        let expected = d.pitch_m() * 1e6 / step as f32;
+        let speed = w.speed_mps(newest);
+        assert!((speed - expected).abs() < 1e-3 * expected, "{speed}");
+    }
+
+    #[test]
+    fn every_configuration_error_says_what_is_wrong() {
+        use std::string::ToString;
+        let all = [
+            WheelConfigError::Circumference,
+            WheelConfigError::NoHoles,
+            WheelConfigError::Window,
+            WheelConfigError::GlitchFraction,
+            WheelConfigError::Timeout,
+        ];
+        let texts: std::vec::Vec<_> = all.iter().map(ToString::to_string).collect();
+        for (error, text) in all.iter().zip(&texts) {
+            assert!(
+                text.starts_with("wheel") || text.contains("wheel"),
+                "{error:?}: {text}"
+            );
+        }
+        let mut unique = texts.clone();
+        unique.sort();
+        unique.dedup();
+        assert_eq!(unique.len(), all.len(), "{texts:?}");
+        assert!(
+            texts[2].contains(&MAX_WINDOW_EDGES.to_string()),
+            "{}",
+            texts[2]
+        );
+    }
+
+    #[test]
     fn single_edge_gives_no_speed_yet() {
         let mut w = WheelSpeed::try_new(WheelConfig::default()).unwrap();
         assert!(w.sample(0).stopped);
