@@ -46,7 +46,7 @@ targets=(
   "nmea-lines|wobble-core|firmware/core/src/gps/line.rs|.|--lib --test gps_properties --test gps_captures"
   "edge-time|wobble-core|firmware/core/src/wheel_capture.rs|.|--lib --test wheel_capture_props"
   "queue|wobble-core|firmware/core/src/channels.rs|RecordQueue|--lib"
-  "episode-fit|wobblog|host-tools/src/analysis/episodes.rs|measure|--test analysis_corpus --test analysis_residual"
+  "episode-fit|wobblog|host-tools/src/analysis/episodes.rs|measure|--test analysis_corpus --test analysis_residual --test censored_episodes --test streaming_analysis"
   "wheel|wobble-core|firmware/core/src/wheel.rs|.|--lib --test wheel_sensor"
   "sdcard|wobble-core|firmware/core/src/drivers/sdcard.rs|.|--test sd_init --test sd_init_no_card --test sd_operation --test sd_reidentify"
   "gnss-bringup|wobble-core|firmware/core/src/drivers/gnss_bringup.rs|.|--test gnss_bringup --test gnss_setup --test gps_setup_runner"
