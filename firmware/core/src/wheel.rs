@@ -418,6 +418,57 @@ mod tests {
     }
 
     #[test]
+    fn the_thresholds_themselves_are_not_bounce_nor_glitch() {
+        let d = WheelConfig::DEFAULT;
+        // Exactly the minimum interval: an edge, not bounce.
+        let mut w = WheelSpeed::try_new(d).unwrap();
+        w.on_edge(1_000);
+        let at_min = 1_000 + u64::from(d.min_edge_interval_us);
+        assert_eq!(w.on_edge(at_min), Edge::Accepted);
+        // Exactly the glitch fraction of the median interval: an edge.
+        let mut w = WheelSpeed::try_new(d).unwrap();
+        for i in 0..5 {
+            w.on_edge(10_000 * i);
+        }
+        assert_eq!(w.on_edge(40_000 + 5_000), Edge::Accepted);
+        let mut w = WheelSpeed::try_new(d).unwrap();
+        for i in 0..5 {
+            w.on_edge(10_000 * i);
+        }
+        assert_eq!(w.on_edge(40_000 + 4_999), Edge::Glitch);
+    }
+
+    #[test]
+    fn two_edges_give_a_speed() {
+        let d = WheelConfig::DEFAULT;
+        let mut w = WheelSpeed::try_new(d).unwrap();
+        w.on_edge(100_000);
+        w.on_edge(110_000);
+        let expected = d.pitch_m() * 1e6 / 10_000.0;
+        assert!((w.speed_mps(110_000) - expected).abs() < 1e-4 * expected);
+    }
+
+    #[test]
+    fn at_low_speed_the_window_shrinks_to_its_time_span() {
+        // 20 edges 100 ms apart, then 40 edges 50 ms apart: a 50-edge
+        // window would reach back into the slow part (17 % low); one of
+        // at most 1 s holds only the last 20 intervals.
+        let d = WheelConfig::DEFAULT;
+        let mut w = WheelSpeed::try_new(d).unwrap();
+        let mut t = 0;
+        for i in 0..60 {
+            t += if i < 20 { 100_000 } else { 50_000 };
+            assert_eq!(w.on_edge(t), Edge::Accepted);
+        }
+        let expected = d.pitch_m() * 1e6 / 50_000.0;
+        let speed = w.speed_mps(t);
+        assert!(
+            (speed - expected).abs() < 1e-3 * expected,
+            "{speed} against {expected}"
+        );
+    }
+
+    #[test]
     fn every_configuration_error_says_what_is_wrong() {
         use std::string::ToString;
         let all = [
