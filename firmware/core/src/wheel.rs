@@ -469,6 +469,27 @@ mod tests {
     }
 
     #[test]
+    fn one_interval_longer_than_the_window_span_still_gives_its_speed() {
+        // A timeout beyond the window's span: a single 1.5 s interval is
+        // longer than the window may reach, yet it is the one measurement.
+        let config = WheelConfig {
+            timeout_us: 3_000_000,
+            ..WheelConfig::DEFAULT
+        };
+        let mut w = WheelSpeed::try_new(config).unwrap();
+        for i in 0..4 {
+            w.on_edge(1_000 + i * 1_500_000);
+        }
+        let newest = 1_000 + 3 * 1_500_000;
+        let expected = config.pitch_m() * 1e6 / 1_500_000.0;
+        let speed = w.speed_mps(newest);
+        assert!(
+            (speed - expected).abs() < 1e-3 * expected,
+            "{speed} against {expected}"
+        );
+    }
+
+    #[test]
     fn every_configuration_error_says_what_is_wrong() {
         use std::string::ToString;
         let all = [
