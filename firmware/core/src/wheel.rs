@@ -490,6 +490,28 @@ mod tests {
     }
 
     #[test]
+    fn an_overdue_edge_bounds_the_speed_by_one_pitch_per_age() {
+        // 20 ms per hole, then the edges stop: once an edge is a quarter
+        // of an interval late, the speed is at most 1.25 pitches per age.
+        let d = WheelConfig::DEFAULT;
+        let mut w = WheelSpeed::try_new(d).unwrap();
+        for i in 0..60 {
+            w.on_edge(i * 20_000);
+        }
+        let newest = 59 * 20_000;
+        let steady = d.pitch_m() * 1e6 / 20_000.0;
+        assert!((w.speed_mps(newest + 20_000) - steady).abs() < 1e-3 * steady);
+        for age in [40_000u64, 100_000, 300_000] {
+            let bound = d.pitch_m() * 1.25e6 / age as f32;
+            let speed = w.speed_mps(newest + age);
+            assert!(
+                (speed - bound).abs() < 1e-3 * bound,
+                "age {age}: {speed} against {bound}"
+            );
+        }
+    }
+
+    #[test]
     fn every_configuration_error_says_what_is_wrong() {
         use std::string::ToString;
         let all = [
