@@ -415,6 +415,9 @@ mod tests {
         let expected = d.pitch_m() * 1e6 / step as f32;
         let speed = w.speed_mps(newest);
         assert!((speed - expected).abs() < 1e-3 * expected, "{speed}");
+        // Stopped only once the timeout has passed.
+        assert!(!w.is_stopped(newest + step));
+        assert!(w.is_stopped(newest + step + 1));
     }
 
     #[test]
@@ -543,6 +546,7 @@ mod tests {
     fn single_edge_gives_no_speed_yet() {
         let mut w = WheelSpeed::try_new(WheelConfig::default()).unwrap();
         assert!(w.sample(0).stopped);
+        assert_eq!(w.sample(0).last_edge_us, None);
         w.on_edge(1000);
         let s = w.sample(2000);
         assert_eq!(
