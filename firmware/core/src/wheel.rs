@@ -334,6 +334,15 @@ impl WheelSpeed {
 mod tests {
     use super::*;
 
+    /// The estimate at `now_us` is `expected` to 0.1 %.
+    fn assert_speed(w: &WheelSpeed, now_us: u64, expected: f32) {
+        let speed = w.speed_mps(now_us);
+        assert!(
+            (speed - expected).abs() < 1e-3 * expected,
+            "{speed} against {expected}"
+        );
+    }
+
     #[test]
     fn defaults_are_valid_and_match_the_bike() {
         let w = WheelSpeed::try_new(WheelConfig::default()).unwrap();
@@ -412,9 +421,7 @@ mod tests {
             assert_eq!(w.on_edge(1_000 + i * step), Edge::Accepted);
         }
         let newest = 1_000 + 9 * step;
-        let expected = d.pitch_m() * 1e6 / step as f32;
-        let speed = w.speed_mps(newest);
-        assert!((speed - expected).abs() < 1e-3 * expected, "{speed}");
+        assert_speed(&w, newest, d.pitch_m() * 1e6 / step as f32);
         // Stopped only once the timeout has passed.
         assert!(!w.is_stopped(newest + step));
         assert!(w.is_stopped(newest + step + 1));
@@ -447,8 +454,7 @@ mod tests {
         let mut w = WheelSpeed::try_new(d).unwrap();
         w.on_edge(100_000);
         w.on_edge(110_000);
-        let expected = d.pitch_m() * 1e6 / 10_000.0;
-        assert!((w.speed_mps(110_000) - expected).abs() < 1e-4 * expected);
+        assert_speed(&w, 110_000, d.pitch_m() * 1e6 / 10_000.0);
     }
 
     #[test]
@@ -463,12 +469,7 @@ mod tests {
             t += if i < 20 { 100_000 } else { 50_000 };
             assert_eq!(w.on_edge(t), Edge::Accepted);
         }
-        let expected = d.pitch_m() * 1e6 / 50_000.0;
-        let speed = w.speed_mps(t);
-        assert!(
-            (speed - expected).abs() < 1e-3 * expected,
-            "{speed} against {expected}"
-        );
+        assert_speed(&w, t, d.pitch_m() * 1e6 / 50_000.0);
     }
 
     #[test]
@@ -484,12 +485,7 @@ mod tests {
             w.on_edge(1_000 + i * 1_500_000);
         }
         let newest = 1_000 + 3 * 1_500_000;
-        let expected = config.pitch_m() * 1e6 / 1_500_000.0;
-        let speed = w.speed_mps(newest);
-        assert!(
-            (speed - expected).abs() < 1e-3 * expected,
-            "{speed} against {expected}"
-        );
+        assert_speed(&w, newest, config.pitch_m() * 1e6 / 1_500_000.0);
     }
 
     #[test]
@@ -502,15 +498,9 @@ mod tests {
             w.on_edge(i * 20_000);
         }
         let newest = 59 * 20_000;
-        let steady = d.pitch_m() * 1e6 / 20_000.0;
-        assert!((w.speed_mps(newest + 20_000) - steady).abs() < 1e-3 * steady);
+        assert_speed(&w, newest + 20_000, d.pitch_m() * 1e6 / 20_000.0);
         for age in [40_000u64, 100_000, 300_000] {
-            let bound = d.pitch_m() * 1.25e6 / age as f32;
-            let speed = w.speed_mps(newest + age);
-            assert!(
-                (speed - bound).abs() < 1e-3 * bound,
-                "age {age}: {speed} against {bound}"
-            );
+            assert_speed(&w, newest + age, d.pitch_m() * 1.25e6 / age as f32);
         }
     }
 
