@@ -305,6 +305,11 @@ fn opt(v: Option<f64>, prec: usize) -> String {
     v.map_or("-".to_owned(), |x| format!("{x:.prec$}"))
 }
 
+/// Episodes the detector found, of all: `found / all`.
+fn detected(r: &Report) -> String {
+    format!("{} / {}", r.episodes.len() - r.missed(), r.episodes.len())
+}
+
 /// The metrics file (`hil-tests/fixtures/corpus/METRICS.md`): the detector
 /// with the speed (as on the bike, where the goals apply) and without it (a
 /// CSV without `speed_mps`).
@@ -328,7 +333,6 @@ pub fn markdown(with_speed: &Report, without_speed: &Report) -> String {
         s,
         "| metric | goal | with speed (firmware) | steering only |\n|---|---|---|---|"
     );
-    let detected = |r: &Report| format!("{} / {}", r.episodes.len() - r.missed(), r.episodes.len());
     let _ = writeln!(
         s,
         "| episodes detected | all | {} | {} |",
@@ -455,12 +459,7 @@ pub fn simulated_markdown(r: &Report) -> String {
         s,
         "| metric | goal | with speed (firmware) |\n|---|---|---|"
     );
-    let _ = writeln!(
-        s,
-        "| episodes detected | all | {} / {} |",
-        r.episodes.len() - r.missed(),
-        r.episodes.len()
-    );
+    let _ = writeln!(s, "| episodes detected | all | {} |", detected(r));
     let _ = writeln!(
         s,
         "| median / worst alert latency | <= {} / {} s | {} / {} s |",

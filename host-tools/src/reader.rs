@@ -156,8 +156,7 @@ pub(crate) mod tests {
     fn chunks_grow_from_any_first_length_and_cover_the_file() {
         let (file, _) = log(60_000, 700);
         let len = std::fs::metadata(file.path()).unwrap().len();
-        // Records passed on, and bytes reported skipped (a skip that spans
-        // chunks is reported in parts).
+        // Records passed on, and bytes reported skipped.
         let count = |(records, skipped): &mut (u64, u64), event: Event<'_>| match event {
             Event::Record(_) => *records += 1,
             Event::Skipped { len, .. } => *skipped += len,

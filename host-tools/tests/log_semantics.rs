@@ -74,15 +74,22 @@ fn a_forward_jump_of_days_is_counted_and_left_out_of_the_duration() {
     );
 }
 
-#[test]
-fn a_block_of_far_future_frames_in_front_holds_nothing_back() {
-    let dir = tempfile::tempdir().unwrap();
-    let log = dir.path().join("front.wbl");
+/// `front.wbl` in `dir`: a block of 20 frames at 2^62 µs, then 30 s of
+/// frames from 0 s.
+fn front_log(dir: &std::path::Path) -> std::path::PathBuf {
+    let log = dir.join("front.wbl");
     let far = 1u64 << 62;
     let frames = (0..20)
         .map(|i| frame(far + i * 10_000))
         .chain((0..3000).map(|i| frame(i * 10_000)));
     write_log(&log, info("fw", 100), &[], frames);
+    log
+}
+
+#[test]
+fn a_block_of_far_future_frames_in_front_holds_nothing_back() {
+    let dir = tempfile::tempdir().unwrap();
+    let log = front_log(dir.path());
     let j = info_json(&log);
     assert_eq!(j["time_jumps"], 1);
     assert_eq!(j["segments"], 2);
@@ -129,12 +136,7 @@ fn a_clock_that_jumps_at_every_block_warns_in_a_few_lines() {
 #[test]
 fn a_run_behind_far_future_frames_is_plotted_over_its_own_stretch() {
     let dir = tempfile::tempdir().unwrap();
-    let log = dir.path().join("front.wbl");
-    let far = 1u64 << 62;
-    let frames = (0..20)
-        .map(|i| frame(far + i * 10_000))
-        .chain((0..3000).map(|i| frame(i * 10_000)));
-    write_log(&log, info("fw", 100), &[], frames);
+    let log = front_log(dir.path());
     let png = dir.path().join("front.png");
     let out = wobblog()
         .arg("plot")

@@ -225,6 +225,21 @@ fn decode(file: &[u8]) -> (Vec<Event<'_>>, DecodeStats) {
     (events, *dec.stats())
 }
 
+/// Decodes `file` fed in chunks of `chunk` bytes (at least a block), each
+/// continuing where the decoder stopped consuming.
+fn decode_in_chunks(file: &[u8], chunk: usize) -> (Vec<Event<'_>>, DecodeStats) {
+    let mut dec = Decoder::new();
+    let mut events = Vec::new();
+    let mut start = 0;
+    while start < file.len() {
+        let end = (start + chunk.max(BLOCK_LEN)).min(file.len());
+        start += dec.feed(&file[start..end], end == file.len(), &mut |e| {
+            events.push(e)
+        });
+    }
+    (events, *dec.stats())
+}
+
 fn records<'a>(events: &[Event<'a>]) -> Vec<Record<'a>> {
     events
         .iter()
@@ -283,13 +298,7 @@ proptest! {
     fn decoding_in_chunks_equals_decoding_at_once(specs in ride(), chunk in 1usize..3000) {
         let (file, _) = encode(&specs);
         let (whole, _) = decode(&file);
-        let mut dec = Decoder::new();
-        let mut pieces = Vec::new();
-        let mut start = 0;
-        while start < file.len() {
-            let end = (start + chunk.max(BLOCK_LEN)).min(file.len());
-            start += dec.feed(&file[start..end], end == file.len(), &mut |e| pieces.push(e));
-        }
+        let (pieces, _) = decode_in_chunks(&file, chunk);
         prop_assert_eq!(records(&pieces), records(&whole));
     }
 
@@ -313,15 +322,9 @@ proptest! {
         file.splice(at..at, garbage);
         file.truncate(file.len() - cut.min(file.len()));
         let (whole, whole_stats) = decode(&file);
-        let mut dec = Decoder::new();
-        let mut pieces = Vec::new();
-        let mut start = 0;
-        while start < file.len() {
-            let end = (start + chunk.max(BLOCK_LEN)).min(file.len());
-            start += dec.feed(&file[start..end], end == file.len(), &mut |e| pieces.push(e));
-        }
+        let (pieces, stats) = decode_in_chunks(&file, chunk);
         prop_assert_eq!(&pieces, &whole);
-        prop_assert_eq!(dec.stats(), &whole_stats);
+        prop_assert_eq!(stats, whole_stats);
     }
 
     #[test]

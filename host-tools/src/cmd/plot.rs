@@ -78,7 +78,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
 fn warn_narrowed(log: &std::path::Path, summary: &Summary, (from, to): (f64, f64)) {
     let frames = summary.longest_segment.map_or(0, |(_, n)| n);
     eprintln!(
-        "{}: time jumps leave most of the run's time span empty; plotting its longest stretch, \
+        "wobblog: {}: warning: time jumps leave most of the run's time span empty; plotting its longest stretch, \
          {from:.2} to {to:.2} s ({frames} of {} frames); --from/--to plot another",
         log.display(),
         summary.samples
