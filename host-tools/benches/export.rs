@@ -116,7 +116,7 @@ fn benches(c: &mut Criterion) {
         });
     }
     group.bench_function("events_one_hour", |b| {
-        b.iter(|| events::table(&events::collect(&log).unwrap()))
+        b.iter(|| events::list(&log, false, std::io::sink()).unwrap().unwrap())
     });
     for (name, path) in [("config_one_hour", &log), ("config_64_mib", &big)] {
         group.bench_function(name, |b| {

@@ -1,5 +1,8 @@
 //! Everything that happened in a log besides the samples, in time order:
-//! what `wobblog events` lists.
+//! what `wobblog events` lists, as the log is read.
+
+use std::cmp::{Ordering, Reverse};
+use std::collections::BinaryHeap;
 
 use serde::Serialize;
 use wobble_core::format::Event;
@@ -153,25 +156,17 @@ impl EventKind {
     }
 }
 
-/// Turns decoder events into [`LogEvent`]s, and collects them.
+/// Turns decoder events into [`LogEvent`]s.
 #[derive(Default)]
-pub struct EventCollector {
-    events: Vec<LogEvent>,
+pub struct EventConverter {
     last_t_s: f64,
 }
 
-impl EventCollector {
-    /// An empty collector.
+impl EventConverter {
+    /// A converter at the start of a log.
     #[must_use]
     pub fn new() -> Self {
         Self::default()
-    }
-
-    /// Takes one decoder event and keeps it if it is a [`LogEvent`].
-    pub fn observe(&mut self, event: &Event<'_>) {
-        if let Some(e) = self.convert(event) {
-            self.events.push(e);
-        }
     }
 
     /// The [`LogEvent`] of a decoder event, if it is one (not kept).
@@ -225,12 +220,91 @@ impl EventCollector {
         };
         Some(LogEvent { t_s, kind })
     }
+}
 
-    /// The events in time order (file order among equal times).
+/// How far behind the latest time an event may come and still be put in
+/// its place, s: a GPS fix is written up to an epoch (about a second) after
+/// its time, and nothing else comes late.
+pub const REORDER_S: f64 = 10.0;
+/// Most events held back for reordering, whatever their times.
+pub const REORDER_MAX: usize = 4096;
+
+/// Puts events that come nearly in time order into time order (file order
+/// among equal times) while holding only those of the last [`REORDER_S`]
+/// (at most [`REORDER_MAX`]): a log of any length, or with its clock jumping
+/// at every block, costs the same memory.
+#[derive(Default)]
+pub struct TimeOrder {
+    held: BinaryHeap<Reverse<Held>>,
+    latest_s: Option<f64>,
+    taken: u64,
+}
+
+/// An event held back, with its place in the file.
+struct Held {
+    seq: u64,
+    event: LogEvent,
+}
+
+impl Held {
+    fn key(&self) -> (f64, u64) {
+        (self.event.t_s, self.seq)
+    }
+}
+
+impl Ord for Held {
+    fn cmp(&self, other: &Self) -> Ordering {
+        let ((t, n), (u, m)) = (self.key(), other.key());
+        t.total_cmp(&u).then(n.cmp(&m))
+    }
+}
+
+impl PartialOrd for Held {
+    fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
+        Some(self.cmp(other))
+    }
+}
+
+impl PartialEq for Held {
+    fn eq(&self, other: &Self) -> bool {
+        self.cmp(other) == Ordering::Equal
+    }
+}
+
+impl Eq for Held {}
+
+impl TimeOrder {
+    /// Nothing held yet.
     #[must_use]
-    pub fn finish(mut self) -> Vec<LogEvent> {
-        self.events.sort_by(|a, b| a.t_s.total_cmp(&b.t_s));
-        self.events
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Takes the next event in file order; `out` gets every event that no
+    /// later one can come before.
+    pub fn push(&mut self, event: LogEvent, out: &mut impl FnMut(LogEvent)) {
+        let latest_s = self.latest_s.map_or(event.t_s, |l| l.max(event.t_s));
+        self.latest_s = Some(latest_s);
+        self.held.push(Reverse(Held {
+            seq: self.taken,
+            event,
+        }));
+        self.taken += 1;
+        while let Some(Reverse(first)) = self.held.peek() {
+            if self.held.len() <= REORDER_MAX && first.event.t_s >= latest_s - REORDER_S {
+                break;
+            }
+            if let Some(Reverse(first)) = self.held.pop() {
+                out(first.event);
+            }
+        }
+    }
+
+    /// Hands over every event still held, in order.
+    pub fn finish(mut self, out: &mut impl FnMut(LogEvent)) {
+        while let Some(Reverse(first)) = self.held.pop() {
+            out(first.event);
+        }
     }
 }
 
@@ -255,4 +329,81 @@ fn record_event(record: &Record<'_>) -> Option<EventKind> {
         },
         _ => return None,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    fn event(t_s: f64, id: u16) -> LogEvent {
+        LogEvent {
+            t_s,
+            kind: EventKind::Marker { id },
+        }
+    }
+
+    fn ordered(events: &[LogEvent]) -> (Vec<LogEvent>, usize) {
+        let mut order = TimeOrder::new();
+        let mut out = Vec::new();
+        let mut most_held = 0;
+        for e in events {
+            order.push(e.clone(), &mut |e| out.push(e));
+            most_held = most_held.max(order.held.len());
+        }
+        order.finish(&mut |e| out.push(e));
+        (out, most_held)
+    }
+
+    proptest! {
+        /// Events at most `REORDER_S` behind the latest come out as a
+        /// stable sort by time would put them.
+        #[test]
+        fn nearly_ordered_events_come_out_sorted(
+            steps in prop::collection::vec((0.0..5.0f64, 0.0..REORDER_S), 0..300),
+        ) {
+            let mut clock = 0.0;
+            let events: Vec<LogEvent> = steps
+                .iter()
+                .enumerate()
+                .map(|(i, &(step, late))| {
+                    clock += step;
+                    event((clock - late).max(0.0).round(), i as u16)
+                })
+                .collect();
+            let mut sorted = events.clone();
+            sorted.sort_by(|a, b| a.t_s.total_cmp(&b.t_s));
+            prop_assert_eq!(ordered(&events).0, sorted);
+        }
+
+        /// Whatever the times, every event comes out once.
+        #[test]
+        fn every_event_comes_out_once(times in prop::collection::vec(-1e9..1e9f64, 0..300)) {
+            let events: Vec<LogEvent> =
+                times.iter().enumerate().map(|(i, &t)| event(t, i as u16)).collect();
+            let mut ids: Vec<u16> = ordered(&events)
+                .0
+                .iter()
+                .map(|e| match e.kind {
+                    EventKind::Marker { id } => id,
+                    _ => unreachable!(),
+                })
+                .collect();
+            ids.sort_unstable();
+            prop_assert_eq!(ids, (0..events.len() as u16).collect::<Vec<_>>());
+        }
+    }
+
+    #[test]
+    fn what_is_held_is_bounded_by_time_and_by_count() {
+        // A clock jumping forward at every event: nothing waits.
+        let jumping: Vec<LogEvent> = (0..10_000).map(|i| event(f64::from(i) * 1e6, 0)).collect();
+        assert_eq!(ordered(&jumping).1, 1);
+        // Ten thousand events at one instant: at most the cap waits, and
+        // they come out in file order.
+        let still: Vec<LogEvent> = (0..10_000).map(|i| event(5.0, i)).collect();
+        let (out, most_held) = ordered(&still);
+        assert_eq!(most_held, REORDER_MAX);
+        assert_eq!(out, still);
+    }
 }

@@ -3,7 +3,7 @@
 use std::io::{IsTerminal, Write};
 use std::path::{Path, PathBuf};
 
-use crate::events::{EventCollector, LogEvent};
+use crate::events::{EventConverter, LogEvent};
 use crate::export::columns::{self, Column};
 use crate::export::{Format, LogMetadata, RowWriter};
 use crate::losses::Losses;
@@ -105,7 +105,7 @@ pub fn decode_to(
     let mut losses = Losses::default();
     let mut meta = LogMetadata::default();
     // Fixes and events have messages of their own only in MCAP.
-    let mut events = (export.format == Format::Mcap).then(EventCollector::new);
+    let mut events = (export.format == Format::Mcap).then(EventConverter::new);
     read_log(log, |event| {
         losses.observe(&event);
         meta.observe(&event);
