@@ -94,6 +94,58 @@ fn an_overlong_wobble_is_measured_in_censored_pieces() {
     }
 }
 
+/// Wobbles held for 100 s, 20 s apart, each for less than the window can
+/// hold: they are measured whole, with or without a window, and none is
+/// called cut by it.
+#[test]
+fn long_wobbles_the_window_can_hold_are_measured_whole() {
+    let mut run = Ride::new(600.0, 5.0, 0.0, 0.0, 0.0).run();
+    for (t, steer) in run.t_s.iter().zip(&mut run.steer_deg) {
+        let u = (t - 20.0).rem_euclid(120.0);
+        let held = if *t < 20.0 || u > 100.0 + wobble::peak_s() {
+            0.0
+        } else {
+            wobble::envelope_deg(u.min(wobble::peak_s()))
+        };
+        *steer = held * (TAU * wobble::FREQ_HZ * t).sin();
+    }
+    let (whole, _) = episodes(&run, WHOLE);
+    assert!(whole.len() >= 4, "{whole:#?}");
+    for chunk in [6000, 7919] {
+        let (streamed, _) = episodes(&run, chunk);
+        assert_eq!(streamed.len(), whole.len(), "chunk {chunk}: {streamed:#?}");
+        for (a, b) in streamed.iter().zip(&whole) {
+            assert_same(a, b);
+            assert!(a.cut_at_start != Some(Cut::Overlong) && a.cut_at_end != Some(Cut::Overlong));
+        }
+    }
+}
+
+/// A wobble from the first frame for longer than the window holds: its
+/// first piece is cut at the start by the start of the data, at the end by
+/// the window.
+#[test]
+fn an_overlong_wobble_from_the_first_frame_names_both_cuts() {
+    let mut run = Ride::new(600.0, 5.0, 0.0, 0.0, 0.0).run();
+    for (t, steer) in run.t_s.iter().zip(&mut run.steer_deg) {
+        // Above the quiet level from the first frame, growing at 0.6/s.
+        let held = if *t < 500.0 {
+            (0.6 * (0.6 * t).exp()).min(wobble::PEAK_DEG)
+        } else {
+            0.0
+        };
+        *steer = held * (TAU * wobble::FREQ_HZ * t).sin();
+    }
+    let (pieces, _) = episodes(&run, 6000);
+    let first = pieces.first().expect("the growth is measured");
+    assert_eq!(
+        (first.cut_at_start, first.cut_at_end),
+        (Some(Cut::DataStart), Some(Cut::Overlong)),
+        "{first:?}"
+    );
+    assert!((first.sigma_per_s - 0.6).abs() < 0.15, "{first:?}");
+}
+
 /// Half an hour of frames, analysed with a window of 6000 frames, never
 /// holds more than four windows.
 #[test]
@@ -175,10 +227,13 @@ fn stretches_under_two_seconds_are_not_analysed() {
         }
         search.finish(&Losses::default())
     };
-    assert!(found(1.9).is_empty(), "{:#?}", found(1.9));
-    let longer = found(2.5);
-    for t0 in [0.0, 10.0, 20.0] {
-        let within = |e: &Episode| (t0..t0 + 2.5).contains(&e.onset_s);
-        assert!(longer.iter().any(within), "{longer:#?}");
+    assert!(found(1.99).is_empty(), "{:#?}", found(1.99));
+    // Exactly 2 s (200 frames) is long enough.
+    for len_s in [2.0, 2.5] {
+        let longer = found(len_s);
+        for t0 in [0.0, 10.0, 20.0] {
+            let within = |e: &Episode| (t0..t0 + len_s).contains(&e.onset_s);
+            assert!(longer.iter().any(within), "{len_s} s: {longer:#?}");
+        }
     }
 }
