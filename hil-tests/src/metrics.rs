@@ -629,8 +629,9 @@ mod tests {
 
     #[test]
     fn overrides_take_keys_with_and_without_their_section() {
-        let c = override_config("amp_on_deg=0.45,detector.window_s=0.32,wheel.circumference_m=2.13")
-            .expect("known keys");
+        let c =
+            override_config("amp_on_deg=0.45,detector.window_s=0.32,wheel.circumference_m=2.13")
+                .expect("known keys");
         assert_eq!(c.detector.amp_on_deg, 0.45);
         assert_eq!(c.detector.window_s, 0.32);
         assert_eq!(c.wheel.circumference_m, 2.13);
