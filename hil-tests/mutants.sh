@@ -39,14 +39,15 @@ export PROPTEST_DISABLE_FAILURE_PERSISTENCE=1
 # something loop.
 timeout_s="${MUTANTS_TIMEOUT_S:-60}"
 
-# name | package | file | name filter | test targets (built and run)
+# name | package | file | name filters (comma-separated) | test targets (built and run)
 targets=(
   "detector|wobble-core|firmware/core/src/detector/machine.rs|analyse|--test detector_machine --test detector_props --test sampler_detector"
   "loss-accounting|wobble-core|firmware/core/src/logger/mod.rs|.|--lib --test logger_card"
   "nmea-lines|wobble-core|firmware/core/src/gps/line.rs|.|--lib --test gps_properties --test gps_captures"
   "edge-time|wobble-core|firmware/core/src/wheel_capture.rs|.|--lib --test wheel_capture_props"
   "queue|wobble-core|firmware/core/src/channels.rs|RecordQueue|--lib"
-  "episode-fit|wobblog|host-tools/src/analysis/episodes.rs|measure|--test analysis_corpus --test analysis_residual --test censored_episodes --test streaming_analysis"
+  "episode-fit|wobblog|host-tools/src/analysis/episodes.rs|measure,neighbours|--test analysis_corpus --test analysis_residual --test censored_episodes --test streaming_analysis --test close_episodes"
+  "episode-search|wobblog|host-tools/src/analysis/search.rs|EpisodeSearch::analyse|--test streaming_analysis --test censored_episodes"
   "wheel|wobble-core|firmware/core/src/wheel.rs|.|--lib --test wheel_sensor"
   "sdcard|wobble-core|firmware/core/src/drivers/sdcard.rs|.|--test sd_init --test sd_init_no_card --test sd_operation --test sd_reidentify"
   "gnss-bringup|wobble-core|firmware/core/src/drivers/gnss_bringup.rs|.|--test gnss_bringup --test gnss_setup --test gps_setup_runner"
@@ -86,7 +87,8 @@ for t in "${targets[@]}"; do
     [[ "$w" == --test ]] && continue
     if [[ "$w" == --lib ]]; then cargo_args+=(--cargo-arg=--lib); else cargo_args+=(--cargo-arg="--test=$w"); fi
   done
-  filters=(-p "$package" -f "$file" -F "$filter")
+  filters=(-p "$package" -f "$file")
+  for re in ${filter//,/ }; do filters+=(-F "$re"); done
   if $list; then
     echo "$name: $(cargo mutants --list "${filters[@]}" | wc -l) mutants ($file, $filter; $tests)"
     continue

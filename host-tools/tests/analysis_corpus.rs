@@ -9,15 +9,12 @@ mod analysis_support;
 use std::path::Path;
 
 use analysis_support::corpus_dir;
+use analysis_support::limits::{
+    FREQ_TOL_HZ, KICK_FREQ_TOL_HZ, KICK_SIGMA_TOL_REL, ONSET_TOL_S, SIGMA_TOL_REL, SPEED_TOL_MPS,
+};
 
 use serde_json::Value;
 use wobblog::analysis::{find_episodes, wobble_speed_mps, Episode, Run, Stability};
-
-/// The acceptance limits.
-const FREQ_TOL_HZ: f64 = 0.1;
-const SIGMA_TOL_REL: f64 = 0.2;
-const ONSET_TOL_S: f64 = 0.2;
-const SPEED_TOL_MPS: f64 = 0.1;
 
 /// Fixtures the fit is known to measure worse, with their own (sigma,
 /// onset) limits, so they cannot get worse unnoticed. The limit cycle (0.9
@@ -147,11 +144,6 @@ fn corpus_rides_without_wobble_have_no_unstable_episode() {
     }
     assert!(checked >= 4, "only {checked} rides without wobble");
 }
-
-/// How closely a kick's ring is measured. Looser than for growth: a ring
-/// decaying at 3-8/s lasts two or three cycles above the background.
-const KICK_FREQ_TOL_HZ: f64 = 0.5;
-const KICK_SIGMA_TOL_REL: f64 = 0.45;
 
 /// Kicks on the handlebar ring the stable wobble mode down: the episodes
 /// found at them are stable, near the ring's frequency and decay rate.

@@ -14,11 +14,13 @@
 //! 3. If the envelope climbs to the peak for long enough, the samples of
 //!    that climb are fitted directly (not their envelope) with a growing
 //!    sinusoid, plus a steady tone for a wheel harmonic beside it (see
-//!    [`super::sinefit`]). If that explains the signal, the wobble is
+//!    [`super::sinefit`]), looked for up to 4 s before the climb but not
+//!    before the previous episode has rung down. If that explains the signal, the wobble is
 //!    **unstable** and sigma is the fitted growth rate. Otherwise the
 //!    oscillation was struck (a kick, a pothole) and rings down: the fall
-//!    from its largest swing is fitted the same way, the mode is **stable**,
-//!    and sigma is the (negative) decay rate.
+//!    from its largest swing is fitted the same way (the tone looked for up
+//!    to 4 s after it, but not into the next episode), the mode is
+//!    **stable**, and sigma is the (negative) decay rate.
 //! 4. An unstable episode's onset is where the fitted exponential is
 //!    [`ONSET_AMP_DEG`]: the wobble's start "from nothing", independent of
 //!    where the noise floor happens to be. A stable episode starts where it
@@ -274,10 +276,13 @@ impl<'a> Span<'a> {
         let around = peak.saturating_sub(half_s).max(region.start)..(peak + half_s).min(region.end);
         let f0_hz = crossing_freq_hz(&self.t_s[around.clone()], &self.band[around])?;
 
+        // No fit reaches into a neighbouring episode: the tone looked for
+        // before a growth or after a decay would be that episode.
+        let (prev_end, next_start) = self.neighbours(region.clone());
         let window = region
             .start
             .saturating_sub(self.samples(BACKGROUND_WINDOW_S))
-            ..(region.end + self.samples(TONE_LOOKBACK_S)).min(self.band.len());
+            ..(region.end + self.samples(TONE_LOOKBACK_S)).min(next_start);
         let t = &self.t_s[window.clone()];
         let env = demod_envelope(&self.band[window.clone()], t, f0_hz, self.fs_hz);
         let before = region.start.saturating_sub(self.samples(0.3)) - window.start;
@@ -315,7 +320,15 @@ impl<'a> Span<'a> {
             // that tone alongside: before a growth, after a decay.
             let lookback = self.samples(TONE_LOOKBACK_S);
             let (fitted, alone) = if growing {
-                let from = range.start.saturating_sub(lookback);
+                // Not before the previous episode's ring-down is over.
+                let prev_gone = prev_end.map_or(0, |end| {
+                    let end = end.saturating_sub(window.start).min(range.start);
+                    clean[end..range.start]
+                        .iter()
+                        .position(|&e| e < floor)
+                        .map_or(range.start, |i| end + i)
+                });
+                let from = range.start.saturating_sub(lookback).max(prev_gone);
                 (from..range.end, from..range.start)
             } else {
                 let to = (range.end + lookback).min(t.len());
@@ -379,6 +392,20 @@ impl<'a> Span<'a> {
             start,
             end: end_cut,
         })
+    }
+
+    /// Where the episodes either side of `region` end and start: the end
+    /// of the one before (if any) and the first frame of the one after (the
+    /// end of the frames if none).
+    fn neighbours(&self, region: Range<usize>) -> (Option<usize>, usize) {
+        let before = self.energy[..region.start]
+            .iter()
+            .rposition(|&e| e > DETECT_AMP_DEG)
+            .map(|hit| self.region(hit).end);
+        let after = self
+            .next_hit(region.end, self.energy.len())
+            .map_or(self.energy.len(), |hit| self.region(hit).start);
+        (before, after)
     }
 
     /// How much the band-pass changes the fitted log amplitude of `mode`

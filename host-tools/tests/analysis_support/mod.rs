@@ -66,6 +66,19 @@ pub fn steady_ride_log(
     (csv_path, log)
 }
 
+/// How closely an episode is measured against its ground truth.
+pub mod limits {
+    /// The acceptance limits for a growing wobble...
+    pub const FREQ_TOL_HZ: f64 = 0.1;
+    pub const SIGMA_TOL_REL: f64 = 0.2;
+    pub const ONSET_TOL_S: f64 = 0.2;
+    pub const SPEED_TOL_MPS: f64 = 0.1;
+    /// ...and for a kick's ring, looser: a ring decaying at 3-8/s lasts two
+    /// or three cycles above the background.
+    pub const KICK_FREQ_TOL_HZ: f64 = 0.5;
+    pub const KICK_SIGMA_TOL_REL: f64 = 0.45;
+}
+
 /// The synthetic corpus: `hil-tests/fixtures/corpus`, or the
 /// directory `CORPUS_DIR` names (e.g. a freshly generated one).
 #[must_use]
