@@ -52,6 +52,8 @@ targets=(
   "sdcard|wobble-core|firmware/core/src/drivers/sdcard.rs|.|--test sd_init --test sd_init_no_card --test sd_operation --test sd_reidentify"
   "gnss-bringup|wobble-core|firmware/core/src/drivers/gnss_bringup.rs|.|--test gnss_bringup --test gnss_setup --test gps_setup_runner"
   "selftest|wobble-core|firmware/core/src/selftest.rs|.|--lib --test selftest_card"
+  "resample|wobblog|host-tools/src/resample.rs|.|--lib --test csv_checks"
+  "decimator|wobblog|host-tools/src/plot/mod.rs|Decimator|--lib --test plot_figures"
 )
 
 list=false
