@@ -47,10 +47,13 @@ targets=(
   "edge-time|wobble-core|firmware/core/src/wheel_capture.rs|.|--lib --test wheel_capture_props"
   "queue|wobble-core|firmware/core/src/channels.rs|RecordQueue|--lib"
   "episode-fit|wobblog|host-tools/src/analysis/episodes.rs|measure,neighbours|--test analysis_corpus --test analysis_residual --test censored_episodes --test streaming_analysis --test close_episodes"
+  "episode-search|wobblog|host-tools/src/analysis/search.rs|EpisodeSearch::analyse|--test streaming_analysis --test censored_episodes"
   "wheel|wobble-core|firmware/core/src/wheel.rs|.|--lib --test wheel_sensor"
   "sdcard|wobble-core|firmware/core/src/drivers/sdcard.rs|.|--test sd_init --test sd_init_no_card --test sd_operation --test sd_reidentify"
   "gnss-bringup|wobble-core|firmware/core/src/drivers/gnss_bringup.rs|.|--test gnss_bringup --test gnss_setup --test gps_setup_runner"
   "selftest|wobble-core|firmware/core/src/selftest.rs|.|--lib --test selftest_card"
+  "resample|wobblog|host-tools/src/resample.rs|.|--lib --test csv_checks"
+  "decimator|wobblog|host-tools/src/plot/mod.rs|Decimator|--lib --test plot_figures"
 )
 
 list=false

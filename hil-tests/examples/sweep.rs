@@ -4,13 +4,18 @@
 //! ```text
 //! cargo run -p wobble-hil --release --example sweep -- window_s=0.32 amp_on_deg=0.45,confirm_hops=1
 //! NOSPEED=1 cargo run ...   # replay without the speed column
+//! SIMULATED=1 cargo run ...  # the rides simulated from the bicycle model
 //! ```
 
 use wobble_core::config::Config;
 use wobble_hil::{corpus, metrics};
 
 fn main() -> Result<(), String> {
-    let fixtures = corpus::generate();
+    let fixtures = if std::env::var_os("SIMULATED").is_some() {
+        corpus::simulated::generate()?
+    } else {
+        corpus::generate()
+    };
     let use_speed = std::env::var_os("NOSPEED").is_none();
     let mut variants = vec![("default".to_owned(), Config::default())];
     for spec in std::env::args().skip(1) {

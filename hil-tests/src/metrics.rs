@@ -602,7 +602,9 @@ pub fn override_config(spec: &str) -> Result<Config, String> {
         .split(',')
         .filter(|s| !s.is_empty())
         .map(|kv| {
-            if kv.contains('.') {
+            // The key's own dots, not the value's (`amp_on_deg=0.45`).
+            let key = kv.split_once('=').map_or(kv, |(k, _)| k);
+            if key.contains('.') {
                 kv.to_owned()
             } else {
                 format!("detector.{kv}")
@@ -618,5 +620,21 @@ pub fn override_config(spec: &str) -> Result<Config, String> {
                 .map_or("", String::as_str),
             f.code
         )),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn overrides_take_keys_with_and_without_their_section() {
+        let c =
+            override_config("amp_on_deg=0.45,detector.window_s=0.32,wheel.circumference_m=2.13")
+                .expect("known keys");
+        assert_eq!(c.detector.amp_on_deg, 0.45);
+        assert_eq!(c.detector.window_s, 0.32);
+        assert_eq!(c.wheel.circumference_m, 2.13);
+        assert!(override_config("no_such_key=1").is_err());
     }
 }

@@ -1,7 +1,8 @@
 //! Writes the 64 MiB logs the memory and time figures in
 //! `docs/robustness.md` are measured on: a clean 7.6 h log, one block
 //! repeated through the file, a block of far-future times in front of the
-//! clean log, and a log whose clock jumps a year forward every block.
+//! clean log, a log whose clock jumps a year forward every block, and a
+//! busy 7.3 h ride whose every column moves (the slowest to export).
 //!
 //! ```text
 //! cargo run -p wobblog --release --example absurd_logs -- OUT_DIR
@@ -10,7 +11,9 @@
 use std::f64::consts::TAU;
 use std::io::Write;
 
-use wobble_core::format::{BlockEncoder, Frame, Record, STEER_COUNTS_PER_DEG};
+use wobble_core::format::{
+    BlockEncoder, FixMode, Frame, GpsFix, Record, UtcSync, UtcTime, STEER_COUNTS_PER_DEG,
+};
 
 /// Size of each log.
 const LEN: usize = 64 << 20;
@@ -42,6 +45,55 @@ fn log(t0_us: u64, jump_us: u64, len: usize) -> Vec<u8> {
     file
 }
 
+/// A ride whose every exported column moves: IMU axes and steering at
+/// full 16-bit scale, speed, GPS fixes at 20 Hz and a UTC sync pair each
+/// second, so no cell is a zero or a repeat (the number formatter's fast cases).
+fn busy(len: usize) -> Vec<u8> {
+    let mut enc = BlockEncoder::new();
+    let mut file = Vec::with_capacity(len);
+    let mut push = |file: &mut Vec<u8>, record: Record| {
+        if let Ok(Some(block)) = enc.push(&record) {
+            file.extend_from_slice(block);
+        }
+    };
+    let mut i = 0u64;
+    while file.len() < len {
+        let t_us = 1_000_000 + i * 10_000;
+        let wave = |k: u64| ((i * k) % 65_521) as i16;
+        let frame = Frame {
+            t_us,
+            accel: [wave(7919), wave(104_729), wave(1_299_709)],
+            gyro: [wave(15_485_863), wave(32_452_843), wave(49_979_687)],
+            steer_cdeg: wave(86_028_121),
+            speed_mm_s: 2_000 + (i % 6_000) as u16,
+            ..Frame::default()
+        };
+        push(&mut file, Record::Frame(frame));
+        if i.is_multiple_of(5) {
+            let gps = GpsFix {
+                t_us,
+                utc: Some(UtcTime {
+                    days_since_2000: 9_800,
+                    ms_of_day: (i * 10 % 86_400_000) as u32,
+                }),
+                lat_e7: Some(520_000_000 + (i * 37 % 1_000_000) as i32),
+                lon_e7: Some(43_000_000 + (i * 53 % 1_000_000) as i32),
+                speed_cm_s: Some(200 + (i % 600) as u16),
+                fix: FixMode::Fix3d,
+                ..GpsFix::default()
+            };
+            push(&mut file, Record::Gps(gps));
+        }
+        if i.is_multiple_of(100) {
+            let unix_ms = 1_796_000_000_000 + i * 10;
+            push(&mut file, Record::UtcSync(UtcSync { t_us, unix_ms }));
+        }
+        i += 1;
+    }
+    file.truncate(len);
+    file
+}
+
 fn main() -> std::io::Result<()> {
     let dir = std::path::PathBuf::from(std::env::args().nth(1).unwrap_or_else(|| ".".into()));
     let write = |name: &str, bytes: &[u8]| {
@@ -53,5 +105,6 @@ fn main() -> std::io::Result<()> {
     let mut front = log(1 << 62, 0, 512);
     front.extend_from_slice(&clean[..LEN - 512]);
     write("front.wbl", &front)?;
-    write("jumps.wbl", &log(1_000_000, YEAR_US, LEN))
+    write("jumps.wbl", &log(1_000_000, YEAR_US, LEN))?;
+    write("busy.wbl", &busy(LEN))
 }

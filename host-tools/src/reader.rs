@@ -11,7 +11,7 @@ use wobble_core::format::{DecodeStats, Decoder, Event, BLOCK_LEN};
 use crate::CliError;
 
 /// Bytes read from the file at a time.
-const CHUNK_LEN: usize = 1 << 20;
+pub const CHUNK_LEN: usize = 1 << 20;
 /// Files larger than this get a progress bar (when stderr is a terminal).
 const PROGRESS_MIN_LEN: u64 = 64 << 20;
 

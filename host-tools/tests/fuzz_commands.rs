@@ -195,13 +195,17 @@ fn every_log_command(path: &Path, dir: &Path) {
         let _ = decode::decode_to(path, &export, std::io::sink(), Path::new("sink"));
     }
     let _ = detect::replay_log(path, &wobble_core::config::Config::default());
-    if let Ok(track) = gpx::track(path, TimeWindow::default()) {
-        for fix in track.iter().flatten() {
+    let mut track = gpx::Gpx::new(std::io::sink(), "fuzz");
+    let walked = gpx::track(path, TimeWindow::default(), |step| {
+        if let gpx::Step::Point(fix) = step {
             let (lat, lon) = (fix.lat_e7.unwrap_or(0), fix.lon_e7.unwrap_or(0));
             assert!(lat.unsigned_abs() <= 900_000_000 && lon.unsigned_abs() <= 1_800_000_000);
             assert!(fix.utc.is_none_or(UtcTime::is_valid));
         }
-        gpx::write_gpx(std::io::sink(), "fuzz", &track).unwrap();
+        track.step(step)
+    });
+    if let Ok(walked) = walked {
+        walked.and_then(|()| track.finish()).unwrap();
     }
     let _ = wobblog::cmd::config::read_header(path);
     if let (Ok(run), Ok(ride)) = (Run::load(path), Ride::load(path)) {

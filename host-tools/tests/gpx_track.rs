@@ -88,3 +88,54 @@ fn log_without_gps_gives_an_empty_track_and_a_warning() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("no GPS fix"));
     assert!(segments(&std::fs::read_to_string(&gpx_path).unwrap()).is_empty());
 }
+
+#[test]
+fn a_log_that_cannot_be_read_leaves_no_output() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = wobblog()
+        .arg("gpx")
+        .arg(dir.path().join("MISSING.WBL"))
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    assert!(
+        out.stdout.is_empty(),
+        "{}",
+        String::from_utf8_lossy(&out.stdout)
+    );
+    assert!(String::from_utf8_lossy(&out.stderr).contains("MISSING.WBL"));
+}
+
+#[test]
+fn the_track_is_walked_as_read_and_stops_at_the_first_failed_write() {
+    use wobblog::cmd::gpx::{track, Step};
+    let dir = tempfile::tempdir().unwrap();
+    let log = dir.path().join("RUN00003.WBL");
+    analysis_support::standard_log(&log);
+    let walk = |stop_after: usize| {
+        let (mut points, mut breaks) = (0, 0);
+        let walked = track(&log, Default::default(), |step| {
+            match step {
+                Step::Point(_) => points += 1,
+                Step::Break => breaks += 1,
+            }
+            if points == stop_after {
+                Err(points)
+            } else {
+                Ok(())
+            }
+        })
+        .unwrap();
+        (walked, points, breaks)
+    };
+    let (whole, points, breaks) = walk(usize::MAX);
+    assert_eq!(whole, Ok(()));
+    assert_eq!(breaks, 1, "one break, at the outage");
+    assert!(points > 100, "{points} points");
+    let (stopped, seen, _) = walk(3);
+    assert_eq!(
+        (stopped, seen),
+        (Err(3), 3),
+        "nothing visited after the error"
+    );
+}

@@ -1,14 +1,15 @@
 //! `wobblog gpx`: the run's GPS track as GPX 1.1, for maps and GIS tools.
 
 use std::io::Write;
+use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
 
-use quick_xml::events::{BytesDecl, BytesText, Event};
+use quick_xml::events::{BytesDecl, BytesEnd, BytesStart, BytesText, Event};
 use quick_xml::Writer;
 use wobble_core::format::{Event as LogEvent, GpsFix, Record};
 
 use crate::output::Output;
-use crate::reader::read_log;
+use crate::reader::{read_log_until, CHUNK_LEN};
 use crate::rows::GpsColumns;
 use crate::time::{TimeWindow, WindowArgs};
 use crate::CliError;
@@ -34,74 +35,159 @@ const SEGMENT_GAP_US: u64 = 5_000_000;
 /// Runs `wobblog gpx`.
 pub fn run(args: &Args) -> Result<(), CliError> {
     let mut out = Output::create_or_stdout(args.output.as_deref(), &[&args.log])?;
-    let segments = track(&args.log, args.window.window())?;
-    if segments.is_empty() {
+    let name = args
+        .log
+        .file_stem()
+        .map_or_else(String::new, |s| s.to_string_lossy().into_owned());
+    let mut points = 0usize;
+    let mut gpx = Gpx::new(&mut out, &name);
+    let walked = track(&args.log, args.window.window(), |step| {
+        points += usize::from(matches!(step, Step::Point(_)));
+        gpx.step(step)
+    })?;
+    walked
+        .and_then(|()| gpx.finish())
+        .map_err(|e| out.error(e))?;
+    if points == 0 {
         eprintln!(
             "wobblog: {}: warning: no GPS fix with a position; the track is empty",
             args.log.display()
         );
     }
-    let name = args
-        .log
-        .file_stem()
-        .map_or_else(String::new, |s| s.to_string_lossy().into_owned());
-    write_gpx(&mut out, &name, &segments).map_err(|e| out.error(e))?;
     out.commit()
 }
 
-/// The fixes with a position inside `window`, split into segments at gaps.
-pub fn track(log: &Path, window: TimeWindow) -> Result<Vec<Vec<GpsFix>>, CliError> {
-    let mut segments: Vec<Vec<GpsFix>> = Vec::new();
-    let mut open = false;
-    read_log(log, |event| {
+/// What the track does next.
+#[derive(Debug)]
+pub enum Step<'a> {
+    /// A fix with a position, in the current segment.
+    Point(&'a GpsFix),
+    /// The current segment ends: a gap in the fixes or in the file.
+    Break,
+}
+
+/// Walks the fixes with a position inside `window`, in file order, a
+/// [`Step::Break`] between segments, without holding them. An error from
+/// `visit` ends the walk and is the inner result.
+///
+/// # Errors
+/// The log cannot be read.
+pub fn track<E>(
+    log: &Path,
+    window: TimeWindow,
+    mut visit: impl FnMut(Step<'_>) -> Result<(), E>,
+) -> Result<Result<(), E>, CliError> {
+    // The time of the open segment's last point.
+    let mut last_us: Option<u64> = None;
+    let mut failed = None;
+    let mut step = |step: Step<'_>| match visit(step) {
+        Ok(()) => ControlFlow::Continue(()),
+        Err(e) => {
+            failed = Some(e);
+            ControlFlow::Break(())
+        }
+    };
+    read_log_until(log, CHUNK_LEN, |event| {
         let LogEvent::Record(Record::Gps(fix)) = event else {
             // A block lost from the file may have held fixes.
-            open &= !matches!(event, LogEvent::Gap(_));
-            return;
+            if matches!(event, LogEvent::Gap(_)) && last_us.take().is_some() {
+                return step(Step::Break);
+            }
+            return ControlFlow::Continue(());
         };
         let utc_ms = fix.utc.and_then(|u| i64::try_from(u.unix_ms()).ok());
         if GpsColumns::from_fix(&fix).is_none() || !window.contains(fix.t_us as f64 / 1e6, utc_ms) {
-            open = false;
-            return;
-        }
-        match segments.last_mut() {
-            Some(seg)
-                if open
-                    && seg
-                        .last()
-                        .is_some_and(|p| fix.t_us.saturating_sub(p.t_us) <= SEGMENT_GAP_US) =>
-            {
-                seg.push(fix);
+            if last_us.take().is_some() {
+                return step(Step::Break);
             }
-            _ => segments.push(vec![fix]),
+            return ControlFlow::Continue(());
         }
-        open = true;
+        if last_us.is_some_and(|t| fix.t_us.saturating_sub(t) > SEGMENT_GAP_US)
+            && step(Step::Break).is_break()
+        {
+            return ControlFlow::Break(());
+        }
+        last_us = Some(fix.t_us);
+        step(Step::Point(&fix))
     })?;
-    Ok(segments)
+    Ok(failed.map_or(Ok(()), Err))
 }
 
-/// Writes the track as GPX 1.1.
-pub fn write_gpx(out: impl Write, name: &str, segments: &[Vec<GpsFix>]) -> std::io::Result<()> {
-    let mut w = Writer::new_with_indent(out, b' ', 1);
-    w.write_event(Event::Decl(BytesDecl::new("1.0", Some("UTF-8"), None)))?;
-    w.create_element("gpx")
-        .with_attribute(("version", "1.1"))
-        .with_attribute(("creator", concat!("wobblog ", env!("CARGO_PKG_VERSION"))))
-        .with_attribute(("xmlns", "http://www.topografix.com/GPX/1/1"))
-        .write_inner_content(|w| {
-            w.create_element("trk").write_inner_content(|w| {
-                w.create_element("name")
-                    .write_text_content(BytesText::new(name))?;
-                for seg in segments {
-                    w.create_element("trkseg").write_inner_content(|w| {
-                        seg.iter().try_for_each(|fix| write_point(w, fix))
-                    })?;
+/// A GPX 1.1 document of one track, written as its points come; nothing
+/// is written before the first step (or [`Gpx::finish`]), so a log that
+/// cannot be opened leaves no output.
+pub struct Gpx<'n, W: Write> {
+    w: Writer<W>,
+    /// The track's name, until the document's start is written.
+    unstarted: Option<&'n str>,
+    in_segment: bool,
+}
+
+impl<'n, W: Write> Gpx<'n, W> {
+    /// A track named `name`, to be written to `out`.
+    pub fn new(out: W, name: &'n str) -> Self {
+        Self {
+            w: Writer::new_with_indent(out, b' ', 1),
+            unstarted: Some(name),
+            in_segment: false,
+        }
+    }
+
+    fn start(&mut self) -> std::io::Result<()> {
+        let Some(name) = self.unstarted.take() else {
+            return Ok(());
+        };
+        let w = &mut self.w;
+        w.write_event(Event::Decl(BytesDecl::new("1.0", Some("UTF-8"), None)))?;
+        let gpx = BytesStart::new("gpx").with_attributes([
+            ("version", "1.1"),
+            ("creator", concat!("wobblog ", env!("CARGO_PKG_VERSION"))),
+            ("xmlns", "http://www.topografix.com/GPX/1/1"),
+        ]);
+        w.write_event(Event::Start(gpx))?;
+        w.write_event(Event::Start(BytesStart::new("trk")))?;
+        w.create_element("name")
+            .write_text_content(BytesText::new(name))?;
+        Ok(())
+    }
+
+    /// Writes the next step of the track.
+    ///
+    /// # Errors
+    /// Writing failed.
+    pub fn step(&mut self, step: Step<'_>) -> std::io::Result<()> {
+        self.start()?;
+        match step {
+            Step::Point(fix) => {
+                if !self.in_segment {
+                    self.w
+                        .write_event(Event::Start(BytesStart::new("trkseg")))?;
+                    self.in_segment = true;
                 }
-                Ok(())
-            })?;
-            Ok(())
-        })?;
-    w.into_inner().flush()
+                write_point(&mut self.w, fix)
+            }
+            Step::Break => self.end_segment(),
+        }
+    }
+
+    fn end_segment(&mut self) -> std::io::Result<()> {
+        if std::mem::take(&mut self.in_segment) {
+            self.w.write_event(Event::End(BytesEnd::new("trkseg")))?;
+        }
+        Ok(())
+    }
+
+    /// Ends the document and flushes it.
+    ///
+    /// # Errors
+    /// Writing failed.
+    pub fn finish(mut self) -> std::io::Result<()> {
+        self.start()?;
+        self.end_segment()?;
+        self.w.write_event(Event::End(BytesEnd::new("trk")))?;
+        self.w.write_event(Event::End(BytesEnd::new("gpx")))?;
+        self.w.into_inner().flush()
+    }
 }
 
 fn write_point<W: Write>(w: &mut Writer<W>, fix: &GpsFix) -> std::io::Result<()> {

@@ -2,15 +2,19 @@
 //! [`columns::COLUMNS`] (or a selection of them).
 
 pub mod columns;
+mod lines;
 pub mod mcap;
 pub mod metadata;
 pub mod parquet;
+mod text;
 
 use std::io::Write;
 use std::path::Path;
 
-use columns::{Column, Value};
+use columns::Column;
+use lines::LineWriter;
 pub use metadata::LogMetadata;
+pub(crate) use text::json_object;
 
 use crate::events::LogEvent;
 use crate::rows::Row;
@@ -103,9 +107,9 @@ pub struct RowWriter<W: Write + Send> {
 // One writer per export: the variants' sizes do not matter.
 #[allow(clippy::large_enum_variant)]
 enum Sink<W: Write + Send> {
-    /// CSV; the flag says whether the header line is out.
-    Csv(csv::Writer<W>, bool),
-    Jsonl(W),
+    /// CSV or JSON lines; the text that goes before the first row (the CSV
+    /// header) until it is out.
+    Lines(LineWriter<W>, Option<String>),
     Parquet(parquet::ParquetWriter<W>),
     /// Built on the first row: creating it writes the file's header.
     Mcap(Option<Box<mcap::McapWriter<W>>>, Option<W>),
@@ -116,28 +120,32 @@ impl<W: Write + Send> RowWriter<W> {
     /// [`Self::finish`], so a log that cannot be read leaves no half output.
     pub fn new(format: Format, columns: Vec<Column>, out: W) -> Self {
         let sink = match format {
-            Format::Csv => Sink::Csv(csv::Writer::from_writer(out), false),
-            Format::Jsonl => Sink::Jsonl(out),
+            Format::Csv => {
+                let names: Vec<&str> = columns.iter().map(|c| c.name).collect();
+                let header = format!("{}\n", names.join(","));
+                Sink::Lines(LineWriter::new(out, &columns, text::csv_line), Some(header))
+            }
+            Format::Jsonl => Sink::Lines(LineWriter::new(out, &columns, text::json_line), None),
             Format::Parquet => Sink::Parquet(parquet::ParquetWriter::new(out, &columns)),
             Format::Mcap => Sink::Mcap(None, Some(out)),
         };
         Self { columns, sink }
     }
 
-    fn header(&mut self) -> csv::Result<()> {
-        if let Sink::Csv(w, done @ false) = &mut self.sink {
-            w.write_record(self.columns.iter().map(|c| c.name))?;
-            *done = true;
+    fn header(&mut self) -> std::io::Result<()> {
+        if let Sink::Lines(w, header) = &mut self.sink {
+            if let Some(text) = header.take() {
+                w.write_text(&text)?;
+            }
         }
         Ok(())
     }
 
     /// Writes one row.
     pub fn write(&mut self, row: &Row) -> std::io::Result<()> {
-        self.header().map_err(csv_io_error)?;
+        self.header()?;
         match &mut self.sink {
-            Sink::Csv(w, _) => write_csv(w, &self.columns, row).map_err(csv_io_error),
-            Sink::Jsonl(w) => write_json(w, &self.columns, row),
+            Sink::Lines(w, _) => w.write(row),
             Sink::Parquet(w) => w.write(row).map_err(std::io::Error::other),
             Sink::Mcap(..) => self.mcap()?.row(row).map_err(mcap_io_error),
         }
@@ -176,139 +184,13 @@ impl<W: Write + Send> RowWriter<W> {
     /// Writes the CSV header if no row came, or the Parquet footer with
     /// `meta`, and flushes buffered output.
     pub fn finish(&mut self, meta: &LogMetadata) -> std::io::Result<()> {
-        self.header().map_err(csv_io_error)?;
+        self.header()?;
         match &mut self.sink {
-            Sink::Csv(w, _) => w.flush(),
-            Sink::Jsonl(w) => w.flush(),
+            Sink::Lines(w, _) => w.flush(),
             Sink::Parquet(w) => w.finish(meta).map_err(std::io::Error::other),
             Sink::Mcap(..) => self.mcap()?.finish(meta).map_err(mcap_io_error),
         }
     }
-}
-
-fn write_csv<W: Write>(w: &mut csv::Writer<W>, columns: &[Column], row: &Row) -> csv::Result<()> {
-    let mut num = ryu::Buffer::new();
-    let mut time = [0u8; UTC_LEN];
-    for column in columns {
-        match (column.value)(row) {
-            Value::Number(Some(v)) => w.write_field(num.format(v))?,
-            Value::Label(Some(s)) => w.write_field(s)?,
-            Value::Utc(Some(us)) => w.write_field(utc_text(us, &mut time))?,
-            Value::Integer(Some(n)) => w.write_field(n.to_string())?,
-            Value::Text(Some(s)) => w.write_field(s)?,
-            Value::Number(None)
-            | Value::Label(None)
-            | Value::Utc(None)
-            | Value::Integer(None)
-            | Value::Text(None) => w.write_field("")?,
-        }
-    }
-    w.write_record(None::<&[u8]>)
-}
-
-/// One JSON object per row, on a line of its own.
-fn write_json<W: Write>(w: &mut W, columns: &[Column], row: &Row) -> std::io::Result<()> {
-    let mut line = String::with_capacity(320);
-    json_object(&mut line, columns, row);
-    line.push('\n');
-    w.write_all(line.as_bytes())
-}
-
-/// Appends the JSON object of `row`'s `columns` to `line`; absent values
-/// are left out. Written by hand: every key is a plain column name and
-/// every string value a fixed name, an ISO time or a file name (escaped by
-/// serde), and nothing is allocated per number (the one-hour export is
-/// benchmarked).
-fn json_object(line: &mut String, columns: &[Column], row: &Row) {
-    let mut num = ryu::Buffer::new();
-    let mut time = [0u8; UTC_LEN];
-    let start = line.len();
-    line.push('{');
-    for column in columns {
-        let value = (column.value)(row);
-        let is_some = match &value {
-            Value::Number(v) => v.is_some(),
-            Value::Label(v) => v.is_some(),
-            Value::Utc(v) | Value::Integer(v) => v.is_some(),
-            Value::Text(v) => v.is_some(),
-        };
-        if !is_some {
-            continue;
-        }
-        if line.len() > start + 1 {
-            line.push(',');
-        }
-        line.push('"');
-        line.push_str(column.name);
-        line.push_str("\":");
-        match value {
-            Value::Number(Some(v)) => line.push_str(num.format(v)),
-            Value::Label(Some(s)) => {
-                line.push('"');
-                line.push_str(s);
-                line.push('"');
-            }
-            Value::Utc(Some(us)) => {
-                line.push('"');
-                line.push_str(utc_text(us, &mut time));
-                line.push('"');
-            }
-            Value::Integer(Some(n)) => line.push_str(&n.to_string()),
-            Value::Text(Some(s)) => {
-                // Serialising a string cannot fail.
-                line.push_str(&serde_json::Value::String(s).to_string());
-            }
-            _ => {}
-        }
-    }
-    line.push('}');
-}
-
-/// Length of `2020-03-18T13:28:20.600Z`.
-const UTC_LEN: usize = 24;
-
-/// UTC in ISO 8601 to the millisecond (rounded down), as
-/// [`crate::time::iso8601`] writes it, into `buf` without allocating;
-/// empty outside the card's dates.
-fn utc_text(us: i64, buf: &mut [u8; UTC_LEN]) -> &str {
-    const MS_PER_DAY: i64 = 86_400_000;
-    const UNIX_MS_AT_2000: i64 = 10_957 * MS_PER_DAY;
-    let since_2000 = us.div_euclid(1000) - UNIX_MS_AT_2000;
-    let Ok(days_since_2000) = u16::try_from(since_2000.div_euclid(MS_PER_DAY)) else {
-        return "";
-    };
-    let ms = since_2000.rem_euclid(MS_PER_DAY);
-    let utc = wobble_core::format::UtcTime {
-        days_since_2000,
-        ms_of_day: ms as u32,
-    };
-    let (year, month, day) = utc.date();
-    let mut put = |at: usize, value: i64, digits: usize| {
-        let mut v = value;
-        for i in (0..digits).rev() {
-            buf[at + i] = b'0' + (v % 10) as u8;
-            v /= 10;
-        }
-    };
-    put(0, i64::from(year), 4);
-    put(5, i64::from(month), 2);
-    put(8, i64::from(day), 2);
-    put(11, ms / 3_600_000, 2);
-    put(14, ms / 60_000 % 60, 2);
-    put(17, ms / 1000 % 60, 2);
-    put(20, ms % 1000, 3);
-    for (at, sep) in [
-        (4, b'-'),
-        (7, b'-'),
-        (10, b'T'),
-        (13, b':'),
-        (16, b':'),
-        (19, b'.'),
-        (23, b'Z'),
-    ] {
-        buf[at] = sep;
-    }
-    std::str::from_utf8(buf).unwrap_or("")
 }
 
 /// Keeps the kind of an I/O error wrapped by `mcap`.
@@ -316,16 +198,6 @@ fn mcap_io_error(err: ::mcap::McapError) -> std::io::Error {
     match err {
         ::mcap::McapError::Io(e) => e,
         other => std::io::Error::other(other.to_string()),
-    }
-}
-
-/// Keeps the kind of an I/O error wrapped by `csv` (its own conversion
-/// turns every error into `Other`, hiding a closed pipe).
-fn csv_io_error(err: csv::Error) -> std::io::Error {
-    let message = err.to_string();
-    match err.into_kind() {
-        csv::ErrorKind::Io(e) => e,
-        _ => std::io::Error::other(message),
     }
 }
 
@@ -337,23 +209,6 @@ mod tests {
     fn the_documented_csv_columns_come_first() {
         let names: Vec<&str> = columns::COLUMNS.iter().map(|c| c.name).collect();
         assert_eq!(names[..CSV_COLUMNS.len()], CSV_COLUMNS);
-    }
-
-    #[test]
-    fn fast_utc_text_is_iso8601() {
-        let mut buf = [0u8; UTC_LEN];
-        for ms in [
-            946_684_800_000i64,
-            1_584_538_100_600,
-            1_584_575_999_999,
-            4_102_444_800_123,
-        ] {
-            assert_eq!(
-                utc_text(ms * 1000 + 999, &mut buf),
-                crate::time::iso8601_unix_ms(ms).unwrap()
-            );
-        }
-        assert_eq!(utc_text(0, &mut buf), "");
     }
 
     #[test]

@@ -278,6 +278,31 @@ mod tests {
     }
 
     #[test]
+    fn points_outside_a_later_window_go_to_its_end_columns() {
+        // Ten 1 s columns from 10 s: before the window is the first column,
+        // after it the last; inside, each point is in its own column.
+        let mut line = Decimator::new(&(10.0..20.0), 10);
+        for (t, y) in [
+            (4.0, 1.0),
+            (10.5, 2.0),
+            (14.5, 3.0),
+            (15.5, 4.0),
+            (25.0, 5.0),
+        ] {
+            line.push(t, y, false);
+        }
+        assert_eq!(
+            line.lines(),
+            vec![
+                vec![(4.0, 1.0), (10.5, 2.0)],
+                vec![(14.5, 3.0)],
+                vec![(15.5, 4.0)],
+                vec![(25.0, 5.0)],
+            ]
+        );
+    }
+
+    #[test]
     fn a_zoomed_line_joins_columns_it_skips() {
         let mut line = Decimator::new(&(0.0..1.0), 100);
         for (t, joins) in [(0.0, false), (0.3, true), (0.6, false), (0.9, true)] {

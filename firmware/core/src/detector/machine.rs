@@ -461,8 +461,8 @@ impl Detector {
                 }
                 self.state = State::Alerting { below: 0 };
                 // Report the frequency from the longer window when it agrees
-                // that the peak is in band (it resolves nearby harmonics
-                // better); otherwise the analysis window's.
+                // that the peak is in band (in noise and beside leftover wheel
+                // ripple it measures better); otherwise the analysis window's.
                 let n = self.p.freq_window_len.min(self.filled);
                 let freq_hz = if n > self.p.window_len {
                     let (window, scale) = if n == self.p.freq_window_len {

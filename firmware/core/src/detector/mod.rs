@@ -106,7 +106,7 @@ pub struct DetectorConfig {
     /// (a kick's ring entering the window, beating wheel harmonics).
     pub max_growth_ratio: f32,
     /// Window of the frequency estimate reported when the alert fires: longer
-    /// than `window_s`, so nearby wheel harmonics bias it less.
+    /// than `window_s`, so noise and nearby wheel harmonics bias it less.
     pub freq_window_s: f32,
     /// Below this wheel speed (when speed is known) the alert stays off.
     pub min_speed_mps: f32,
