@@ -19,9 +19,12 @@ use wobblog::analysis::{find_episodes, wobble_speed_mps, Episode, Run, Stability
 /// Fixtures the fit is known to measure worse, with their own (sigma,
 /// onset) limits, so they cannot get worse unnoticed. The limit cycle (0.9
 /// deg held for 6 s at 6.6 Hz, 4.4 m/s) beats with the wheel's 3rd harmonic
-/// 0.55 Hz below it (2.18 m wheel): the envelope first reaches 85 % of its
-/// peak 0.4 s into the plateau, so the growth fit runs into the plateau
-/// (measured: sigma 21 % low, onset 0.57 s early).
+/// 0.55 Hz below it (2.18 m wheel). The largest envelope is a beat's crest,
+/// so the climb reaches 85 % of it 0.39 s into the plateau; a beat's trough
+/// restarts the climb at 10.83 s, so the tone fitted alongside is sought
+/// where the wobble already grows and is the wobble itself (6.58 Hz).
+/// Measured: sigma 21 % low, onset 0.57 s early. Correcting the three costs
+/// the simulated family its onset limit (host-tools/docs/analysis.md).
 const KNOWN_WORSE: [(&str, f64, f64); 1] = [("wobble_limit_cycle", 0.25, 0.6)];
 
 fn manifest() -> Value {
