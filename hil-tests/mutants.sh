@@ -54,6 +54,10 @@ targets=(
   "selftest|wobble-core|firmware/core/src/selftest.rs|.|--lib --test selftest_card"
   "resample|wobblog|host-tools/src/resample.rs|.|--lib --test csv_checks"
   "decimator|wobblog|host-tools/src/plot/mod.rs|Decimator|--lib --test plot_figures"
+  "csv-lines|wobblog|host-tools/src/export/text.rs|.|--lib --test roundtrip"
+  "line-writer|wobblog|host-tools/src/export/lines.rs|.|--lib --test broken_pipe"
+  "event-order|wobblog|host-tools/src/events.rs|TimeOrder|--lib --test events_config"
+  "gpx-track|wobblog|host-tools/src/cmd/gpx.rs|.|--test gpx_track --test log_semantics --test broken_pipe"
 )
 
 list=false
