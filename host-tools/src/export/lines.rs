@@ -196,6 +196,24 @@ mod tests {
         }
     }
 
+    /// Rows go out in whole batches, and once there are more batches than
+    /// workers every worker holds one: the text is formatted in parallel.
+    #[test]
+    fn rows_go_out_in_full_batches_to_every_worker() {
+        for workers in 1..=MAX_WORKERS {
+            let mut w = LineWriter::with_workers(std::io::sink(), &COLUMNS, csv_line, workers);
+            let rows = rows(BATCH_ROWS);
+            for batch in 1..=2 * workers {
+                rows.iter().try_for_each(|row| w.write(row)).unwrap();
+                assert_eq!(w.sent, batch, "{workers} workers");
+                assert_eq!(w.in_flight.len(), batch.min(workers), "{workers} workers");
+            }
+            w.write(&rows[0]).unwrap();
+            w.flush().unwrap();
+            assert_eq!((w.sent, w.in_flight.len()), (2 * workers + 1, 0));
+        }
+    }
+
     /// Takes `room` bytes, then fails as a closed pipe does.
     struct Closing {
         room: usize,

@@ -159,6 +159,7 @@ fn utc_text(us: i64, buf: &mut [u8; UTC_LEN]) -> &str {
 
 #[cfg(test)]
 mod tests {
+    use super::super::columns::{Kind, COLUMNS};
     use super::*;
     use proptest::prelude::*;
 
@@ -241,10 +242,10 @@ mod tests {
         #[test]
         fn csv_lines_are_the_csv_writers(
             row in any_row(),
-            picks in prop::collection::vec(0..super::super::columns::COLUMNS.len(), 1..20),
+            picks in prop::collection::vec(0..COLUMNS.len(), 1..20),
         ) {
             let columns: Vec<Column> =
-                picks.iter().map(|&i| super::super::columns::COLUMNS[i]).collect();
+                picks.iter().map(|&i| COLUMNS[i]).collect();
             let mut line = String::new();
             csv_line(&mut line, &columns, &row);
             prop_assert_eq!(line, csv_writers_line(&columns, &row));
@@ -257,13 +258,72 @@ mod tests {
         ) {
             let column = Column::<Option<String>> {
                 name: "card",
-                kind: super::super::columns::Kind::Text,
+                kind: Kind::Text,
                 value: |s| Value::Text(s.clone()),
             };
             let columns = vec![column; count];
             let mut line = String::new();
             csv_line(&mut line, &columns, &text);
             prop_assert_eq!(line, csv_writers_line(&columns, &text));
+        }
+
+        /// Each JSON line parses (serde_json) to exactly the present cells:
+        /// numbers, names, times, whole numbers and escaped text.
+        #[test]
+        fn json_lines_parse_to_their_cells(
+            row in any_row(),
+            picks in prop::sample::subsequence((0..COLUMNS.len() + 2).collect::<Vec<_>>(), 1..=COLUMNS.len() + 2),
+        ) {
+            let finite = |v: f64| if v.is_finite() { v } else { 0.0 };
+            let row = Row {
+                t_s: finite(row.t_s),
+                accel_g: row.accel_g.map(finite),
+                ..row
+            };
+            let extra = [
+                Column {
+                    name: "wheel_count",
+                    kind: Kind::Integer,
+                    value: |r: &Row| Value::Integer(Some(i64::from(r.wheel_count) - 40_000)),
+                },
+                Column {
+                    name: "card",
+                    kind: Kind::Text,
+                    value: |r: &Row| Value::Text(Some(format!("\"{}\"\\\u{e9}\n", r.status.0))),
+                },
+            ];
+            let columns: Vec<Column> = picks
+                .iter()
+                .map(|&i| COLUMNS.get(i).copied().unwrap_or_else(|| extra[i - COLUMNS.len()]))
+                .collect();
+            let mut line = String::new();
+            json_line(&mut line, &columns, &row);
+            prop_assert!(line.ends_with('\n') && line.matches('\n').count() == 1, "{}", line);
+            let parsed: serde_json::Map<String, serde_json::Value> =
+                serde_json::from_str(&line).map_err(|e| TestCaseError::fail(format!("{e}: {line}")))?;
+            let mut time = [0u8; UTC_LEN];
+            let mut present = 0;
+            for column in &columns {
+                let cell = parsed.get(column.name);
+                let expected = match (column.value)(&row) {
+                    Value::Number(v) => v.map(serde_json::Value::from),
+                    Value::Label(s) => s.map(serde_json::Value::from),
+                    Value::Utc(us) => us.map(|us| utc_text(us, &mut time).into()),
+                    Value::Integer(n) => n.map(serde_json::Value::from),
+                    Value::Text(s) => s.map(serde_json::Value::from),
+                };
+                present += usize::from(expected.is_some());
+                // serde_json reads a number to within an ulp, not to the bit.
+                let near = |a: &serde_json::Value, b: &serde_json::Value| match (a.as_f64(), b.as_f64()) {
+                    (Some(x), Some(y)) if a.is_f64() => (x - y).abs() <= 1e-15 * y.abs(),
+                    _ => a == b,
+                };
+                prop_assert!(
+                    cell.zip(expected.as_ref()).map_or(cell.is_none() && expected.is_none(), |(a, b)| near(a, b)),
+                    "{}: {:?} for {:?}", column.name, cell, expected
+                );
+            }
+            prop_assert_eq!(parsed.len(), present);
         }
     }
 }
