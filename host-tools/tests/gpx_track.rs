@@ -139,3 +139,72 @@ fn the_track_is_walked_as_read_and_stops_at_the_first_failed_write() {
         "nothing visited after the error"
     );
 }
+
+/// A log whose only fixes are at `times_s`, each 1e-4 degrees further north.
+fn log_with_fixes(path: &std::path::Path, times_s: &[f64]) {
+    use wobble_core::format::{FixMode, GpsFix, Record};
+    let records = times_s
+        .iter()
+        .enumerate()
+        .map(|(k, &t)| {
+            Record::Gps(GpsFix {
+                t_us: (t * 1e6).round() as u64,
+                lat_e7: Some(522_000_000 + 1000 * k as i32),
+                lon_e7: Some(68_800_000),
+                fix: FixMode::Fix3d,
+                ..GpsFix::default()
+            })
+        })
+        .collect();
+    let extras = Extras {
+        records,
+        ..Extras::default()
+    };
+    analysis_support::write_log(path, &Ride::new(30.0, 5.0, 0.0, 0.0, 0.0), &extras);
+}
+
+/// Five seconds without any fix record still continue a segment, more
+/// than that starts a new one; the document is whole, and no warning is
+/// given for a track that has points.
+#[test]
+fn a_silence_over_five_seconds_splits_the_track() {
+    let dir = tempfile::tempdir().unwrap();
+    let log = dir.path().join("RUN00004.WBL");
+    let times = [1.0, 2.0, 3.0, 8.0, 14.0, 15.0];
+    log_with_fixes(&log, &times);
+    let out = wobblog().arg("gpx").arg(&log).output().unwrap();
+    assert!(out.status.success());
+    assert!(
+        out.stderr.is_empty(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let gpx = String::from_utf8(out.stdout).unwrap();
+    assert!(gpx.trim_end().ends_with("</gpx>"), "{gpx}");
+    let counts: Vec<usize> = segments(&gpx).iter().map(Vec::len).collect();
+    assert_eq!(counts, [4, 2], "3 s to 8 s is 5 s, 8 s to 14 s is 6 s");
+}
+
+/// `--from/--to` in seconds since boot keep the fixes inside.
+#[test]
+fn the_window_keeps_the_fixes_inside_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let log = dir.path().join("RUN00005.WBL");
+    let times: Vec<f64> = (1..=20).map(f64::from).collect();
+    log_with_fixes(&log, &times);
+    let gpx = stdout_of(
+        wobblog()
+            .arg("gpx")
+            .arg(&log)
+            .args(["--from", "5", "--to", "9.5"]),
+    );
+    let lats: Vec<f64> = segments(&gpx).iter().flatten().map(|p| p.0).collect();
+    let expected: Vec<f64> = (4..9).map(|k| 52.2 + 1e-4 * f64::from(k)).collect();
+    assert_eq!(lats.len(), expected.len(), "{gpx}");
+    assert!(
+        lats.iter()
+            .zip(&expected)
+            .all(|(a, b)| (a - b).abs() < 1e-9),
+        "{lats:?}"
+    );
+}
