@@ -33,6 +33,8 @@ struct Worker {
 /// Writes rows as text lines to `out`, in order.
 pub struct LineWriter<W: Write> {
     out: W,
+    columns: Vec<Column>,
+    format: FormatLine,
     batch: Vec<Row>,
     workers: Vec<Worker>,
     /// Workers holding a batch, in the order the batches were sent.
@@ -51,28 +53,32 @@ impl<W: Write> LineWriter<W> {
         Self::with_workers(out, columns, format, count)
     }
 
+    /// With `count` workers, or as many of them as the system starts (with
+    /// none, rows are formatted on the calling thread).
     fn with_workers(out: W, columns: &[Column], format: FormatLine, count: usize) -> Self {
         let workers = (0..count)
-            .map(|_| {
+            .filter_map(|_| {
                 let (to, rows) = sync_channel::<Batch>(1);
                 let (done, from) = sync_channel::<Batch>(1);
                 let columns = columns.to_vec();
-                std::thread::spawn(move || {
+                let worker = move || {
                     for (rows, mut text) in rows {
-                        text.clear();
-                        for row in &rows {
-                            format(&mut text, &columns, row);
-                        }
+                        format_batch(format, &columns, &rows, &mut text);
                         if done.send((rows, text)).is_err() {
                             break;
                         }
                     }
-                });
-                Worker { to, from }
+                };
+                let started = std::thread::Builder::new()
+                    .name("wobblog-format".into())
+                    .spawn(worker);
+                started.ok().map(|_| Worker { to, from })
             })
             .collect();
         Self {
             out,
+            columns: columns.to_vec(),
+            format,
             batch: Vec::with_capacity(BATCH_ROWS),
             workers,
             in_flight: VecDeque::new(),
@@ -109,6 +115,12 @@ impl<W: Write> LineWriter<W> {
         if self.batch.is_empty() {
             return Ok(());
         }
+        if self.workers.is_empty() {
+            let mut text = String::new();
+            format_batch(self.format, &self.columns, &self.batch, &mut text);
+            self.batch.clear();
+            return self.out.write_all(text.as_bytes());
+        }
         if self.in_flight.len() == self.workers.len() {
             self.write_oldest()?;
         }
@@ -140,6 +152,14 @@ impl<W: Write> LineWriter<W> {
             self.write_oldest()?;
         }
         Ok(())
+    }
+}
+
+/// The text of `rows`, in `text` (cleared first).
+fn format_batch(format: FormatLine, columns: &[Column], rows: &[Row], text: &mut String) {
+    text.clear();
+    for row in rows {
+        format(text, columns, row);
     }
 }
 
@@ -183,7 +203,9 @@ mod tests {
             for row in &rows {
                 csv_line(&mut expected, &COLUMNS, row);
             }
-            for workers in 1..=MAX_WORKERS {
+            // No worker: the system started none, and the rows are
+            // formatted where they are written.
+            for workers in 0..=MAX_WORKERS {
                 let mut w = LineWriter::with_workers(Vec::new(), &COLUMNS, csv_line, workers);
                 w.write_text("header\n").unwrap();
                 for row in &rows {
@@ -235,7 +257,7 @@ mod tests {
 
     #[test]
     fn a_failed_write_is_the_error_and_nothing_waits() {
-        for workers in 1..=MAX_WORKERS {
+        for workers in 0..=MAX_WORKERS {
             let mut w =
                 LineWriter::with_workers(Closing { room: 1000 }, &COLUMNS, csv_line, workers);
             let rows = rows(20 * BATCH_ROWS);
