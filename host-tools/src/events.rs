@@ -281,8 +281,15 @@ impl TimeOrder {
     }
 
     /// Takes the next event in file order; `out` gets every event that no
-    /// later one can come before.
-    pub fn push(&mut self, event: LogEvent, out: &mut impl FnMut(LogEvent)) {
+    /// later one can come before, and its first error is returned.
+    ///
+    /// # Errors
+    /// `out` failed.
+    pub fn push<E>(
+        &mut self,
+        event: LogEvent,
+        out: &mut impl FnMut(LogEvent) -> Result<(), E>,
+    ) -> Result<(), E> {
         let latest_s = self.latest_s.map_or(event.t_s, |l| l.max(event.t_s));
         self.latest_s = Some(latest_s);
         self.held.push(Reverse(Held {
@@ -295,16 +302,21 @@ impl TimeOrder {
                 break;
             }
             if let Some(Reverse(first)) = self.held.pop() {
-                out(first.event);
+                out(first.event)?;
             }
         }
+        Ok(())
     }
 
     /// Hands over every event still held, in order.
-    pub fn finish(mut self, out: &mut impl FnMut(LogEvent)) {
+    ///
+    /// # Errors
+    /// `out` failed.
+    pub fn finish<E>(mut self, out: &mut impl FnMut(LogEvent) -> Result<(), E>) -> Result<(), E> {
         while let Some(Reverse(first)) = self.held.pop() {
-            out(first.event);
+            out(first.event)?;
         }
+        Ok(())
     }
 }
 
@@ -348,10 +360,18 @@ mod tests {
         let mut out = Vec::new();
         let mut most_held = 0;
         for e in events {
-            order.push(e.clone(), &mut |e| out.push(e));
+            let pushed: Result<(), ()> = order.push(e.clone(), &mut |e| {
+                out.push(e);
+                Ok(())
+            });
+            pushed.unwrap();
             most_held = most_held.max(order.held.len());
         }
-        order.finish(&mut |e| out.push(e));
+        let finished: Result<(), ()> = order.finish(&mut |e| {
+            out.push(e);
+            Ok(())
+        });
+        finished.unwrap();
         (out, most_held)
     }
 

@@ -11,7 +11,7 @@ use wobble_core::format::{DecodeStats, Decoder, Event, BLOCK_LEN};
 use crate::CliError;
 
 /// Bytes read from the file at a time.
-pub const CHUNK_LEN: usize = 1 << 20;
+const CHUNK_LEN: usize = 1 << 20;
 /// Files larger than this get a progress bar (when stderr is a terminal).
 const PROGRESS_MIN_LEN: u64 = 64 << 20;
 
@@ -25,6 +25,27 @@ pub fn read_log(path: &Path, mut visit: impl FnMut(Event<'_>)) -> Result<DecodeS
         visit(event);
         ControlFlow::Continue(())
     })
+}
+
+/// Decodes the log at `path` like [`read_log`] until `visit` fails (a
+/// closed pipe, say): the rest of the file is not read, and its error is
+/// the inner result.
+///
+/// # Errors
+/// The log cannot be read.
+pub fn read_log_try<E>(
+    path: &Path,
+    mut visit: impl FnMut(Event<'_>) -> Result<(), E>,
+) -> Result<Result<(), E>, CliError> {
+    let mut failed = None;
+    read_log_until(path, CHUNK_LEN, |event| match visit(event) {
+        Ok(()) => ControlFlow::Continue(()),
+        Err(e) => {
+            failed = Some(e);
+            ControlFlow::Break(())
+        }
+    })?;
+    Ok(failed.map_or(Ok(()), Err))
 }
 
 /// Decodes the log at `path` like [`read_log`] until `visit` breaks: the

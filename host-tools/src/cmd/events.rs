@@ -2,12 +2,11 @@
 //! in time order, listed as the log is read.
 
 use std::io::Write;
-use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
 
 use crate::events::{EventConverter, LogEvent, TimeOrder};
 use crate::output::Output;
-use crate::reader::{read_log_until, CHUNK_LEN};
+use crate::reader::read_log_try;
 use crate::CliError;
 
 /// Arguments of `wobblog events`.
@@ -57,27 +56,11 @@ pub fn walk<E>(
 ) -> Result<Result<(), E>, CliError> {
     let mut converter = EventConverter::new();
     let mut order = TimeOrder::new();
-    let mut failed = None;
-    read_log_until(path, CHUNK_LEN, |event| {
-        if let Some(e) = converter.convert(&event) {
-            order.push(e, &mut |e| hand(&mut visit, &mut failed, e));
-        }
-        // After a failed write (a closed pipe) the rest is not read.
-        if failed.is_some() {
-            ControlFlow::Break(())
-        } else {
-            ControlFlow::Continue(())
-        }
+    let walked = read_log_try(path, |event| match converter.convert(&event) {
+        Some(e) => order.push(e, &mut visit),
+        None => Ok(()),
     })?;
-    order.finish(&mut |e| hand(&mut visit, &mut failed, e));
-    Ok(failed.map_or(Ok(()), Err))
-}
-
-/// Hands `e` to `visit` unless an earlier visit failed; keeps the failure.
-fn hand<E>(visit: &mut impl FnMut(LogEvent) -> Result<(), E>, failed: &mut Option<E>, e: LogEvent) {
-    if failed.is_none() {
-        *failed = visit(e).err();
-    }
+    Ok(walked.and_then(|()| order.finish(&mut visit)))
 }
 
 /// The events as a table or as JSON lines.

@@ -1,7 +1,6 @@
 //! `wobblog gpx`: the run's GPS track as GPX 1.1, for maps and GIS tools.
 
 use std::io::Write;
-use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
 
 use quick_xml::events::{BytesDecl, BytesEnd, BytesStart, BytesText, Event};
@@ -9,7 +8,7 @@ use quick_xml::Writer;
 use wobble_core::format::{Event as LogEvent, GpsFix, Record};
 
 use crate::output::Output;
-use crate::reader::{read_log_until, CHUNK_LEN};
+use crate::reader::read_log_try;
 use crate::rows::GpsColumns;
 use crate::time::{TimeWindow, WindowArgs};
 use crate::CliError;
@@ -79,38 +78,27 @@ pub fn track<E>(
 ) -> Result<Result<(), E>, CliError> {
     // The time of the open segment's last point.
     let mut last_us: Option<u64> = None;
-    let mut failed = None;
-    let mut step = |step: Step<'_>| match visit(step) {
-        Ok(()) => ControlFlow::Continue(()),
-        Err(e) => {
-            failed = Some(e);
-            ControlFlow::Break(())
-        }
-    };
-    read_log_until(log, CHUNK_LEN, |event| {
+    read_log_try(log, |event| {
         let LogEvent::Record(Record::Gps(fix)) = event else {
             // A block lost from the file may have held fixes.
             if matches!(event, LogEvent::Gap(_)) && last_us.take().is_some() {
-                return step(Step::Break);
+                visit(Step::Break)?;
             }
-            return ControlFlow::Continue(());
+            return Ok(());
         };
         let utc_ms = fix.utc.and_then(|u| i64::try_from(u.unix_ms()).ok());
         if GpsColumns::from_fix(&fix).is_none() || !window.contains(fix.t_us as f64 / 1e6, utc_ms) {
             if last_us.take().is_some() {
-                return step(Step::Break);
+                visit(Step::Break)?;
             }
-            return ControlFlow::Continue(());
+            return Ok(());
         }
-        if last_us.is_some_and(|t| fix.t_us.saturating_sub(t) > SEGMENT_GAP_US)
-            && step(Step::Break).is_break()
-        {
-            return ControlFlow::Break(());
+        if last_us.is_some_and(|t| fix.t_us.saturating_sub(t) > SEGMENT_GAP_US) {
+            visit(Step::Break)?;
         }
         last_us = Some(fix.t_us);
-        step(Step::Point(&fix))
-    })?;
-    Ok(failed.map_or(Ok(()), Err))
+        visit(Step::Point(&fix))
+    })
 }
 
 /// A GPX 1.1 document of one track, written as its points come; nothing
