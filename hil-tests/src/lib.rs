@@ -6,5 +6,6 @@
 #![warn(missing_docs)]
 
 pub mod corpus;
+pub mod kick_metrics;
 pub mod metrics;
 pub mod qemu;

@@ -35,6 +35,20 @@ pub enum EventKind {
     },
     /// The alert switched off.
     AlertOff,
+    /// A kick's ring-down as the detector measured it on board (the time
+    /// is the kick's).
+    Kick {
+        /// Mean speed over the ring, m/s (`null`: unknown).
+        speed_mps: Option<f64>,
+        /// Ring frequency, Hz.
+        freq_hz: f64,
+        /// Growth rate, 1/s (negative: decaying).
+        sigma_per_s: f64,
+        /// Ring amplitude at the kick, degrees.
+        amp_deg: f64,
+        /// Standard error of `sigma_per_s`, 1/s.
+        sigma_se_per_s: f64,
+    },
     /// The rider pressed the marker button.
     Marker {
         /// Marker number since boot.
@@ -109,6 +123,7 @@ impl EventKind {
         match self {
             Self::AlertOn { .. } => "alert_on",
             Self::AlertOff => "alert_off",
+            Self::Kick { .. } => "kick",
             Self::Marker { .. } => "marker",
             Self::Fault { .. } => "fault",
             Self::Dropout { .. } => "dropout",
@@ -126,6 +141,16 @@ impl EventKind {
         match self {
             Self::AlertOn { freq_hz, amp_deg } => format!("{freq_hz:.2} Hz, {amp_deg:.2} deg"),
             Self::AlertOff => String::new(),
+            Self::Kick {
+                speed_mps,
+                freq_hz,
+                sigma_per_s,
+                amp_deg,
+                sigma_se_per_s,
+            } => format!(
+                "{freq_hz:.2} Hz, sigma {sigma_per_s:.2} +- {sigma_se_per_s:.2} 1/s, {amp_deg:.2} deg, {}",
+                speed_mps.map_or("speed unknown".to_owned(), |v| format!("{v:.2} m/s"))
+            ),
             Self::Marker { id } => format!("marker {id}"),
             Self::Fault {
                 source,
@@ -327,6 +352,13 @@ fn record_event(record: &Record<'_>) -> Option<EventKind> {
             amp_deg: f64::from(a.amp_cdeg) / 100.0,
         },
         Record::Alert(_) => EventKind::AlertOff,
+        Record::Kick(k) => EventKind::Kick {
+            speed_mps: k.speed_mm_s.map(|v| f64::from(v) / 1000.0),
+            freq_hz: f64::from(k.freq_chz) / 100.0,
+            sigma_per_s: f64::from(k.sigma_milli_per_s) / 1000.0,
+            amp_deg: f64::from(k.amp_cdeg) / 100.0,
+            sigma_se_per_s: f64::from(k.sigma_se_milli_per_s) / 1000.0,
+        },
         Record::Marker(m) => EventKind::Marker { id: m.id },
         Record::Fault(f) => EventKind::Fault {
             source: f.source.as_str(),

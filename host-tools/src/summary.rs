@@ -199,7 +199,8 @@ impl SummaryBuilder {
                 s.run = Some(info.run);
                 s.sample_rate_hz = Some(info.sample_rate_hz);
             }
-            Record::Channel(_) => {}
+            // `wobblog events` lists the kicks.
+            Record::Channel(_) | Record::Kick(_) => {}
             Record::Config(line) => s.config.push(escape_controls(line.text).into_owned()),
         }
         let with_gps = &mut self.rows_with_gps;

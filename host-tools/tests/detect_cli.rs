@@ -82,7 +82,7 @@ fn same_events_as_the_corpus_metrics() {
 }
 
 #[test]
-fn non_wobble_ride_prints_no_alerts() {
+fn non_wobble_ride_prints_no_alerts_and_its_kicks() {
     let out = wobblog()
         .args(["detect", "--csv"])
         .arg(corpus("ride_kicks.csv"))
@@ -90,16 +90,53 @@ fn non_wobble_ride_prints_no_alerts() {
         .expect("runs");
     assert_eq!(out.status.code(), Some(0));
     let text = String::from_utf8(out.stdout).expect("utf-8");
+    let summary = text.lines().last().unwrap_or("");
     assert!(
-        text.starts_with("no alerts over 119.99 s (12000 samples, with speed)"),
+        summary.starts_with("no alerts over 119.99 s (12000 samples, with speed), "),
         "{text}"
     );
+    assert!(!text.contains("alert_on"), "{text}");
     let out = wobblog()
         .args(["detect", "--json", "--csv"])
         .arg(corpus("ride_kicks.csv"))
         .output()
         .expect("runs");
-    assert!(out.stdout.is_empty());
+    let text = String::from_utf8(out.stdout).expect("utf-8");
+    // Every line is a kick the fixture holds (manifest.json: its times).
+    let manifest: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(corpus("manifest.json")).expect("manifest"))
+            .expect("JSON");
+    let fixture = manifest["fixtures"]
+        .as_array()
+        .and_then(|f| f.iter().find(|f| f["name"] == "ride_kicks"))
+        .expect("ride_kicks in the manifest");
+    let true_kicks: Vec<f64> = fixture["events"]
+        .as_array()
+        .expect("events")
+        .iter()
+        .filter(|e| e["kind"] == "kick")
+        .map(|e| e["t_s"].as_f64().expect("t_s"))
+        .collect();
+    let lines: Vec<serde_json::Value> = text
+        .lines()
+        .map(|l| serde_json::from_str(l).expect("each line is JSON"))
+        .collect();
+    assert!(!lines.is_empty(), "no kick measured");
+    assert_eq!(summary.matches("kick").count(), 1, "{summary}");
+    for l in &lines {
+        assert_eq!(l["event"], "kick", "{l}");
+        let t = l["t_s"].as_f64().expect("t_s");
+        assert!(true_kicks.iter().any(|k| (k - t).abs() < 0.5), "{l}");
+        for key in [
+            "speed_mps",
+            "freq_hz",
+            "sigma_per_s",
+            "amp_deg",
+            "sigma_se_per_s",
+        ] {
+            assert!(l[key].is_number(), "{key} in {l}");
+        }
+    }
 }
 
 #[test]

@@ -556,6 +556,8 @@ const KEYS: &[Key] = &[
     key!(Detector: detector.min_speed_mps),
     key!(Detector: detector.harmonic_tol_hz),
     key!(Detector: detector.harmonic_growth_ratio),
+    key!(Detector: detector.decay_span_s),
+    key!(Detector: detector.decay_span_ratio),
     key!(Alert: alert.enabled),
     key!(Alert: alert.pattern.beep_on_us),
     key!(Alert: alert.pattern.beep_off_us),

@@ -28,6 +28,7 @@ struct Model {
     cfg: DetectorConfig,
     lookback: usize,
     off_hold: usize,
+    decay_span: usize,
     /// The dominant amplitude of every analysis so far.
     amps: Vec<f32>,
     confirm: u8,
@@ -44,6 +45,7 @@ impl Model {
             cfg,
             lookback: hops(cfg.lookback_s),
             off_hold: hops(cfg.off_hold_s).max(1),
+            decay_span: hops(cfg.decay_span_s),
             amps: Vec::new(),
             confirm: 0,
             alerting: None,
@@ -100,7 +102,12 @@ impl Model {
         } else {
             c.min_growth_ratio
         };
+        // The largest amplitude of the decay span, this analysis included.
+        let span_peak = self.amps[self.amps.len().saturating_sub(self.decay_span)..]
+            .iter()
+            .fold(0.0_f32, |m, &a| m.max(a));
         let on = has_lookback
+            && e.amp_deg >= c.decay_span_ratio * span_peak
             && e.amp_deg >= c.amp_on_deg
             && self.in_band(e.freq_hz)
             && !e.impulse_holdoff

@@ -6,7 +6,7 @@ use super::signal::{wobble_mode_hz, Ride, WobbleSpec};
 
 /// Typical wheel-harmonic ripple: well under 0.5 degrees, the 3rd and 4th
 /// (5.6 and 7.5 Hz at 4 m/s) as large as the 1st.
-const HARMONICS: [f64; 6] = [0.10, 0.05, 0.10, 0.10, 0.04, 0.02];
+pub(crate) const HARMONICS: [f64; 6] = [0.10, 0.05, 0.10, 0.10, 0.04, 0.02];
 /// A wheel out of true with a worn tyre: ripple twice as strong.
 const STRONG_HARMONICS: [f64; 6] = [0.20, 0.10, 0.20, 0.20, 0.08, 0.04];
 

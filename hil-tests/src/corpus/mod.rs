@@ -13,6 +13,7 @@
 //! what is committed and what is generated cannot drift apart.
 
 pub mod catalog;
+pub mod kicks;
 pub mod rng;
 pub mod signal;
 pub mod simulated;

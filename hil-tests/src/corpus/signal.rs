@@ -289,6 +289,22 @@ impl Ride {
         self.event("kick", t_s, amp_deg, freq_hz, decay_per_s);
     }
 
+    /// A kick whose push shows: the bar is first pushed aside, a half-sine of
+    /// `push_deg` lasting `push_s`, then the wobble mode rings as in
+    /// [`Ride::kick`] from the end of the push. The truth's time is the
+    /// push's start.
+    pub fn pushed_kick(&mut self, t_s: f64, push_deg: f64, push_s: f64, ring: (f64, f64, f64)) {
+        let (amp_deg, freq_hz, decay_per_s) = ring;
+        let start = libm::ceil(t_s * FS_HZ) as usize;
+        let end = libm::ceil((t_s + push_s) * FS_HZ) as usize;
+        for i in start..end.min(self.len()) {
+            let tau = i as f64 / FS_HZ - t_s;
+            self.steer[i] += push_deg * sin(core::f64::consts::PI * tau / push_s);
+        }
+        self.add_ring(t_s + push_s, amp_deg, freq_hz, decay_per_s);
+        self.event("kick", t_s, amp_deg, freq_hz, decay_per_s);
+    }
+
     /// A pothole: a sharp jolt of `amp_deg` when the front wheel drops in
     /// (40 ms), ringing of the steering mode, and a smaller second hit when
     /// the rear wheel follows one wheelbase (1.1 m) later.

@@ -6,7 +6,7 @@ use std::io::{self, Read};
 use std::path::{Path, PathBuf};
 
 use wobble_core::config::Config;
-use wobble_core::detector::{AlertEvent, Detector};
+use wobble_core::detector::{AlertEvent, Detector, Kick};
 use wobble_core::format::{Event, FaultSource};
 
 use crate::csv_input::{number_in, Cell, Step, TimeSteps};
@@ -27,12 +27,17 @@ that was on is reported off at the last sample before the gap, and a note goes
 to stderr). Samples closer than 7.5 ms, or three gaps of the same length in a
 row, are an error: the CSV is not at 100 Hz.
 
-Output with --json: one JSON object per line for each alert change,
+Output with --json: one JSON object per line for each alert change and each
+kick whose ring-down the detector measured, in time order (a kick's time is
+the kick's; speed_mps is null when the speed is unknown),
+  {\"t_s\": 12.4, \"event\": \"kick\", \"speed_mps\": 3.1, \"freq_hz\": 6.2, \"sigma_per_s\": -1.8, \"amp_deg\": 1.5, \"sigma_se_per_s\": 0.04}
   {\"t_s\": 17.12, \"event\": \"alert_on\", \"freq_hz\": 6.4, \"amp_deg\": 0.8}
   {\"t_s\": 18.9, \"event\": \"alert_off\"}
-and nothing else. Without --json: a table with one line per change (time in
-seconds, event, dominant frequency in Hz and zero-to-peak steering amplitude in
-degrees when the alert switches on), then one summary line.
+and nothing else (sigma_per_s: growth rate of the ring, negative when it
+decays; sigma_se_per_s: its standard error from the fit). Without --json: a
+table with one line per change or kick (time in seconds, event, frequency in
+Hz and zero-to-peak steering amplitude in degrees, and for a kick its growth
+rate and speed), then one summary line.
 
 Exit codes: 0 ok (alerts or not), 1 unreadable or malformed input (the message
 names the file, the line and what is wrong), 2 usage error.";
@@ -67,11 +72,22 @@ pub struct Change {
     pub event: AlertEvent,
 }
 
+/// A kick's ring-down measured during a replay.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct KickAt {
+    /// Time of the kick, seconds (the detector reports it later).
+    pub t_s: f64,
+    /// The measurement.
+    pub kick: Kick,
+}
+
 /// What a replay saw besides the changes.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Replay {
     /// Alert changes in time order.
     pub changes: Vec<Change>,
+    /// Measured kicks, in the order they were reported.
+    pub kicks: Vec<KickAt>,
     /// Rows replayed.
     pub samples: u64,
     /// First and last `t_s`.
@@ -193,6 +209,13 @@ impl Replay {
         if let Some(event) = det.push(steer_deg as f32, speed_mps.map(|v| v as f32)) {
             self.changes.push(Change { t_s, event });
         }
+        if let Some(kick) = det.take_kick() {
+            let ago_s = f64::from(kick.samples_ago) / f64::from(det.config().sample_rate_hz);
+            self.kicks.push(KickAt {
+                t_s: t_s - ago_s,
+                kick,
+            });
+        }
     }
 }
 
@@ -307,18 +330,66 @@ pub fn json_line(c: &Change) -> String {
     }
 }
 
+/// The JSON line of one measured kick.
+#[must_use]
+pub fn kick_json_line(k: &KickAt) -> String {
+    let num = |x: f64| serde_json::to_string(&x).unwrap_or_else(|_| "null".into());
+    let m = &k.kick;
+    format!(
+        "{{\"t_s\": {}, \"event\": \"kick\", \"speed_mps\": {}, \"freq_hz\": {}, \"sigma_per_s\": {}, \"amp_deg\": {}, \"sigma_se_per_s\": {}}}",
+        num(round(k.t_s, 3)),
+        m.speed_mps
+            .map_or("null".into(), |v| num(round(f64::from(v), 2))),
+        num(round(f64::from(m.freq_hz), 2)),
+        num(round(f64::from(m.sigma_per_s), 3)),
+        num(round(f64::from(m.amp_deg), 2)),
+        num(round(f64::from(m.sigma_se_per_s), 3)),
+    )
+}
+
+/// Alert changes and kicks, each with its time, in time order (a kick is
+/// reported after later samples, so the two lists interleave).
+fn in_time_order(r: &Replay) -> Vec<(f64, Result<&Change, &KickAt>)> {
+    let mut all: Vec<_> = r
+        .changes
+        .iter()
+        .map(|c| (c.t_s, Ok(c)))
+        .chain(r.kicks.iter().map(|k| (k.t_s, Err(k))))
+        .collect();
+    all.sort_by(|a, b| a.0.total_cmp(&b.0));
+    all
+}
+
 /// The human-readable report.
 #[must_use]
 pub fn table(r: &Replay) -> String {
     use std::fmt::Write as _;
     let mut s = String::new();
-    if !r.changes.is_empty() {
+    if !r.changes.is_empty() || !r.kicks.is_empty() {
         let _ = writeln!(
             s,
-            "{:>10}  {:<9}  {:>7}  {:>7}",
-            "t_s", "event", "freq_hz", "amp_deg"
+            "{:>10}  {:<9}  {:>7}  {:>7}  {:>11}  {:>9}",
+            "t_s", "event", "freq_hz", "amp_deg", "sigma_per_s", "speed_mps"
         );
-        for c in &r.changes {
+        for (_, item) in in_time_order(r) {
+            let c = match item {
+                Ok(c) => c,
+                Err(k) => {
+                    let m = &k.kick;
+                    let speed = m.speed_mps.map_or("-".into(), |v| format!("{v:.2}"));
+                    let _ = writeln!(
+                        s,
+                        "{:>10.2}  {:<9}  {:>7.2}  {:>7.2}  {:>11}  {:>9}",
+                        k.t_s,
+                        "kick",
+                        m.freq_hz,
+                        m.amp_deg,
+                        format!("{:.2}+-{:.2}", m.sigma_per_s, m.sigma_se_per_s),
+                        speed
+                    );
+                    continue;
+                }
+            };
             match c.event {
                 AlertEvent::On { freq_hz, amp_deg } => {
                     let _ = writeln!(
@@ -354,6 +425,13 @@ pub fn table(r: &Replay) -> String {
             "steering only"
         }
     );
+    if !r.kicks.is_empty() {
+        let _ = write!(
+            s,
+            ", {} measured",
+            crate::words::plural(r.kicks.len(), "kick")
+        );
+    }
     if !r.restarts.is_empty() {
         let _ = write!(s, ", {} restarts at time gaps", r.restarts.len());
     }
@@ -390,8 +468,11 @@ pub fn run(args: &Args) -> Result<(), CliError> {
     }
     let text = if args.json {
         let mut s = String::new();
-        for c in &r.changes {
-            s.push_str(&json_line(c));
+        for (_, item) in in_time_order(&r) {
+            s.push_str(&match item {
+                Ok(c) => json_line(c),
+                Err(k) => kick_json_line(k),
+            });
             s.push('\n');
         }
         s

@@ -177,6 +177,10 @@ impl Sampler {
             self.pattern
                 .set_alert(now_us, matches!(ev, AlertEvent::On { .. }));
         }
+        if let Some(kick) = self.detector.take_kick() {
+            let rate_hz = self.detector.config().sample_rate_hz;
+            out(Record::Kick(kick.to_record(now_us, rate_hz)));
+        }
         self.pattern.update(now_us, alert_out);
         if self.detector.alert_active() {
             frame.status.0 |= FrameStatus::ALERT;

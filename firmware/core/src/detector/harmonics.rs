@@ -236,6 +236,45 @@ mod tests {
         assert!(r < 0.1, "{r}");
     }
 
+    /// Runs `secs` of `amp` degrees of ripple at order 3 alone, phase-locked
+    /// to the wheel at 4 m/s, through a fresh canceller that always learns;
+    /// returns the amplitude it learned.
+    fn learned(secs: f32, amp: f32) -> f32 {
+        let (fs, v, c) = (100.0, 4.0, 2.13);
+        let mut h = HarmonicCanceller::new(4.5, 10.5, 3.0, c, 1.5, fs);
+        for i in 0..(secs * fs) as usize {
+            let th = core::f32::consts::TAU * v / c * (i as f32 / fs);
+            h.process(amp * (3.0 * th + 0.7).sin(), Some(v), true);
+        }
+        h.amplitude_deg(3)
+    }
+
+    #[test]
+    fn the_error_clip_bounds_how_fast_a_large_oscillation_is_learned() {
+        // 3 deg on the 3rd harmonic for 1 s. Unclipped, LMS with a 3 s time
+        // constant learns 3 (1 - e^(-1/3)) = 0.85 deg of it; with the error
+        // clipped to CLIP_DEG each weight moves by at most mu x CLIP_DEG per
+        // sample: 100 x (2 / 300) x 0.2 = 0.13 deg in 1 s.
+        let a = learned(1.0, 3.0);
+        let bound = 100.0 * (2.0 / 300.0) * CLIP_DEG;
+        assert!(a <= bound, "learned {a} deg, clip bound {bound}");
+        // A ripple under the clip is learned at the full rate.
+        let small = learned(1.0, 0.15);
+        assert!(
+            (small / 0.15 - (1.0 - (-1.0_f32 / 3.0).exp())).abs() < 0.05,
+            "{small}"
+        );
+    }
+
+    #[test]
+    fn the_leak_holds_learned_ripple_one_percent_low() {
+        // At convergence leak x w = (mu / 2) (A - w): w = A / (1 + 2 leak /
+        // mu) = A / 1.01 with the leak 200 times slower than learning. No
+        // leak would converge to A itself.
+        let a = learned(60.0, 0.1) / 0.1;
+        assert!((a - 1.0 / 1.01).abs() < 0.002, "{a}");
+    }
+
     #[test]
     fn unknown_speed_passes_through() {
         let mut h = HarmonicCanceller::new(4.5, 10.5, 3.0, 2.13, 1.5, 100.0);

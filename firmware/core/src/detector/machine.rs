@@ -4,6 +4,7 @@
 use super::filter::HighPass4;
 use super::goertzel::{GoertzelBank, MAX_BINS};
 use super::harmonics::HarmonicCanceller;
+use super::ringdown::{Kick, RingDown};
 use super::{math, ConfigError, DetectorConfig, Params, MAX_HISTORY, MAX_WINDOW};
 use crate::format::{quantise_u16, Alert};
 
@@ -148,6 +149,10 @@ pub struct Detector {
     last_input: Option<f32>,
     estimate: Estimate,
     state: State,
+    /// The ring-down of the latest kick being measured, and the measured
+    /// kick not yet taken.
+    ringdown: RingDown,
+    kick: Option<Kick>,
 }
 
 /// A Hann window of `n` taps sampled at bin midpoints (no zero end taps, sum
@@ -231,6 +236,8 @@ impl Detector {
             last_input: None,
             estimate: Estimate::default(),
             state: State::Quiet { confirm: 0 },
+            ringdown: RingDown::new(cfg.sample_rate_hz, (cfg.bin_lo_hz, cfg.bin_hi_hz)),
+            kick: None,
         })
     }
 
@@ -264,6 +271,13 @@ impl Detector {
     #[must_use]
     pub fn estimate(&self) -> Estimate {
         self.estimate
+    }
+
+    /// The latest kick whose ring-down has been measured, once: poll it after
+    /// every [`Detector::push`] (a kick is reported about 0.5-2 s after it
+    /// happened, [`Kick::samples_ago`] says how long).
+    pub fn take_kick(&mut self) -> Option<Kick> {
+        self.kick.take()
     }
 
     /// Samples between two analyses.
@@ -353,6 +367,9 @@ impl Detector {
             y = c.process(y, speed, adapt);
         }
 
+        if let Some(kick) = self.ringdown.sample(y, speed) {
+            self.kick = Some(kick);
+        }
         self.ring[self.head] = y;
         self.head = (self.head + 1) % MAX_WINDOW;
         if self.filled < MAX_WINDOW {
@@ -372,6 +389,27 @@ impl Detector {
             return None;
         }
         self.analyse(speed)
+    }
+
+    /// A new impulse: the kick before it, if one was still being measured, is
+    /// reported with what was measured; this one's ring-down is measured
+    /// (not during an alert, nor below walking speed). An envelope jump is
+    /// seen within a hop of the kick; a spectral jump once its ring fills
+    /// part of the window, about a look-back later.
+    fn start_ringdown(&mut self, envelope_jump: bool, freq_hz: f32, speed_mps: Option<f32>) {
+        if let Some(kick) = self.ringdown.finish() {
+            self.kick = Some(kick);
+        }
+        let walking = speed_mps.is_some_and(|v| v < self.cfg.min_speed_mps);
+        if self.alert_active() || walking {
+            return;
+        }
+        let lead = if envelope_jump {
+            self.p.hop
+        } else {
+            self.p.lookback * self.p.hop
+        };
+        self.ringdown.start(lead as u32, freq_hz);
     }
 
     /// One analysis: spectrum, impulse detector, state machine.
@@ -396,6 +434,7 @@ impl Detector {
             && growth_ratio >= self.cfg.max_growth_ratio;
         if envelope_jump || spectral_jump {
             if self.holdoff_left == 0 {
+                self.start_ringdown(envelope_jump, freq_hz, speed_mps);
                 // The jolt that caused a spectral jump may be anywhere in the
                 // analysis window: start from the envelope's peak over it.
                 let hops = self.p.window_len.div_ceil(self.p.hop);
@@ -444,7 +483,12 @@ impl Detector {
                     } else {
                         self.cfg.min_growth_ratio
                     };
+                // Decayed from the largest amplitude of the decay span (a kick's
+                // ring-down outlasting the impulse hold-off): no alert.
+                let decayed =
+                    amp_deg < self.cfg.decay_span_ratio * self.amps.max(0, self.p.decay_span);
                 let on = previous.is_some()
+                    && !decayed
                     && amp_deg >= self.cfg.amp_on_deg
                     && in_band
                     && !holdoff
@@ -460,6 +504,8 @@ impl Detector {
                     return None;
                 }
                 self.state = State::Alerting { below: 0 };
+                // A ring that alerts is not a ring-down.
+                self.ringdown.cancel();
                 // Report the frequency from the longer window when it agrees
                 // that the peak is in band (in noise and beside leftover wheel
                 // ripple it measures better); otherwise the analysis window's.
@@ -575,6 +621,54 @@ mod tests {
         assert!(!d.alert_active());
         d.reset();
         assert_eq!(d.estimate(), Estimate::default());
+    }
+
+    #[test]
+    fn the_canceller_does_not_learn_a_wobble_while_the_alert_is_on() {
+        // A wobble phase-locked to the wheel's 3rd harmonic (5 m/s): grows
+        // at 2/s from 0.02 deg to 0.7 deg (under the 0.8 deg input gate, so
+        // only the alert stops the learning), then holds for 12 s. Learning
+        // it during the alert would remove it within a few 3 s time
+        // constants and switch the alert off while the wobble goes on.
+        let mut d = detector();
+        let v = 5.0;
+        let f = 3.0 * v / crate::wheel::WheelConfig::DEFAULT.circumference_m;
+        let mut on_at = None;
+        for i in 0..2000 {
+            let t = i as f32 / 100.0;
+            let env = (0.02 * (2.0 * t).exp()).min(0.7);
+            match d.push(env * (TAU * f * t).sin(), Some(v)) {
+                Some(AlertEvent::On { .. }) => on_at = Some(t),
+                Some(AlertEvent::Off) => panic!("alert off at {t} s during the wobble"),
+                None => {}
+            }
+        }
+        let on = on_at.expect("the wobble alerts");
+        assert!(on < 3.0, "{on}");
+        assert!(d.alert_active());
+    }
+
+    #[test]
+    fn a_decaying_ring_past_the_impulse_hold_off_does_not_alert() {
+        // A kick ringing from 2.5 deg at 6.5 Hz, decaying at 0.4/s: the
+        // 0.2 s look-back sees 0.92 of the amplitude (above
+        // min_growth_ratio), but against the largest amplitude of the last
+        // 1.5 s the ring has decayed below decay_span_ratio.
+        let mut d = detector();
+        let mut kick = None;
+        for i in 0..1200 {
+            let t = i as f32 / 100.0;
+            let x = if t < 2.0 {
+                0.0
+            } else {
+                2.5 * (-0.4 * (t - 2.0)).exp() * (TAU * 6.5 * (t - 2.0)).sin()
+            };
+            assert_eq!(d.push(x, Some(3.0)), None, "alert at {t} s");
+            kick = kick.or(d.take_kick());
+        }
+        let k = kick.expect("the ring-down is measured");
+        assert!((k.sigma_per_s + 0.4).abs() < 0.1, "{k:?}");
+        assert!((k.freq_hz - 6.5).abs() < 0.05, "{k:?}");
     }
 
     #[test]

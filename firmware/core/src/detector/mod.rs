@@ -33,12 +33,14 @@ mod harmonics;
 mod machine;
 pub mod math;
 mod pattern;
+mod ringdown;
 
 pub use filter::{Biquad, HighPass4};
 pub use goertzel::{goertzel_power, GoertzelBank, MAX_BINS};
 pub use harmonics::{sincos_turns, HarmonicCanceller};
 pub use machine::{AlertEvent, Detector, Estimate};
 pub use pattern::{AlertOutput, AlertPattern, PatternConfig};
+pub use ringdown::Kick;
 
 /// Longest analysis window, samples (0.64 s at 100 Hz).
 pub const MAX_WINDOW: usize = 64;
@@ -120,6 +122,13 @@ pub struct DetectorConfig {
     /// Learning time constant of the wheel-harmonic canceller (speed known);
     /// 0 switches the canceller off.
     pub harmonic_tau_s: f32,
+    /// Span of the decay check: the largest amplitude of the analyses over
+    /// this long (the current one included)...
+    pub decay_span_s: f32,
+    /// ...times this ratio must not exceed the amplitude now. Below it the
+    /// oscillation has died down since (a kick's ring-down once it is past
+    /// the impulse hold-off) and never alerts; 0 switches the check off.
+    pub decay_span_ratio: f32,
 }
 
 impl DetectorConfig {
@@ -145,14 +154,16 @@ impl DetectorConfig {
         impulse_ratio: 3.0,
         impulse_min_deg: 0.50,
         impulse_holdoff_s: 1.0,
-        impulse_catchup: 1.0,
-        impulse_capture_s: 0.20,
+        impulse_catchup: 1.4,
+        impulse_capture_s: 0.40,
         max_growth_ratio: 2.7,
         freq_window_s: 0.64,
         min_speed_mps: 1.5,
         harmonic_tol_hz: 0.20,
         harmonic_growth_ratio: 1.05,
         harmonic_tau_s: 3.0,
+        decay_span_s: 1.5,
+        decay_span_ratio: 0.85,
     };
 
     /// Worst-case and average arithmetic per sample for this configuration
@@ -279,8 +290,8 @@ pub enum ConfigError {
     Bins,
     /// `amp_off_deg` is not below `amp_on_deg`, or a threshold is negative.
     Thresholds,
-    /// A look-back or impulse span does not fit [`MAX_HISTORY`] hops, or is
-    /// zero.
+    /// A look-back, impulse or decay span does not fit [`MAX_HISTORY`] hops,
+    /// or is zero.
     History,
     /// A value is NaN or infinite.
     NotFinite,
@@ -297,7 +308,7 @@ impl core::fmt::Display for ConfigError {
             Self::Hop => "hop must be 1 sample to the window length",
             Self::Bins => "bins must be 3 to 32 between 0 Hz and Nyquist",
             Self::Thresholds => "amp_off_deg must be below amp_on_deg, thresholds non-negative",
-            Self::History => "look-back and impulse spans must be 1 to 32 hops",
+            Self::History => "look-back, impulse and decay spans must be 1 to 31 hops",
             Self::NotFinite => "a value is NaN or infinite",
             Self::Circumference => "wheel circumference must be a positive number of metres",
         })
@@ -320,6 +331,7 @@ pub(crate) struct Params {
     pub impulse_ref: usize,
     pub impulse_holdoff: usize,
     pub impulse_capture: usize,
+    pub decay_span: usize,
 }
 
 /// Nearest count to a non-negative `x` (no `f32::round` without std).
@@ -361,6 +373,8 @@ impl Params {
             c.harmonic_tol_hz,
             c.harmonic_growth_ratio,
             c.harmonic_tau_s,
+            c.decay_span_s,
+            c.decay_span_ratio,
         ];
         if all.iter().any(|v| !v.is_finite()) {
             return Err(ConfigError::NotFinite);
@@ -406,6 +420,8 @@ impl Params {
             c.harmonic_tol_hz,
             c.harmonic_growth_ratio,
             c.harmonic_tau_s,
+            c.decay_span_s,
+            c.decay_span_ratio,
         ];
         if c.amp_off_deg >= c.amp_on_deg || non_negative.iter().any(|&v| v < 0.0) {
             return Err(ConfigError::Thresholds);
@@ -415,7 +431,10 @@ impl Params {
         let lookback = hops(c.lookback_s);
         let impulse_fast = hops(c.impulse_fast_s);
         let impulse_ref = hops(c.impulse_ref_s);
+        let decay_span = hops(c.decay_span_s);
         if lookback == 0
+            || decay_span == 0
+            || decay_span >= MAX_HISTORY
             || lookback >= MAX_HISTORY
             || impulse_fast == 0
             || impulse_ref == 0
@@ -434,6 +453,7 @@ impl Params {
             impulse_ref,
             impulse_holdoff: hops(c.impulse_holdoff_s),
             impulse_capture: hops(c.impulse_capture_s),
+            decay_span,
         })
     }
 }

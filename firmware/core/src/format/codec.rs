@@ -32,6 +32,10 @@ pub const TAG_LOG_INFO: u8 = 0x80;
 pub const TAG_CHANNEL: u8 = 0x81;
 /// Tag: configuration line (length-prefixed).
 pub const TAG_CONFIG: u8 = 0x82;
+/// Tag: a kick's measured ring-down (length-prefixed, format 1.1).
+pub const TAG_KICK: u8 = 0x83;
+/// `KickRingDown::speed_mm_s` on the card when the speed is unknown.
+const SPEED_UNKNOWN: u16 = u16::MAX;
 /// Nominal frame period: frame time deltas are stored relative to it.
 pub const FRAME_PERIOD_US: i64 = 10_000;
 /// First tag of the length-prefixed range.
@@ -189,6 +193,16 @@ pub fn encode(
             )?
         }
         Record::Config(c) => sized(&mut w, TAG_CONFIG, sdelta, &[c.text.as_bytes()])?,
+        Record::Kick(k) => {
+            let mut body = [0u8; 11];
+            body[0..2].copy_from_slice(&k.speed_mm_s.unwrap_or(SPEED_UNKNOWN).to_le_bytes());
+            body[2..4].copy_from_slice(&k.freq_chz.to_le_bytes());
+            body[4..6].copy_from_slice(&k.sigma_milli_per_s.to_le_bytes());
+            body[6..8].copy_from_slice(&k.sigma_se_milli_per_s.to_le_bytes());
+            body[8..10].copy_from_slice(&k.amp_cdeg.to_le_bytes());
+            body[10] = k.segments;
+            sized(&mut w, TAG_KICK, sdelta, &[&body])?
+        }
     };
     Ok(fits.map(|()| w.len))
 }
@@ -512,7 +526,7 @@ impl<'a> Records<'a> {
 
     /// `Ok(None)` for a length-prefixed tag this reader does not know.
     fn sized_record(&self, tag: u8, r: &mut Reader<'a>) -> Result<Option<Record<'a>>, RecordError> {
-        let known = matches!(tag, TAG_LOG_INFO | TAG_CHANNEL | TAG_CONFIG);
+        let known = matches!(tag, TAG_LOG_INFO | TAG_CHANNEL | TAG_CONFIG | TAG_KICK);
         if !known {
             return Ok(None);
         }
@@ -547,6 +561,16 @@ impl<'a> Records<'a> {
                     counts_per_unit,
                 })
             }
+            // Later minor versions may append fields: the rest is skipped.
+            TAG_KICK => Record::Kick(KickRingDown {
+                t_us,
+                speed_mm_s: Some(r.u16()?).filter(|&v| v != SPEED_UNKNOWN),
+                freq_chz: r.u16()?,
+                sigma_milli_per_s: r.i16()?,
+                sigma_se_milli_per_s: r.u16()?,
+                amp_cdeg: r.u16()?,
+                segments: r.u8()?,
+            }),
             _ => Record::Config(ConfigLine {
                 t_us,
                 text: Reader::str(r.rest(), tag)?,

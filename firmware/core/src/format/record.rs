@@ -441,6 +441,57 @@ pub struct Fault {
     pub count: u16,
 }
 
+/// A kick's ring-down as the on-board detector measured it
+/// (`wobble_core::detector::Kick`): the stable wobble mode's frequency and
+/// growth rate at the speed of the kick.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct KickRingDown {
+    /// Local time of the kick, µs since boot (the record is written when the
+    /// ring has been measured, up to about 2 s later).
+    pub t_us: u64,
+    /// Mean wheel speed over the ring, mm/s (`None`: unknown).
+    pub speed_mm_s: Option<u16>,
+    /// Ring frequency, hundredths of a hertz.
+    pub freq_chz: u16,
+    /// Growth rate, thousandths of 1/s (negative: the ring decays).
+    pub sigma_milli_per_s: i16,
+    /// Standard error of the growth rate, thousandths of 1/s.
+    pub sigma_se_milli_per_s: u16,
+    /// Ring amplitude at the kick, hundredths of a degree.
+    pub amp_cdeg: u16,
+    /// Demodulation segments the fit used.
+    pub segments: u8,
+}
+
+impl KickRingDown {
+    /// Speed, m/s.
+    #[must_use]
+    pub fn speed_mps(&self) -> Option<f32> {
+        self.speed_mm_s.map(|v| f32::from(v) / 1000.0)
+    }
+    /// Frequency, Hz.
+    #[must_use]
+    pub fn freq_hz(&self) -> f32 {
+        f32::from(self.freq_chz) / 100.0
+    }
+    /// Growth rate, 1/s.
+    #[must_use]
+    pub fn sigma_per_s(&self) -> f32 {
+        f32::from(self.sigma_milli_per_s) / 1000.0
+    }
+    /// Standard error of the growth rate, 1/s.
+    #[must_use]
+    pub fn sigma_se_per_s(&self) -> f32 {
+        f32::from(self.sigma_se_milli_per_s) / 1000.0
+    }
+    /// Amplitude at the kick, degrees.
+    #[must_use]
+    pub fn amp_deg(&self) -> f32 {
+        f32::from(self.amp_cdeg) / 100.0
+    }
+}
+
 /// Identity of the logger and firmware that wrote a log (file header).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -507,6 +558,8 @@ pub enum Record<'a> {
     Channel(ChannelDef<'a>),
     /// Header: configuration line.
     Config(ConfigLine<'a>),
+    /// A kick's measured ring-down (format 1.1).
+    Kick(KickRingDown),
 }
 
 impl Record<'_> {
@@ -524,6 +577,7 @@ impl Record<'_> {
             Self::LogInfo(r) => r.t_us,
             Self::Channel(r) => r.t_us,
             Self::Config(r) => r.t_us,
+            Self::Kick(r) => r.t_us,
         }
     }
 }

@@ -4,7 +4,7 @@ use super::road::RoadClass;
 use super::Recipe;
 
 /// The seed paper's test bicycle with its 83 kg rider (wobble speed 3.8 m/s).
-const TEST_BIKE: &str = "test-bicycle.toml";
+pub(crate) const TEST_BIKE: &str = "test-bicycle.toml";
 /// A knock on the handlebar, N m for 30 ms. Near the wobble speed the
 /// wobble mode is barely damped, and a harder knock rings it like a wobble:
 /// with 3 N m at 3.4-3.6 m/s on a class B road the ring reaches 0.6-0.7

@@ -1,0 +1,345 @@
+//! Measuring a kick's ring-down: the frequency and growth rate of the stable
+//! wobble mode that a kick on the bar (or a jolt) rings.
+//!
+//! When the impulse detector sees a kick, the push itself (a short, large
+//! steering transient) is skipped for [`SKIP_S`]; then the high-passed,
+//! ripple-cancelled steering is demodulated at a fixed frequency `f0` (the
+//! dominant frequency at the kick, or the band's centre) in Hann-windowed
+//! segments of [`SEGMENT_S`] every [`STRIDE_S`]. For a damped sinusoid
+//! `A e^(sigma t) cos(2 pi f t + phi)` each segment's complex amplitude is
+//! `A' e^(sigma t_k) e^(j 2 pi (f - f0) t_k)`, `t_k` its centre, so
+//!
+//! - `sigma` is the slope of `ln |X_k|` against `t_k`, fitted by weighted
+//!   least squares with weights `|X_k|^2` (the inverse variance of `ln |X|`
+//!   in additive noise), and its standard error comes from the residuals;
+//! - `f - f0` is the phase advance per stride, from the pulse pair
+//!   `sum X_(k+1) conj(X_k)` (unbiased by white noise, unlike `|X|`);
+//! - the initial amplitude is the fit extrapolated back to the kick.
+//!
+//! A segment is used while its amplitude is at least [`FLOOR_DEG`]: the fit
+//! stops at the first one below, after [`MAX_SEGMENTS`], or when an alert
+//! fires or another impulse arrives, and reports a kick only from
+//! [`MIN_SEGMENTS`] segments or more with the frequency in the wobble band.
+//!
+//! Cost: per sample, while measuring, one oscillator rotation and one
+//! complex multiply-add per open segment (at most 3); per segment, one
+//! logarithm; one `atan2` per kick. Memory: about 300 bytes, no allocation.
+
+use super::harmonics::sincos_turns;
+use crate::format::{quantise_i16, quantise_u16, KickRingDown};
+
+/// The push and the high-pass's answer to it are skipped for this long after
+/// the impulse is first seen, s.
+pub const SKIP_S: f32 = 0.15;
+/// Length of a demodulation segment, s.
+pub const SEGMENT_S: f32 = 0.3;
+/// Time between the starts of two segments, s.
+pub const STRIDE_S: f32 = 0.1;
+/// Most segments per kick (the fit spans at most 1.8 s of ring).
+pub const MAX_SEGMENTS: usize = 16;
+/// Fewest segments a kick is reported from.
+pub const MIN_SEGMENTS: usize = 4;
+/// Segments below this amplitude (degrees) end the fit: noise would bias
+/// `ln |X|` upwards.
+pub const FLOOR_DEG: f32 = 0.1;
+/// Longest segment, samples (0.3 s at up to 200 Hz).
+const MAX_SEGMENT_LEN: usize = 64;
+/// Segments open at once: `SEGMENT_S / STRIDE_S`.
+const OPEN: usize = 3;
+
+/// A kick's ring-down as the detector measured it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Kick {
+    /// Samples from the kick (the analysis that first saw it, less the hop)
+    /// to the sample that reported it: the kick happened this long ago.
+    pub samples_ago: u32,
+    /// Mean wheel speed over the fitted ring (`None`: speed unknown), m/s.
+    pub speed_mps: Option<f32>,
+    /// Ring frequency, Hz.
+    pub freq_hz: f32,
+    /// Growth rate of the ring, 1/s (negative: it decays).
+    pub sigma_per_s: f32,
+    /// Standard error of `sigma_per_s` from the fit's residuals, 1/s.
+    pub sigma_se_per_s: f32,
+    /// Ring amplitude extrapolated back to the kick, degrees (zero to peak).
+    pub amp_deg: f32,
+    /// Segments the fit used.
+    pub segments: u8,
+}
+
+impl Kick {
+    /// The card-log record of this kick, reported on the sample at local
+    /// time `now_us` of a detector running at `sample_rate_hz`.
+    #[must_use]
+    pub fn to_record(&self, now_us: u64, sample_rate_hz: f32) -> KickRingDown {
+        let ago_us = (self.samples_ago as f32 * 1e6 / sample_rate_hz) as u64;
+        KickRingDown {
+            t_us: now_us.saturating_sub(ago_us),
+            speed_mm_s: self.speed_mps.map(|v| quantise_u16(v, 1000.0)),
+            freq_chz: quantise_u16(self.freq_hz, 100.0),
+            sigma_milli_per_s: quantise_i16(self.sigma_per_s, 1000.0),
+            sigma_se_milli_per_s: quantise_u16(self.sigma_se_per_s, 1000.0),
+            amp_cdeg: quantise_u16(self.amp_deg, 100.0),
+            segments: self.segments,
+        }
+    }
+}
+
+/// One segment's demodulated amplitude.
+#[derive(Clone, Copy, Debug, Default)]
+struct Segment {
+    /// Centre, s after the kick.
+    t_s: f32,
+    re: f32,
+    im: f32,
+}
+
+/// The ring-down measurement in progress (one at a time).
+#[derive(Clone, Debug)]
+pub(crate) struct RingDown {
+    fs_hz: f32,
+    band: (f32, f32),
+    skip: u32,
+    seg_len: usize,
+    stride: u32,
+    window: [f32; MAX_SEGMENT_LEN],
+    amp_scale: f32,
+    /// Samples since the kick, while measuring.
+    age: Option<u32>,
+    f0_hz: f32,
+    /// Open segments: start age and running sums.
+    open: [Option<(u32, f32, f32)>; OPEN],
+    segments: [Segment; MAX_SEGMENTS],
+    n: usize,
+    speed_sum: f32,
+    speed_n: u32,
+    speed_known: bool,
+}
+
+impl RingDown {
+    /// A measurement at sample rate `fs_hz` for rings in `band` (Hz).
+    pub(crate) fn new(fs_hz: f32, band: (f32, f32)) -> Self {
+        let n = |s: f32| (s * fs_hz + 0.5) as usize;
+        let seg_len = n(SEGMENT_S).clamp(4, MAX_SEGMENT_LEN);
+        let mut window = [0.0; MAX_SEGMENT_LEN];
+        let mut sum = 0.0;
+        for (i, w) in window.iter_mut().enumerate().take(seg_len) {
+            let (_, c) = sincos_turns((i as f32 + 0.5) / seg_len as f32);
+            *w = 0.5 - 0.5 * c;
+            sum += *w;
+        }
+        Self {
+            fs_hz,
+            band,
+            skip: n(SKIP_S) as u32,
+            seg_len,
+            stride: n(STRIDE_S).max(1) as u32,
+            window,
+            amp_scale: if sum > 0.0 { 2.0 / sum } else { 0.0 },
+            age: None,
+            f0_hz: 0.0,
+            open: [None; OPEN],
+            segments: [Segment::default(); MAX_SEGMENTS],
+            n: 0,
+            speed_sum: 0.0,
+            speed_n: 0,
+            speed_known: true,
+        }
+    }
+
+    /// Starts measuring a kick first seen `lead` samples ago, ringing at
+    /// about `f0_hz` (the band's centre when that is outside the band).
+    pub(crate) fn start(&mut self, lead: u32, f0_hz: f32) {
+        let (lo, hi) = self.band;
+        self.f0_hz = if f0_hz >= lo && f0_hz <= hi {
+            f0_hz
+        } else {
+            0.5 * (lo + hi)
+        };
+        self.age = Some(lead);
+        self.open = [None; OPEN];
+        self.n = 0;
+        self.speed_sum = 0.0;
+        self.speed_n = 0;
+        self.speed_known = true;
+    }
+
+    /// Stops without reporting.
+    pub(crate) fn cancel(&mut self) {
+        self.age = None;
+    }
+
+    /// Ends the measurement now (another impulse, an alert) and reports the
+    /// kick if enough of the ring was measured.
+    pub(crate) fn finish(&mut self) -> Option<Kick> {
+        let age = self.age.take()?;
+        self.fit(age)
+    }
+
+    /// Feeds one high-passed, ripple-cancelled sample `y` (degrees) and the
+    /// speed; returns the kick once its ring-down is measured.
+    pub(crate) fn sample(&mut self, y: f32, speed_mps: Option<f32>) -> Option<Kick> {
+        let age = self.age?;
+        let next = age + 1;
+        self.age = Some(next);
+        if age < self.skip {
+            return None;
+        }
+        let since = age - self.skip;
+        if since % self.stride == 0 && self.n + self.open_count() < MAX_SEGMENTS {
+            if let Some(slot) = self.open.iter_mut().find(|s| s.is_none()) {
+                *slot = Some((age, 0.0, 0.0));
+            }
+        }
+        match speed_mps {
+            Some(v) => {
+                self.speed_sum += v;
+                self.speed_n += 1;
+            }
+            None => self.speed_known = false,
+        }
+        // The reference oscillator's phase is tied to the kick's time, so
+        // every segment's phase is on one clock.
+        let turns = self.f0_hz * age as f32 / self.fs_hz;
+        let (s, c) = sincos_turns(turns - (turns as u32) as f32);
+        let mut closed = None;
+        for slot in &mut self.open {
+            if let Some((start, re, im)) = slot {
+                let i = (age - *start) as usize;
+                let wy = self.window[i] * y;
+                *re += wy * c;
+                *im -= wy * s;
+                if i + 1 == self.seg_len {
+                    let centre = *start as f32 + 0.5 * (self.seg_len - 1) as f32;
+                    closed = Some(Segment {
+                        t_s: centre / self.fs_hz,
+                        re: *re * self.amp_scale,
+                        im: *im * self.amp_scale,
+                    });
+                    *slot = None;
+                }
+            }
+        }
+        let seg = closed?;
+        let amp = super::math::sqrtf(seg.re * seg.re + seg.im * seg.im);
+        if amp < FLOOR_DEG {
+            self.age = None;
+            return self.fit(next);
+        }
+        self.segments[self.n] = seg;
+        self.n += 1;
+        if self.n == MAX_SEGMENTS {
+            self.age = None;
+            return self.fit(next);
+        }
+        None
+    }
+
+    fn open_count(&self) -> usize {
+        self.open.iter().filter(|s| s.is_some()).count()
+    }
+
+    /// The fit over the segments so far, reported `age` samples after the
+    /// kick.
+    fn fit(&self, age: u32) -> Option<Kick> {
+        let seg = &self.segments[..self.n];
+        if seg.len() < MIN_SEGMENTS {
+            return None;
+        }
+        // Weighted least squares of ln|X| on t, weights |X|^2.
+        let (mut sw, mut st, mut sl) = (0.0_f32, 0.0_f32, 0.0_f32);
+        let mut logs = [0.0_f32; MAX_SEGMENTS];
+        let mut weights = [0.0_f32; MAX_SEGMENTS];
+        for (k, s) in seg.iter().enumerate() {
+            let p = s.re * s.re + s.im * s.im;
+            logs[k] = 0.5 * libm::logf(p);
+            weights[k] = p;
+            sw += p;
+            st += p * s.t_s;
+            sl += p * logs[k];
+        }
+        let (t_mean, l_mean) = (st / sw, sl / sw);
+        let (mut stt, mut stl) = (0.0_f32, 0.0_f32);
+        for (k, s) in seg.iter().enumerate() {
+            let dt = s.t_s - t_mean;
+            stt += weights[k] * dt * dt;
+            stl += weights[k] * dt * (logs[k] - l_mean);
+        }
+        if stt <= 0.0 {
+            return None;
+        }
+        let sigma = stl / stt;
+        let mut ssr = 0.0_f32;
+        for (k, s) in seg.iter().enumerate() {
+            let r = logs[k] - l_mean - sigma * (s.t_s - t_mean);
+            ssr += weights[k] * r * r;
+        }
+        let dof = (seg.len() - 2) as f32;
+        let sigma_se = super::math::sqrtf(ssr / dof / stt);
+        // Pulse pair: the mean phase advance per stride.
+        let (mut pr, mut pi) = (0.0_f32, 0.0_f32);
+        for w in seg.windows(2) {
+            pr += w[1].re * w[0].re + w[1].im * w[0].im;
+            pi += w[1].im * w[0].re - w[1].re * w[0].im;
+        }
+        let stride_s = self.stride as f32 / self.fs_hz;
+        let freq_hz = self.f0_hz + libm::atan2f(pi, pr) / (core::f32::consts::TAU * stride_s);
+        if !(freq_hz >= self.band.0 && freq_hz <= self.band.1 && sigma.is_finite()) {
+            return None;
+        }
+        // The segments' Hann window passes a tone (f - f0) away at
+        // sinc(d) / (1 - d^2) of its amplitude, d = (f - f0) x its length.
+        let d = (freq_hz - self.f0_hz) * self.seg_len as f32 / self.fs_hz;
+        let pd = core::f32::consts::PI * d;
+        let gain = if d.abs() < 1e-3 {
+            1.0
+        } else if (1.0 - d.abs()).abs() < 1e-3 {
+            0.5
+        } else {
+            libm::sinf(pd) / (pd * (1.0 - d * d))
+        };
+        let amp_deg = libm::expf(l_mean - sigma * t_mean) / gain.max(0.1);
+        Some(Kick {
+            samples_ago: age,
+            speed_mps: (self.speed_known && self.speed_n > 0)
+                .then(|| self.speed_sum / self.speed_n as f32),
+            freq_hz,
+            sigma_per_s: sigma,
+            sigma_se_per_s: sigma_se,
+            amp_deg,
+            segments: seg.len() as u8,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A clean damped sinusoid from the kick on, measured.
+    fn measure(f: f32, sigma: f32, amp: f32) -> Kick {
+        let mut r = RingDown::new(100.0, (5.8, 9.2));
+        r.start(0, 7.0);
+        for i in 0..400 {
+            let t = i as f32 / 100.0;
+            let y = amp * libm::expf(sigma * t) * libm::sinf(core::f32::consts::TAU * f * t);
+            if let Some(k) = r.sample(y, Some(3.0)) {
+                return k;
+            }
+        }
+        panic!("no kick reported");
+    }
+
+    #[test]
+    fn a_clean_ring_is_measured_exactly() {
+        for (f, sigma, amp) in [(6.2, -0.3, 1.5), (7.6, -1.5, 2.0), (8.8, -3.0, 2.6)] {
+            let k = measure(f, sigma, amp);
+            assert!((k.freq_hz - f).abs() < 0.02, "{k:?}");
+            assert!((k.sigma_per_s - sigma).abs() < 0.05, "{k:?}");
+            assert!((k.amp_deg - amp).abs() < 0.05 * amp, "{k:?}");
+            assert!(k.sigma_se_per_s < 0.05, "{k:?}");
+            assert_eq!(k.speed_mps, Some(3.0));
+        }
+    }
+}

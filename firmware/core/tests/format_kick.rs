@@ -1,0 +1,139 @@
+//! The kick ring-down record (tag 0x83, format 1.1): its bytes as
+//! `firmware/FORMAT.md` lays them out, the round trip, a body longer than
+//! this reader knows (a later minor version), and a 1.0 card still decoding.
+
+use wobble_core::format::block::{BlockHeader, BLOCK_LEN, VERSION_MINOR};
+use wobble_core::format::*;
+
+fn frame(t_us: u64) -> Record<'static> {
+    Record::Frame(Frame {
+        t_us,
+        ..Frame::default()
+    })
+}
+
+fn encode(records: &[Record<'_>]) -> Vec<u8> {
+    let mut enc = BlockEncoder::new();
+    let mut file = Vec::new();
+    for r in records {
+        if let Some(b) = enc.push(r).unwrap() {
+            file.extend_from_slice(b);
+        }
+    }
+    file.extend_from_slice(enc.finish().unwrap());
+    file
+}
+
+fn decode(file: &[u8]) -> (Vec<Record<'static>>, DecodeStats) {
+    let mut dec = Decoder::new();
+    let mut out = Vec::new();
+    dec.feed(file, true, &mut |e| {
+        if let Event::Record(r) = e {
+            // Frames and kicks own no borrowed text.
+            match r {
+                Record::Frame(f) => out.push(Record::Frame(f)),
+                Record::Kick(k) => out.push(Record::Kick(k)),
+                _ => {}
+            }
+        }
+    });
+    (out, *dec.stats())
+}
+
+const KICK: KickRingDown = KickRingDown {
+    t_us: 1_985_000,
+    speed_mm_s: Some(3_104),
+    freq_chz: 623,
+    sigma_milli_per_s: -1_812,
+    sigma_se_milli_per_s: 47,
+    amp_cdeg: 153,
+    segments: 9,
+};
+
+#[test]
+fn the_record_is_laid_out_as_documented() {
+    // After a frame at 2.0 s (the cursor), a kick 15 ms before it.
+    let file = encode(&[frame(2_000_000), Record::Kick(KICK)]);
+    let payload = &file[24..];
+    // Frame: tag, three time bytes (the block's first frame is 10 ms early
+    // against its cursor, t0), 21 body bytes.
+    let kick = &payload[25..];
+    let delta = -15_000_i64;
+    let zz = ((delta << 1) ^ (delta >> 63)) as u64; // 29 999
+    let mut expected = vec![0x83, 14];
+    expected.extend([
+        (zz & 0x7f) as u8 | 0x80,
+        ((zz >> 7) & 0x7f) as u8 | 0x80,
+        (zz >> 14) as u8,
+    ]);
+    expected.extend(3_104_u16.to_le_bytes());
+    expected.extend(623_u16.to_le_bytes());
+    expected.extend((-1_812_i16).to_le_bytes());
+    expected.extend(47_u16.to_le_bytes());
+    expected.extend(153_u16.to_le_bytes());
+    expected.push(9);
+    assert_eq!(&kick[..expected.len()], &expected[..]);
+    let payload_len = usize::from(u16::from_le_bytes([file[6], file[7]]));
+    assert_eq!(payload_len, 25 + expected.len(), "nothing after the kick");
+    assert_eq!(file[5], VERSION_MINOR);
+    assert_eq!(VERSION_MINOR, 1);
+}
+
+#[test]
+fn kicks_round_trip_with_and_without_speed() {
+    let unknown = KickRingDown {
+        speed_mm_s: None,
+        sigma_milli_per_s: 250,
+        ..KICK
+    };
+    let records = [
+        frame(0),
+        frame(10_000),
+        Record::Kick(KICK),
+        frame(20_000),
+        Record::Kick(unknown),
+    ];
+    let (decoded, stats) = decode(&encode(&records));
+    assert_eq!(decoded, records);
+    assert_eq!(stats.unknown_records, 0);
+}
+
+/// Rewrites block 0 of `file`: `edit` gets its header and bytes (CRC
+/// checked first), then the block is resealed.
+fn reseal(file: &mut [u8], edit: impl FnOnce(&mut BlockHeader, &mut [u8])) {
+    let block: &mut Block = (&mut file[..BLOCK_LEN]).try_into().unwrap();
+    let mut header = BlockHeader::parse(block).unwrap();
+    edit(&mut header, block);
+    header.seal(block);
+}
+
+#[test]
+fn a_longer_body_from_a_later_minor_version_decodes_its_known_fields() {
+    let mut file = encode(&[frame(0), Record::Kick(KICK), frame(10_000)]);
+    // Lengthen the kick's body by two bytes, as a 1.2 writer appending a
+    // field would: the frame after it must still be found.
+    reseal(&mut file, |h, block| {
+        let at = 24 + 25;
+        let len = usize::from(block[at + 1]);
+        let end = 24 + usize::from(h.payload_len);
+        let tail: Vec<u8> = block[at + 2 + len..end].to_vec();
+        block[at + 1] = (len + 2) as u8;
+        block[at + 2 + len..at + 4 + len].copy_from_slice(&[0xAA, 0xBB]);
+        block[at + 4 + len..at + 4 + len + tail.len()].copy_from_slice(&tail);
+        h.payload_len += 2;
+        h.version_minor = 2;
+    });
+    let (decoded, stats) = decode(&file);
+    assert_eq!(decoded, [frame(0), Record::Kick(KICK), frame(10_000)]);
+    assert_eq!(stats.unknown_records, 0);
+}
+
+#[test]
+fn a_card_of_format_1_0_still_decodes() {
+    let records = [frame(0), frame(10_000), frame(20_000)];
+    let mut file = encode(&records);
+    reseal(&mut file, |h, _| h.version_minor = 0);
+    let (decoded, stats) = decode(&file);
+    assert_eq!(decoded, records);
+    assert_eq!(stats.unknown_records, 0);
+}
