@@ -12,6 +12,9 @@ use crate::CliError;
 #[derive(Parser)]
 #[command(name = "wobblog", version, about)]
 pub struct Cli {
+    /// Replace an output file that is write-protected or has other hard links.
+    #[arg(long, global = true)]
+    force: bool,
     #[command(subcommand)]
     command: Command,
 }
@@ -38,6 +41,8 @@ enum Command {
     Plot(cmd::plot::Args),
     /// Measure every wobble episode (frequency, growth rate, speed); Figure 8 with --plot.
     Wobble(cmd::wobble::Args),
+    /// Predict the wobble speed from handlebar kicks below it, with its 95 % interval.
+    Margin(cmd::margin::Args),
     /// Write a run's GPS track as GPX.
     Gpx(cmd::gpx::Args),
     /// One row per run in a directory: duration, distance, episodes, wobble speed, losses.
@@ -58,6 +63,7 @@ enum Command {
 #[must_use]
 pub fn main() -> ExitCode {
     let cli = Cli::parse();
+    crate::output::set_force(cli.force);
     let result = match cli.command {
         Command::Info(args) => cmd::info::run(&args),
         Command::Decode(args) => cmd::decode::run(&args),
@@ -69,6 +75,7 @@ pub fn main() -> ExitCode {
         Command::Nmea(args) => cmd::nmea::run(&args),
         Command::Plot(args) => cmd::plot::run(&args),
         Command::Wobble(args) => cmd::wobble::run(&args),
+        Command::Margin(args) => cmd::margin::run(&args),
         Command::Gpx(args) => cmd::gpx::run(&args),
         Command::Summary(args) => cmd::summary::run(&args),
         Command::Model(command) => cmd::model::run(&command),
