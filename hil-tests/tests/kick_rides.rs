@@ -54,7 +54,7 @@ fn the_rides_hold_the_kicks_the_issue_describes() {
     // The model's wobble decays ever more slowly towards the wobble speed.
     assert!(m.iter().all(|k| k.sigma_per_s < 0.0
         && k.speed_mps < kicks::TEST_BIKE_WOBBLE_MPS
-        && k.amp_deg < 3.0));
+        && k.amp_deg < 3.5));
 }
 
 #[test]
@@ -67,4 +67,25 @@ fn no_decaying_ring_down_alerts_on_signal_model_kicks() {
 fn no_decaying_ring_down_alerts_on_the_simulated_bicycle() {
     let bad = alerted(simulated());
     assert!(bad.is_empty(), "{}", bad.join("\n"));
+}
+
+/// The share of kicks at 1.5-6 m/s measured within the issue's accuracy:
+/// sigma within 0.3 1/s and the frequency within 0.2 Hz of the truth.
+fn accurate_share(scores: &[KickScore]) -> f64 {
+    let band: Vec<_> = scores
+        .iter()
+        .filter(|k| (1.5..=6.0).contains(&k.speed_mps))
+        .collect();
+    band.iter().filter(|k| k.within(0.3, 0.2)).count() as f64 / band.len() as f64
+}
+
+#[test]
+fn at_least_80_percent_of_kicks_are_measured_within_the_goal() {
+    // Measured (firmware/docs/detector.md): 83 % of the signal-model kicks
+    // of seeds 1-2 (rings down to -3 1/s, half of them behind a push) and
+    // 85 % of the simulated bicycle's.
+    for (family, scores) in [("signal", signal()), ("simulated", simulated())] {
+        let share = accurate_share(scores);
+        assert!(share >= 0.8, "{family}: {:.0} %", 100.0 * share);
+    }
 }

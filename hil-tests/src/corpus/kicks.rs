@@ -20,7 +20,7 @@
 use super::catalog::HARMONICS;
 use super::rng::Rng;
 use super::signal::{wobble_mode_hz, Ride};
-use super::simulated::{catalog::TEST_BIKE, road::RoadClass, Recipe};
+use super::simulated::{catalog::TEST_BIKE, road::RoadClass, Recipe, KICK_S};
 use super::Fixture;
 
 /// Kicks per signal-model ride.
@@ -80,6 +80,12 @@ pub const TEST_BIKE_WOBBLE_MPS: f64 = 4.1;
 /// holds the weave (the simulation diverges), so the family starts at 0.6.
 pub const SIMULATED_SPEEDS: [f64; 6] = [0.6, 0.65, 0.7, 0.75, 0.8, 0.85];
 
+/// A visible push: the torque held this long, over and back, s.
+const PUSH_S: f64 = 0.12;
+/// Wheel ripple on the steering of the bicycle-model rides, degrees per
+/// harmonic (a clean-ish wheel).
+const RIPPLE_DEG: f64 = 0.05;
+
 /// Knock on the bar, N m for 30 ms: rings the mode at 1-2.5 degrees at
 /// these speeds.
 const KNOCK_NM: (f64, f64) = (8.0, 16.0);
@@ -97,13 +103,16 @@ pub fn simulated_recipes(seed: u64, speeds_rel: &[f64]) -> Vec<Recipe> {
             let kicks = (1..=8)
                 .map(|i| {
                     let t = 8.0 * f64::from(i) + rng.range(-1.0, 1.0);
-                    (t, rng.range(KNOCK_NM.0, KNOCK_NM.1) * rng.sign())
+                    // A push holds its torque four times as long.
+                    let scale = if k % 2 == 0 { 1.0 } else { 0.3 };
+                    (t, scale * rng.range(KNOCK_NM.0, KNOCK_NM.1) * rng.sign())
                 })
                 .collect();
             Recipe {
                 name: format!("kicks_sim_{seed}_{k}"),
                 description: format!("knocks on the bar at {speed:.2} m/s"),
                 bike: TEST_BIKE,
+                changes: Vec::new(),
                 seed: seed.wrapping_mul(1000).wrapping_add(500 + k as u64),
                 duration_s: 75.0,
                 road: if k % 2 == 0 {
@@ -115,6 +124,10 @@ pub fn simulated_recipes(seed: u64, speeds_rel: &[f64]) -> Vec<Recipe> {
                 grip_at_deg: None,
                 rider_nm: (0.05, 0.1),
                 kicks,
+                // Every other ride pushes the bar over and back before it
+                // rings (a visible push), the others knock it.
+                kick_s: if k % 2 == 0 { KICK_S } else { PUSH_S },
+                ripple_deg: RIPPLE_DEG,
                 committed: false,
             }
         })

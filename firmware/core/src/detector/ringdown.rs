@@ -42,6 +42,8 @@ pub const MIN_SEGMENTS: usize = 4;
 /// Segments below this amplitude (degrees) end the fit: noise would bias
 /// `ln |X|` upwards.
 pub const FLOOR_DEG: f32 = 0.1;
+/// Leading segments the fit may leave out (a push's remains).
+const MAX_TRIMMED: usize = 2;
 /// Longest segment, samples (0.3 s at up to 200 Hz).
 const MAX_SEGMENT_LEN: usize = 64;
 /// Segments open at once: `SEGMENT_S / STRIDE_S`.
@@ -187,7 +189,7 @@ impl RingDown {
             return None;
         }
         let since = age - self.skip;
-        if since % self.stride == 0 && self.n + self.open_count() < MAX_SEGMENTS {
+        if since.is_multiple_of(self.stride) && self.n + self.open_count() < MAX_SEGMENTS {
             if let Some(slot) = self.open.iter_mut().find(|s| s.is_none()) {
                 *slot = Some((age, 0.0, 0.0));
             }
@@ -241,42 +243,23 @@ impl RingDown {
     }
 
     /// The fit over the segments so far, reported `age` samples after the
-    /// kick.
+    /// kick. What is left of a push in the first segments bends the line:
+    /// the fit is also made without the first one and the first two, and
+    /// the one whose residuals are smallest (per degree of freedom, relative
+    /// to its weights) is kept.
     fn fit(&self, age: u32) -> Option<Kick> {
-        let seg = &self.segments[..self.n];
-        if seg.len() < MIN_SEGMENTS {
-            return None;
-        }
-        // Weighted least squares of ln|X| on t, weights |X|^2.
-        let (mut sw, mut st, mut sl) = (0.0_f32, 0.0_f32, 0.0_f32);
-        let mut logs = [0.0_f32; MAX_SEGMENTS];
-        let mut weights = [0.0_f32; MAX_SEGMENTS];
-        for (k, s) in seg.iter().enumerate() {
-            let p = s.re * s.re + s.im * s.im;
-            logs[k] = 0.5 * libm::logf(p);
-            weights[k] = p;
-            sw += p;
-            st += p * s.t_s;
-            sl += p * logs[k];
-        }
-        let (t_mean, l_mean) = (st / sw, sl / sw);
-        let (mut stt, mut stl) = (0.0_f32, 0.0_f32);
-        for (k, s) in seg.iter().enumerate() {
-            let dt = s.t_s - t_mean;
-            stt += weights[k] * dt * dt;
-            stl += weights[k] * dt * (logs[k] - l_mean);
-        }
-        if stt <= 0.0 {
-            return None;
-        }
-        let sigma = stl / stt;
-        let mut ssr = 0.0_f32;
-        for (k, s) in seg.iter().enumerate() {
-            let r = logs[k] - l_mean - sigma * (s.t_s - t_mean);
-            ssr += weights[k] * r * r;
-        }
-        let dof = (seg.len() - 2) as f32;
-        let sigma_se = super::math::sqrtf(ssr / dof / stt);
+        let all = &self.segments[..self.n];
+        let (line, seg) = (0..=MAX_TRIMMED)
+            .filter(|&j| all.len() >= j + MIN_SEGMENTS)
+            .filter_map(|j| Some((line_fit(&all[j..])?, &all[j..])))
+            .min_by(|a, b| a.0.score.total_cmp(&b.0.score))?;
+        let Line {
+            sigma,
+            sigma_se,
+            t_mean,
+            l_mean,
+            ..
+        } = line;
         // Pulse pair: the mean phase advance per stride.
         let (mut pr, mut pi) = (0.0_f32, 0.0_f32);
         for w in seg.windows(2) {
@@ -311,6 +294,57 @@ impl RingDown {
             segments: seg.len() as u8,
         })
     }
+}
+
+/// A weighted straight line through `ln |X_k|` against `t_k`.
+struct Line {
+    sigma: f32,
+    sigma_se: f32,
+    t_mean: f32,
+    l_mean: f32,
+    /// Weighted residual variance per degree of freedom over the mean
+    /// weight: comparable between fits over different segments.
+    score: f32,
+}
+
+/// Weighted least squares of `ln |X|` on `t`, weights `|X|^2` (the inverse
+/// variance of `ln |X|` in additive noise); `None` without a spread in time.
+fn line_fit(seg: &[Segment]) -> Option<Line> {
+    let (mut sw, mut st, mut sl) = (0.0_f32, 0.0_f32, 0.0_f32);
+    let mut logs = [0.0_f32; MAX_SEGMENTS];
+    let mut weights = [0.0_f32; MAX_SEGMENTS];
+    for (k, s) in seg.iter().enumerate() {
+        let p = s.re * s.re + s.im * s.im;
+        logs[k] = 0.5 * libm::logf(p);
+        weights[k] = p;
+        sw += p;
+        st += p * s.t_s;
+        sl += p * logs[k];
+    }
+    let (t_mean, l_mean) = (st / sw, sl / sw);
+    let (mut stt, mut stl) = (0.0_f32, 0.0_f32);
+    for (k, s) in seg.iter().enumerate() {
+        let dt = s.t_s - t_mean;
+        stt += weights[k] * dt * dt;
+        stl += weights[k] * dt * (logs[k] - l_mean);
+    }
+    if stt.is_nan() || stt <= 0.0 {
+        return None;
+    }
+    let sigma = stl / stt;
+    let mut ssr = 0.0_f32;
+    for (k, s) in seg.iter().enumerate() {
+        let r = logs[k] - l_mean - sigma * (s.t_s - t_mean);
+        ssr += weights[k] * r * r;
+    }
+    let dof = (seg.len() - 2) as f32;
+    Some(Line {
+        sigma,
+        sigma_se: super::math::sqrtf(ssr / dof / stt),
+        t_mean,
+        l_mean,
+        score: ssr / dof / (sw / seg.len() as f32),
+    })
 }
 
 #[cfg(test)]
