@@ -43,12 +43,15 @@ impl KickScore {
     }
 }
 
-/// Every ride's replay: the alert-ons and the measured kicks (time of the
-/// kick, kick), with the speed column, as `config` sets the detector up.
+/// What one replay saw: the times of the alert-ons, and each measured kick
+/// with the time the detector puts it at.
+pub type Replayed = (Vec<f64>, Vec<(f64, Kick)>);
+
+/// A ride's replay with the speed column, as `config` sets the detector up.
 ///
 /// # Errors
 /// An invalid `config` or a ride whose CSV does not parse.
-pub fn replay(fx: &Fixture, config: &Config) -> Result<(Vec<f64>, Vec<(f64, Kick)>), String> {
+pub fn replay(fx: &Fixture, config: &Config) -> Result<Replayed, String> {
     let rows = fx.rows()?;
     let mut det = config.detector().map_err(|e| e.to_string())?;
     let fs = f64::from(det.config().sample_rate_hz);
