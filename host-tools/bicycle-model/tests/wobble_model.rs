@@ -280,3 +280,24 @@ fn no_slip_counterpart_with_a_rigid_head_is_the_rider_lean_bicycle() {
         }
     }
 }
+
+/// Writes the test bicycle's pencil `A0`, `A1` (14 rows each) to the file
+/// `PENCIL_OUT` names, for `scripts/lapack_batch_reference.py` (run by hand).
+#[test]
+#[ignore = "writes a file for the LAPACK comparison"]
+fn write_pencil() {
+    let out = std::env::var("PENCIL_OUT").expect("PENCIL_OUT names the file to write");
+    let (a0, a1) = Model::from_set(&set("test-bicycle.toml"))
+        .unwrap()
+        .pencil()
+        .unwrap();
+    let mut text = String::new();
+    for m in [a0, a1] {
+        for r in m.row_iter() {
+            let cells: Vec<String> = r.iter().map(|v| format!("{v:e}")).collect();
+            text.push_str(&cells.join(","));
+            text.push('\n');
+        }
+    }
+    std::fs::write(out, text).unwrap();
+}
