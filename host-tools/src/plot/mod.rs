@@ -4,6 +4,7 @@
 //! Text is drawn with the DejaVu Sans font compiled into the program, so
 //! plotting needs no system font libraries; an SVG carries the font with it.
 
+pub mod margin;
 pub mod modes;
 mod svg_font;
 pub mod timeplot;
