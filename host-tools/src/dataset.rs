@@ -366,16 +366,26 @@ pub fn build(
     let name = target
         .file_name()
         .map_or_else(String::new, |n| n.to_string_lossy().into_owned());
-    let temp = tempfile::Builder::new()
-        .prefix(&format!(".{name}."))
-        .suffix(".tmp")
-        .tempdir_in(parent)
-        .map_err(|e| CliError::file(target, format!("cannot create the dataset: {e}")))?;
-    let skipped = write_dataset(entries, temp.path(), strict, progress)?;
+    // Removed if a signal ends the process before it is in place.
+    let temp = crate::interrupt::make_tracked(
+        || {
+            tempfile::Builder::new()
+                .prefix(&format!(".{name}."))
+                .suffix(".tmp")
+                .tempdir_in(parent)
+        },
+        tempfile::TempDir::path,
+    )
+    .map_err(|e| CliError::file(target, format!("cannot create the dataset: {e}")))?;
     // A non-empty directory that appeared at `target` meanwhile makes the
     // rename fail rather than be replaced.
-    std::fs::rename(temp.path(), target)
-        .map_err(|e| CliError::file(target, format!("cannot move the dataset in place: {e}")))?;
+    let result = write_dataset(entries, temp.path(), strict, progress).and_then(|skipped| {
+        std::fs::rename(temp.path(), target)
+            .map(|()| skipped)
+            .map_err(|e| CliError::file(target, format!("cannot move the dataset in place: {e}")))
+    });
+    crate::interrupt::untrack(temp.path());
+    let skipped = result?;
     // The directory moved; there is nothing left to clean up.
     let _ = temp.keep();
     Ok(skipped)
