@@ -108,3 +108,62 @@ fn a_lateral_velocity_is_a_slip_relaxed_over_sigma() {
         assert!((lags[2] + u / p.rear_tyre.relaxation_length).abs() < 1e-12);
     }
 }
+
+/// The twist mode with the frame locked: the fork and front wheel turn about
+/// the twist axis `t = (cos lambda, 0, -sin lambda)` through the steer axis at
+/// height `steer_head.z`, on the head spring. By hand (parallel axes) its
+/// inertia is `sum t' I_b t + m_b |t x (c_b - o)|^2`, and the mode's natural
+/// frequency with frame and pitch locked `sqrt(k / I_t)`; the model's mass
+/// matrix has exactly that inertia. (Its stiffness adds the weight of the
+/// whole bicycle through the pitch the twist forces on the front contact,
+/// which no hand figure here checks.)
+#[test]
+fn twist_inertia_and_frequency_with_the_frame_locked() {
+    use nalgebra::{Matrix3, Vector3};
+    use wobble_model::multibody::BETA;
+    let m = model();
+    let p = m.params;
+    let lam = p.steer_axis_tilt;
+    let t = Vector3::new(lam.cos(), 0.0, -lam.sin());
+    let o = Vector3::new(
+        p.wheelbase + p.trail + p.twist_z * lam.tan(),
+        0.0,
+        p.twist_z,
+    );
+    let fw = p.front_wheel;
+    let bodies = [
+        (
+            p.fork.mass,
+            Vector3::new(p.fork.x, 0.0, p.fork.z),
+            Matrix3::new(
+                p.fork.inertia_xx,
+                0.0,
+                p.fork.inertia_xz,
+                0.0,
+                p.fork.inertia_yy,
+                0.0,
+                p.fork.inertia_xz,
+                0.0,
+                p.fork.inertia_zz,
+            ),
+        ),
+        (
+            fw.mass,
+            Vector3::new(p.wheelbase, 0.0, -fw.radius),
+            Matrix3::from_diagonal(&Vector3::new(fw.inertia_xx, fw.inertia_yy, fw.inertia_xx)),
+        ),
+    ];
+    let inertia: f64 = bodies
+        .iter()
+        .map(|(mass, c, i)| (t.transpose() * i * t)[0] + mass * t.cross(&(c - o)).norm_squared())
+        .sum();
+    let mbb = m.lin.m[(2 + BETA, 2 + BETA)];
+    assert!(
+        (mbb - inertia).abs() < 1e-12 * inertia,
+        "{mbb} against {inertia}"
+    );
+    // With frame and pitch locked the twist mode is sqrt(k / I_t): 0.254 kg m^2
+    // and 3000 N m/rad give 17.3 Hz.
+    let hz = (p.head_stiffness / mbb).sqrt() / std::f64::consts::TAU;
+    assert!((hz - 17.3).abs() < 0.05, "{hz} Hz");
+}
