@@ -16,7 +16,7 @@ use wobble_core::config::{
     FAULT_UNREADABLE,
 };
 use wobble_core::drivers::gnss_bringup::{
-    FAULT_SETUP_SILENT, FAULT_SETUP_SLOW, FAULT_SETUP_UNCONFIRMED,
+    FAULT_RECEIVER_LOST, FAULT_SETUP_SILENT, FAULT_SETUP_SLOW, FAULT_SETUP_UNCONFIRMED,
 };
 use wobble_core::format::{DropoutReason, FaultSource};
 use wobble_core::gps::{
@@ -26,7 +26,7 @@ use wobble_core::gps::{
 use wobble_core::logger::{FAULT_CARD_ABSENT, FAULT_CARD_FULL, FAULT_CARD_WRITE};
 
 /// Every fault code the firmware records: (source, code, meaning).
-pub const FAULT_MEANINGS: [(FaultSource, u8, &str); 33] = [
+pub const FAULT_MEANINGS: [(FaultSource, u8, &str); 34] = [
     (
         FaultSource::Imu,
         FAULT_IMU_NO_RESPONSE,
@@ -76,6 +76,7 @@ pub const FAULT_MEANINGS: [(FaultSource, u8, &str); 33] = [
     (FaultSource::Gps, FAULT_SETUP_SILENT, "set-up: no valid NMEA at any baud rate (logging at 9600)"),
     (FaultSource::Gps, FAULT_SETUP_UNCONFIRMED, "set-up: no command set confirmed (logging at the receiver's own baud and rate)"),
     (FaultSource::Gps, FAULT_SETUP_SLOW, "set-up: configured, but fixes come slower than 15 Hz"),
+    (FaultSource::Gps, FAULT_RECEIVER_LOST, "receiver lost: no valid sentence for 3 s while logging; the set-up runs again"),
     (
         FaultSource::Card,
         FAULT_CARD_ABSENT,

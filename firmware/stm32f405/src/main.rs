@@ -27,14 +27,13 @@ use embedded_hal_bus::spi::ExclusiveDevice;
 use embedded_sdmmc::VolumeManager;
 use static_cell::StaticCell;
 use wobble_core::app::sampler::{Sampler, SamplerPorts};
-use wobble_core::app::{gps, gps_setup, sampler, writer};
+use wobble_core::app::{gps, sampler, writer};
 use wobble_core::boot;
 use wobble_core::channels::{RecordQueue, SharedStatus};
 use wobble_core::config::{self, Config, Loaded, KEY_COUNT, MAX_TEXT_LEN};
 use wobble_core::drivers::icm42688::{self, Icm42688};
-use wobble_core::format::{Fault, FaultSource, Record};
+use wobble_core::format::Record;
 use wobble_core::frame_assembly::FrameConfig;
-use wobble_core::gps::{GpsConfig, GpsReceiver};
 use wobble_core::imu::Imu;
 use wobble_core::logger::{CardLogger, FixedTime, HeaderSpec, LoggerConfig};
 use wobble_core::steering::Steering;
@@ -312,19 +311,10 @@ async fn sampler_task(mut sampler: Sampler, mut ports: Ports) {
 
 #[embassy_executor::task]
 async fn gps_task(mut port: GpsAdapter) {
-    let outcome = gps_setup::run(&mut port, &mut |step| defmt::info!("GPS set-up: {}", step)).await;
-    defmt::info!("GPS: {}", outcome);
-    if let Some(code) = outcome.fault() {
-        let t_us = Instant::now().as_micros();
-        QUEUE.push(Record::Fault(Fault {
-            t_us,
-            source: FaultSource::Gps,
-            code,
-            count: 1,
-        }));
-    }
-    let mut receiver = GpsReceiver::new(GpsConfig::default());
-    gps::run(&mut port, &mut receiver, &QUEUE, &SHARED).await;
+    gps::run_link(&mut port, &QUEUE, &SHARED, &mut |step| {
+        defmt::info!("GPS set-up: {}", step);
+    })
+    .await;
 }
 
 #[embassy_executor::task]

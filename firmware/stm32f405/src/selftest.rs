@@ -95,7 +95,7 @@ async fn sensors(
         ticker.next().await;
         k += 1;
         led.set_level((k / 10).is_multiple_of(2).into());
-        if steering.read().await.is_ok() {
+        if steering.read(0).await.is_ok() {
             if let Some((lo, hi)) = steering.last_range() {
                 let (a, b) = m.steer_counts.unwrap_or((lo, hi));
                 m.steer_counts = Some((a.min(lo), b.max(hi)));
