@@ -20,25 +20,20 @@
 //! completely, at most once per [`REINIT_INTERVAL_US`], until samples flow.
 
 /// Samples read from a converter's DMA ring and not yet handed to a frame,
-/// oldest first; `N` must hold the whole ring.
-#[derive(Clone, Debug)]
-pub struct SampleBacklog<const N: usize> {
-    samples: [u16; N],
+/// oldest first, in `storage` (a `static` on the board: the adapter stays
+/// small inside its task's future). The storage must hold the whole ring.
+#[derive(Debug)]
+pub struct SampleBacklog<'a> {
+    samples: &'a mut [u16],
     held: usize,
 }
 
-impl<const N: usize> Default for SampleBacklog<N> {
-    fn default() -> Self {
-        Self::new()
-    }
-}
-
-impl<const N: usize> SampleBacklog<N> {
-    /// Empty.
+impl<'a> SampleBacklog<'a> {
+    /// Empty, holding at most `storage.len()` samples.
     #[must_use]
-    pub const fn new() -> Self {
+    pub fn new(storage: &'a mut [u16]) -> Self {
         Self {
-            samples: [0; N],
+            samples: storage,
             held: 0,
         }
     }
@@ -57,7 +52,7 @@ impl<const N: usize> SampleBacklog<N> {
 
     /// `n` samples were written to the start of [`SampleBacklog::spare`].
     pub fn filled(&mut self, n: usize) {
-        self.held = (self.held + n).min(N);
+        self.held = (self.held + n).min(self.samples.len());
     }
 
     /// Drops every held sample (the converter was restarted).
@@ -69,7 +64,7 @@ impl<const N: usize> SampleBacklog<N> {
     /// it is owed: all held but the newest `late_us × rate_hz`, which were
     /// converted after that time and belong to the next frame. Returns
     /// them, oldest first; the rest stay held.
-    pub fn take_owed(&mut self, late_us: u64, rate_hz: u32) -> Owed<'_, N> {
+    pub fn take_owed(&mut self, late_us: u64, rate_hz: u32) -> Owed<'_, 'a> {
         let newer = u64::from(rate_hz).saturating_mul(late_us) / 1_000_000;
         let keep = usize::try_from(newer).unwrap_or(usize::MAX).min(self.held);
         Owed {
@@ -81,12 +76,12 @@ impl<const N: usize> SampleBacklog<N> {
 
 /// A frame's share of a [`SampleBacklog`]; dropping it removes the share
 /// and keeps the samples that belong to later frames.
-pub struct Owed<'a, const N: usize> {
-    backlog: &'a mut SampleBacklog<N>,
+pub struct Owed<'b, 'a> {
+    backlog: &'b mut SampleBacklog<'a>,
     keep: usize,
 }
 
-impl<const N: usize> Owed<'_, N> {
+impl Owed<'_, '_> {
     /// The frame's samples, oldest first.
     #[must_use]
     pub fn samples(&self) -> &[u16] {
@@ -95,7 +90,7 @@ impl<const N: usize> Owed<'_, N> {
     }
 }
 
-impl<const N: usize> Drop for Owed<'_, N> {
+impl Drop for Owed<'_, '_> {
     fn drop(&mut self) {
         let b = &mut *self.backlog;
         let owed = b.held - self.keep;
@@ -202,7 +197,8 @@ mod tests {
     /// read into a backlog at the given times, each frame `late_us` after
     /// its schedule; returns each frame's samples.
     fn frames(reads: &[(u64, u64)]) -> Vec<Vec<u16>> {
-        let mut backlog = SampleBacklog::<RING>::new();
+        let mut storage = [0u16; RING];
+        let mut backlog = SampleBacklog::new(&mut storage);
         let mut produced = 0u64;
         let mut out = Vec::new();
         for &(now_us, late_us) in reads {
@@ -258,7 +254,8 @@ mod tests {
 
     #[test]
     fn a_frame_late_beyond_what_is_held_gets_nothing_and_loses_nothing() {
-        let mut backlog = SampleBacklog::<8>::new();
+        let mut storage = [0u16; 8];
+        let mut backlog = SampleBacklog::new(&mut storage);
         backlog.spare()[..3].copy_from_slice(&[1, 2, 3]);
         backlog.filled(3);
         assert!(backlog.take_owed(1_000_000, RATE_HZ).samples().is_empty());

@@ -22,6 +22,8 @@ use wobble_core::watchdog::{Liveness, Verdict, TIMEOUT_REQUEST_US};
 
 /// How often the task behind the writer asks.
 const ASK_MS: u64 = 250;
+/// Asks between two stack reports: a minute.
+const STACK_REPORT_ASKS: u32 = 240;
 
 /// A task's heartbeat counter.
 pub struct Heartbeat(AtomicU32);
@@ -97,8 +99,16 @@ pub async fn feed(iwdg: Peri<'static, IWDG>) -> ! {
         let beats = [SAMPLER.count(), GPS.count()];
         d.liveness.arm(Instant::now().as_micros(), beats);
     });
+    let mut asks = 0u32;
     loop {
         prove_alive();
+        // The stack's high-water mark in the log once a minute (a scan of
+        // the painted stack, well under a millisecond).
+        if asks.is_multiple_of(STACK_REPORT_ASKS) {
+            let (used, size) = crate::startup::stack_use();
+            defmt::info!("stack: {} of {} bytes used at most", used, size);
+        }
+        asks = asks.wrapping_add(1);
         Timer::after_millis(ASK_MS).await;
     }
 }

@@ -14,23 +14,20 @@ mod tests {
     use embassy_stm32::adc::{Adc, AdcChannel, Exten, SampleTime, CONTINUOUS};
     use embassy_stm32::pac;
     use embassy_time::{block_for, Duration, Instant, Timer};
-    use static_cell::StaticCell;
     use wobble_core::adc_ring::DRY_US;
     use wobble_core::app::ports::{SensorError, SteeringPort};
     use wobble_core::app::sampler::FRAME_PERIOD_US;
     use wobble_core::stall::LONGEST_STALL_US;
     use wobble_core::steering::{Steering, SteeringCalibration};
-    use wobble_stm32f405::adapters::steering::{SteeringAdapter, CONVERSIONS_HZ, DMA_SAMPLES};
+    use wobble_stm32f405::adapters::steering::{self, SteeringAdapter, CONVERSIONS_HZ};
     use wobble_stm32f405::pins::Irqs;
-
-    static RING: StaticCell<[u16; DMA_SAMPLES]> = StaticCell::new();
 
     fn adapter() -> SteeringAdapter {
         let (board, _) = wobble_on_target::board();
         let pins = board.steering;
         let adc = Adc::new(pins.adc).into_ring_buffered(
             pins.dma,
-            RING.init([0; DMA_SAMPLES]),
+            steering::ring(),
             Irqs,
             [(pins.wiper.degrade_adc(), SampleTime::CYCLES480)].into_iter(),
             CONTINUOUS,

@@ -15,6 +15,7 @@
 use embassy_stm32::gpio::Pull;
 use embassy_stm32::mode::Async;
 use embassy_stm32::usart::{self, RingBufferedUartRx, Uart, UartTx};
+use static_cell::StaticCell;
 use wobble_core::app::gps_setup::GpsLink;
 use wobble_core::app::ports::GpsPort;
 use wobble_core::drivers::gnss_bringup::PROBE_BAUDS;
@@ -25,21 +26,28 @@ use crate::pins::{GpsPins, Irqs};
 /// far more than the GPS task's executor is ever kept from running.
 pub const RING_BYTES: usize = 1024;
 
+static RING: StaticCell<[u8; RING_BYTES]> = StaticCell::new();
+static STAGED: StaticCell<[u8; RING_BYTES]> = StaticCell::new();
+
 /// Both directions of the receiver's UART.
 pub struct GpsAdapter {
     tx: UartTx<'static, Async>,
     rx: RingBufferedUartRx<'static>,
     /// Everything the ring held at the last wake-up (a read takes it all,
     /// so the bytes still to hand out are known: [`GpsPort::pending`]).
-    staged: [u8; RING_BYTES],
+    staged: &'static mut [u8; RING_BYTES],
     staged_len: usize,
     handed: usize,
 }
 
 impl GpsAdapter {
     /// USART2 at the receivers' usual power-up rate (the bring-up finds
-    /// theirs), receiving into `ring`.
-    pub fn new(pins: GpsPins, ring: &'static mut [u8; RING_BYTES]) -> Self {
+    /// theirs), receiving into the DMA ring, each wake-up's bytes staged
+    /// until the GPS task has taken them. Once per boot: the buffers are
+    /// this module's statics (so the adapter stays small in its task).
+    pub fn new(pins: GpsPins) -> Self {
+        let ring = RING.init([0; RING_BYTES]);
+        let staged = STAGED.init([0; RING_BYTES]);
         let mut config = usart::Config::default();
         config.baudrate = PROBE_BAUDS[0];
         config.rx_pull = Pull::Up;
@@ -60,7 +68,7 @@ impl GpsAdapter {
         Self {
             tx,
             rx,
-            staged: [0; RING_BYTES],
+            staged,
             staged_len: 0,
             handed: 0,
         }
@@ -73,7 +81,7 @@ impl GpsPort for GpsAdapter {
         crate::watchdog::GPS.beat();
         while self.handed == self.staged_len {
             // Cancel-safe: until it returns, the bytes stay in the ring.
-            match self.rx.read(&mut self.staged).await {
+            match self.rx.read(&mut self.staged[..]).await {
                 Ok(n) => {
                     self.staged_len = n;
                     self.handed = 0;

@@ -8,6 +8,7 @@ use embassy_stm32::adc::RingBufferedAdc;
 use embassy_stm32::pac;
 use embassy_stm32::peripherals::ADC1;
 use embassy_time::Instant;
+use static_cell::StaticCell;
 use wobble_core::adc_ring::{OverrunRecovery, Recovery, RecoveryStats, SampleBacklog};
 use wobble_core::app::ports::{SensorError, SteeringPort, SteeringSample};
 use wobble_core::stall;
@@ -25,12 +26,21 @@ const STREAM: usize = 4;
 // The ring's length goes into the 16-bit NDTR register.
 const _: () = assert!(DMA_SAMPLES <= u16::MAX as usize);
 
+static RING: StaticCell<[u16; DMA_SAMPLES]> = StaticCell::new();
+/// What the frames after a stall are still owed (as large as the ring).
+static BACKLOG: StaticCell<[u16; DMA_SAMPLES]> = StaticCell::new();
+
+/// The DMA ring for `RingBufferedAdc` (once per boot).
+pub fn ring() -> &'static mut [u16; DMA_SAMPLES] {
+    RING.init([0; DMA_SAMPLES])
+}
+
 /// ADC ring buffer plus the core's steering channel.
 pub struct SteeringAdapter {
     adc: RingBufferedAdc<'static, ADC1>,
     channel: Steering,
     /// Samples taken from the ring and owed to frames still to come.
-    backlog: SampleBacklog<DMA_SAMPLES>,
+    backlog: SampleBacklog<'static>,
     recovery: OverrunRecovery,
     /// Lowest and highest raw count of the last frame (the self-test's).
     last_range: Option<(u16, u16)>,
@@ -39,13 +49,14 @@ pub struct SteeringAdapter {
 }
 
 impl SteeringAdapter {
-    /// Starts the conversions.
+    /// Starts the conversions of `adc` (made on [`ring`]). Once per boot:
+    /// the backlog is this module's static.
     pub fn new(mut adc: RingBufferedAdc<'static, ADC1>, channel: Steering) -> Self {
         adc.start();
         Self {
             adc,
             channel,
-            backlog: SampleBacklog::new(),
+            backlog: SampleBacklog::new(BACKLOG.init([0; DMA_SAMPLES])),
             recovery: OverrunRecovery::new(),
             last_range: None,
             last_samples: 0,
