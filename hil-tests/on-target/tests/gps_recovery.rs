@@ -46,7 +46,7 @@ mod tests {
     /// after it was first switched to 20 Hz, noting when in `reset_at`.
     /// Runs until the test ends.
     async fn receiver(uart: &mut Uart<'static, Async>, reset_at: &mut Option<Instant>) -> ! {
-        let (mut baud, mut hz) = (9_600u32, 1u64);
+        let mut hz = 1u64;
         let mut configured_at = None;
         let mut cmd = [0u8; 128];
         loop {
@@ -63,8 +63,7 @@ mod tests {
                 let heard = cmd.get(..n).unwrap_or_default();
                 let has = |needle: &[u8]| heard.windows(needle.len()).any(|w| w == needle);
                 if has(b"PMTK251,115200") {
-                    baud = 115_200;
-                    defmt::unwrap!(uart.set_baudrate(baud).ok());
+                    defmt::unwrap!(uart.set_baudrate(115_200).ok());
                 }
                 if has(b"PMTK220,50") {
                     hz = 20;
@@ -75,8 +74,8 @@ mod tests {
                 configured_at.is_some_and(|t| t.elapsed() >= Duration::from_secs(RESET_AFTER_S));
             if due && reset_at.is_none() {
                 // Brown-out: back to the power-up settings.
-                (baud, hz) = (9_600, 1);
-                defmt::unwrap!(uart.set_baudrate(baud).ok());
+                hz = 1;
+                defmt::unwrap!(uart.set_baudrate(9_600).ok());
                 *reset_at = Some(Instant::now());
                 defmt::info!("receiver: reset to 9600 baud, 1 Hz");
             }
@@ -103,9 +102,8 @@ mod tests {
         let mut player =
             defmt::unwrap!(Uart::new(uart, rx, tx, tx_dma, rx_dma, PlayerIrqs, config).ok());
         let mut reset_at = None;
-        let task = run_link(&mut port, &QUEUE, &SHARED, &mut |step| {
-            defmt::info!("GPS set-up: {}", step);
-        });
+        let mut log = |step: &_| defmt::info!("GPS set-up: {}", step);
+        let task = run_link(&mut port, &QUEUE, &SHARED, &mut log);
         let watch = async {
             let end = Instant::now() + Duration::from_secs(60);
             let (mut lost, mut fixes_after) = (None, 0u32);
