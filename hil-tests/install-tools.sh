@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Installs, once, what building and running the firmware under QEMU needs:
-# the ARM target, qemu-system-arm and dosfstools (mkfs.fat, fsck.fat).
+# the ARM target, qemu-system-arm and dosfstools (mkfs.fat, fsck.fat), and
+# the Python packages the host tests read outputs with.
 # Sourced by demo.sh and test-all.sh; does nothing when all is there.
 TARGET=thumbv7em-none-eabihf
 rustup target list --installed | grep -qx "$TARGET" || rustup target add "$TARGET"
@@ -13,16 +14,22 @@ if ((${#missing[@]})); then
     $SUDO apt-get update
     DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y "${missing[@]}"
 fi
-# DuckDB's Python wheel: the dataset test queries `wobblog export` output
-# with a real engine (the duckdb crate's bundled C++ build would cost CI
-# minutes). A user install; Debian's Python refuses pip without the flag.
-if ! python3 -c 'import duckdb' 2>/dev/null; then
+# Python packages the tests read outputs back with, as researchers do:
+# DuckDB, Polars, pyarrow and pandas (datasets, Parquet, CSV, JSON lines) and
+# gpxpy (GPX). Wheels, no C++ builds; a user install, as Debian's Python
+# refuses pip without the flag. Only what is missing is installed.
+PY_PACKAGES=(duckdb polars pyarrow pandas gpxpy)
+py_missing=()
+for pkg in "${PY_PACKAGES[@]}"; do
+    python3 -c "import $pkg" 2>/dev/null || py_missing+=("$pkg")
+done
+if ((${#py_missing[@]})); then
     python3 -m pip --version >/dev/null 2>&1 || {
         SUDO=""
         [ "$(id -u)" -eq 0 ] || SUDO=sudo
         $SUDO apt-get update
         DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y python3-pip
     }
-    python3 -m pip install --user --quiet duckdb 2>/dev/null ||
-        python3 -m pip install --user --quiet --break-system-packages duckdb
+    python3 -m pip install --user --quiet "${py_missing[@]}" 2>/dev/null ||
+        python3 -m pip install --user --quiet --break-system-packages "${py_missing[@]}"
 fi

@@ -12,6 +12,9 @@ use crate::CliError;
 #[derive(Parser)]
 #[command(name = "wobblog", version, about)]
 pub struct Cli {
+    /// Replace an output file that is write-protected or has other hard links.
+    #[arg(long, global = true)]
+    force: bool,
     #[command(subcommand)]
     command: Command,
 }
@@ -58,6 +61,7 @@ enum Command {
 #[must_use]
 pub fn main() -> ExitCode {
     let cli = Cli::parse();
+    crate::output::set_force(cli.force);
     let result = match cli.command {
         Command::Info(args) => cmd::info::run(&args),
         Command::Decode(args) => cmd::decode::run(&args),

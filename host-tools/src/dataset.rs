@@ -1,17 +1,27 @@
-//! A campaign as one Hive-partitioned Parquet dataset: the frames of every
-//! run under `run=NNNNN/part-0.parquet` (under `card=NAME/` as well for a
-//! folder of cards), beside `runs.parquet` (one row per run, as `wobblog
-//! summary`) and `episodes.parquet` (one row per wobble episode, as
-//! `wobblog wobble`), so DuckDB or Polars query a season at once.
+//! A campaign as Parquet datasets, one folder per table, so Polars,
+//! pyarrow and DuckDB open each with their default options:
+//! `frames/run=N/part-0.parquet` (Hive-partitioned, under `card=NAME/` as
+//! well for a folder of cards; the run number unpadded so readers type it
+//! as an integer), `runs/part-0.parquet` (one row per run, as `wobblog
+//! summary`) and `episodes/part-0.parquet` (one row per wobble episode, as
+//! `wobblog wobble`). Every file carries its columns' units as key-value
+//! metadata (`unit.NAME`).
 
 use std::path::{Path, PathBuf};
 
-use crate::analysis::{Episode, Ride, Stability};
+use crate::analysis::{Cut, Episode, Ride, Stability};
 use crate::cmd::summary::{logs_in, RunRow};
 use crate::export::columns::{Column, Kind, Value};
 use crate::export::parquet::ParquetWriter;
 use crate::output::Output;
 use crate::CliError;
+
+/// The folder of each table in a dataset.
+pub const FRAMES: &str = "frames";
+/// See [`FRAMES`].
+pub const RUNS: &str = "runs";
+/// See [`FRAMES`].
+pub const EPISODES: &str = "episodes";
 
 /// One log of the campaign and where it goes.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -25,13 +35,14 @@ pub struct LogEntry {
 }
 
 impl LogEntry {
-    /// The partition directory, relative to the dataset.
+    /// The frames' partition directory, relative to the dataset.
     #[must_use]
     pub fn partition(&self) -> PathBuf {
-        let run = PathBuf::from(format!("run={:05}", self.run));
+        let run = PathBuf::from(format!("run={}", self.run));
+        let frames = Path::new(FRAMES);
         match &self.card {
-            Some(card) => Path::new(&format!("card={card}")).join(run),
-            None => run,
+            Some(card) => frames.join(format!("card={card}")).join(run),
+            None => frames.join(run),
         }
     }
 }
@@ -173,6 +184,7 @@ fn runs_columns() -> Vec<Column<RunsRow>> {
         number!(RunsRow, "max_speed_mps", r => Some(r.row.max_speed_mps)),
         count!(RunsRow, "episodes", r => r.row.episodes),
         count!(RunsRow, "unstable_episodes", r => r.row.unstable_episodes),
+        count!(RunsRow, "censored_episodes", r => r.row.censored_episodes),
         number!(RunsRow, "wobble_speed_mps", r => r.row.wobble_speed_mps),
         count!(RunsRow, "frames_lost", r => r.row.frames_lost),
         count!(RunsRow, "lost_blocks", r => r.row.lost_blocks),
@@ -211,48 +223,101 @@ fn episodes_columns() -> Vec<Column<EpisodesRow>> {
                 }))
             },
         },
+        Column {
+            name: "censored",
+            kind: Kind::Bool,
+            value: |r| Value::Bool(Some(r.episode.censored)),
+        },
+        Column {
+            name: "cut_at_start",
+            kind: Kind::Label,
+            value: |r| Value::Label(r.episode.cut_at_start.map(Cut::as_str)),
+        },
+        Column {
+            name: "cut_at_end",
+            kind: Kind::Label,
+            value: |r| Value::Label(r.episode.cut_at_end.map(Cut::as_str)),
+        },
     ]);
     columns
 }
 
-/// Writes `rows` as the Parquet file `path`.
-fn write_table<R>(path: &Path, columns: &[Column<R>], rows: &[R]) -> Result<(), CliError> {
-    let mut out = Output::create(path, &[])?;
+/// Writes `rows` as the one file of the table folder `dir`.
+fn write_table<R>(dir: &Path, columns: &[Column<R>], rows: &[R]) -> Result<(), CliError> {
+    std::fs::create_dir_all(dir).map_err(|e| CliError::file(dir, e))?;
+    let path = dir.join("part-0.parquet");
+    let mut out = Output::create(&path, &[])?;
     let mut writer = ParquetWriter::new(&mut out, columns);
-    let pairs = vec![(
+    let mut pairs = vec![(
         "wobblog.version".to_string(),
         env!("CARGO_PKG_VERSION").to_string(),
     )];
+    pairs.extend(crate::export::metadata::units(columns));
     rows.iter()
         .try_for_each(|r| writer.write(r))
         .and_then(|()| writer.finish_with(pairs))
-        .map_err(|e| CliError::file(path, e))?;
+        .map_err(|e| CliError::file(&path, e))?;
     drop(writer);
     out.commit()
 }
 
+/// What a log gave the dataset, or why it gave nothing.
+pub enum Outcome<'a> {
+    /// Its frames, run row and episodes are in.
+    Written(&'a Ride),
+    /// It could not be read; the dataset goes on without it.
+    Skipped(&'a CliError),
+}
+
+/// Writes one log's frame file and analysis; nothing of it stays on failure.
+fn write_log(entry: &LogEntry, dir: &Path) -> Result<Ride, CliError> {
+    // Analysed first: a log that cannot be read fails before a file is made.
+    let ride = Ride::load(&entry.path)?;
+    let partition = dir.join(entry.partition());
+    std::fs::create_dir_all(&partition).map_err(|e| CliError::file(&partition, e))?;
+    let part = partition.join("part-0.parquet");
+    let written = Output::create(&part, &[&entry.path]).and_then(|mut out| {
+        let export = crate::cmd::decode::Export::all(crate::export::Format::Parquet);
+        crate::cmd::decode::decode_to(&entry.path, &export, &mut out, &part)?;
+        out.commit()
+    });
+    if written.is_err() {
+        // Only the empty partition folder this call made; never data.
+        let _ = std::fs::remove_dir(&partition);
+    }
+    written.map(|()| ride)
+}
+
 /// Writes the dataset of `entries` into `dir` (which must exist and be
-/// empty); `progress` is called after each log.
+/// empty); `progress` is told what became of each log. A log that cannot
+/// be read is left out (and told) unless `strict`.
 ///
 /// # Errors
-/// The first log that cannot be read, or an output that cannot be written.
+/// With `strict`, the first log that cannot be read; an output that cannot
+/// be written. Returns how many logs were skipped.
 pub fn write_dataset(
     entries: &[LogEntry],
     dir: &Path,
-    mut progress: impl FnMut(&LogEntry, &Ride),
-) -> Result<(), CliError> {
+    strict: bool,
+    mut progress: impl FnMut(&LogEntry, Outcome<'_>),
+) -> Result<usize, CliError> {
     let mut runs = Vec::new();
     let mut episodes = Vec::new();
+    let mut skipped = 0;
     for entry in entries {
-        let partition = dir.join(entry.partition());
-        std::fs::create_dir_all(&partition).map_err(|e| CliError::file(&partition, e))?;
-        let part = partition.join("part-0.parquet");
-        let mut out = Output::create(&part, &[&entry.path])?;
-        let export = crate::cmd::decode::Export::all(crate::export::Format::Parquet);
-        crate::cmd::decode::decode_to(&entry.path, &export, &mut out, &part)?;
-        out.commit()?;
-        let ride = Ride::load(&entry.path)?;
-        progress(entry, &ride);
+        let ride = match write_log(entry, dir) {
+            Ok(ride) => ride,
+            Err(e)
+                if !strict
+                    && matches!(e, CliError::File { ref path, .. } if path == &entry.path) =>
+            {
+                progress(entry, Outcome::Skipped(&e));
+                skipped += 1;
+                continue;
+            }
+            Err(e) => return Err(e),
+        };
+        progress(entry, Outcome::Written(&ride));
         episodes.extend(ride.episodes.iter().cloned().map(|episode| EpisodesRow {
             entry: entry.clone(),
             episode,
@@ -264,12 +329,15 @@ pub fn write_dataset(
             firmware: ride.summary.firmware.clone(),
         });
     }
-    write_table(&dir.join("runs.parquet"), &runs_columns(), &runs)?;
-    write_table(
-        &dir.join("episodes.parquet"),
-        &episodes_columns(),
-        &episodes,
-    )
+    if runs.is_empty() {
+        return Err(CliError::Failed(format!(
+            "none of the {} logs could be read; no dataset written",
+            entries.len()
+        )));
+    }
+    write_table(&dir.join(RUNS), &runs_columns(), &runs)?;
+    write_table(&dir.join(EPISODES), &episodes_columns(), &episodes)?;
+    Ok(skipped)
 }
 
 /// Builds the dataset of `entries` at `target` whole or not at all: in a
@@ -277,12 +345,14 @@ pub fn write_dataset(
 ///
 /// # Errors
 /// `target` exists already (a dataset is never merged into or replaced), or
-/// any failure of [`write_dataset`]; nothing is left behind then.
+/// any failure of [`write_dataset`]; nothing is left behind then. Returns
+/// how many logs were skipped.
 pub fn build(
     entries: &[LogEntry],
     target: &Path,
-    progress: impl FnMut(&LogEntry, &Ride),
-) -> Result<(), CliError> {
+    strict: bool,
+    progress: impl FnMut(&LogEntry, Outcome<'_>),
+) -> Result<usize, CliError> {
     if target.exists() {
         return Err(CliError::file(
             target,
@@ -296,17 +366,27 @@ pub fn build(
     let name = target
         .file_name()
         .map_or_else(String::new, |n| n.to_string_lossy().into_owned());
-    let temp = tempfile::Builder::new()
-        .prefix(&format!(".{name}."))
-        .suffix(".tmp")
-        .tempdir_in(parent)
-        .map_err(|e| CliError::file(target, format!("cannot create the dataset: {e}")))?;
-    write_dataset(entries, temp.path(), progress)?;
+    // Removed if a signal ends the process before it is in place.
+    let temp = crate::interrupt::make_tracked(
+        || {
+            tempfile::Builder::new()
+                .prefix(&format!(".{name}."))
+                .suffix(".tmp")
+                .tempdir_in(parent)
+        },
+        tempfile::TempDir::path,
+    )
+    .map_err(|e| CliError::file(target, format!("cannot create the dataset: {e}")))?;
     // A non-empty directory that appeared at `target` meanwhile makes the
     // rename fail rather than be replaced.
-    std::fs::rename(temp.path(), target)
-        .map_err(|e| CliError::file(target, format!("cannot move the dataset in place: {e}")))?;
+    let result = write_dataset(entries, temp.path(), strict, progress).and_then(|skipped| {
+        std::fs::rename(temp.path(), target)
+            .map(|()| skipped)
+            .map_err(|e| CliError::file(target, format!("cannot move the dataset in place: {e}")))
+    });
+    crate::interrupt::untrack(temp.path());
+    let skipped = result?;
     // The directory moved; there is nothing left to clean up.
     let _ = temp.keep();
-    Ok(())
+    Ok(skipped)
 }

@@ -9,7 +9,7 @@ pub enum CliError {
     #[error("{0}")]
     Usage(String),
     /// A file could not be read, written or understood (exit code 1).
-    #[error("{path}: {message}")]
+    #[error("{}: {message}", crate::text::shown(path))]
     File {
         /// The file concerned.
         path: PathBuf,

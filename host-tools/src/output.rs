@@ -8,7 +8,26 @@
 //! and leaves whatever was at the target as it was. An output that is the
 //! same file as one of the command's inputs (same path, a hard link, or a
 //! symlink to it: handles are compared, not names) is refused before
-//! anything is created.
+//! anything is created, and so is standard output when it is an input
+//! (`decode LOG >> LOG`, which `cat` refuses too).
+//!
+//! What is replaced, and how:
+//! - a name for one of the process's open files (`/dev/stdout`,
+//!   `/dev/stderr`, `/dev/fd/N`, `/proc/self/fd/N`, or a link to one) is
+//!   written in place, appending: `-o /dev/stdout >> all.csv` appends like
+//!   the redirection says;
+//! - a device, FIFO or socket is written in place;
+//! - a symlink is followed to its destination (which may not exist yet),
+//!   and the destination is replaced: the link stays a link;
+//! - a replaced file keeps its permission bits;
+//! - a write-protected file (no write bit) or one with other hard links
+//!   (which a rename would split from it) is refused unless `--force`;
+//! - a directory is refused before any work is done.
+//!
+//! The temporary file is `.NAME.PID.XXXXXX.tmp`; one left by a run that
+//! was killed (its process gone) is removed, with a note, by the next run
+//! writing the same target. Messages name the target, never the
+//! temporary file.
 //!
 //! ```no_run
 //! # use std::io::Write;
@@ -23,8 +42,10 @@
 //! # }
 //! ```
 
+use std::fs::{self, OpenOptions};
 use std::io::{self, BufWriter, Stdout, Write};
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
 
 use tempfile::NamedTempFile;
 
@@ -32,6 +53,21 @@ use crate::CliError;
 
 /// Bytes buffered before they go to the file or pipe.
 const BUFFER_LEN: usize = 1 << 16;
+
+/// Longest file name most file systems take, bytes.
+const NAME_MAX: usize = 255;
+
+/// Symlinks followed before a target is refused as a loop (as the kernel's
+/// own limit).
+const MAX_LINKS: usize = 40;
+
+/// `--force`: replace write-protected files and files with other hard links.
+static FORCE: AtomicBool = AtomicBool::new(false);
+
+/// Sets whether outputs replace write-protected and hard-linked files.
+pub fn set_force(force: bool) {
+    FORCE.store(force, Ordering::Relaxed);
+}
 
 /// One command output: an atomically replaced file, or standard output.
 pub struct Output {
@@ -45,7 +81,7 @@ pub struct Output {
 
 enum Sink {
     File {
-        temp: BufWriter<NamedTempFile>,
+        temp: BufWriter<Temp>,
         /// Where the temporary file goes on commit (a symlinked target's
         /// destination, so the link stays a link).
         target: PathBuf,
@@ -60,30 +96,60 @@ impl Output {
     /// any of `inputs`. Nothing at `target` changes until [`Self::commit`].
     pub fn create(target: &Path, inputs: &[&Path]) -> Result<Self, CliError> {
         refuse_inputs(target, inputs)?;
-        let resolved = resolve_symlink(target);
+        // One of this process's open files: written through, appending, so
+        // a redirection's `>>` stays an append and nothing is renamed over
+        // the file behind it.
+        if names_open_file(target) {
+            let file = OpenOptions::new()
+                .append(true)
+                .open(target)
+                .map_err(|e| CliError::file(target, plain(&e)))?;
+            return Ok(Self::in_place(target, file));
+        }
+        let resolved = follow_links(target).map_err(|e| CliError::file(target, plain(&e)))?;
+        let existing = match fs::metadata(&resolved) {
+            Ok(meta) => Some(meta),
+            Err(e) if e.kind() == io::ErrorKind::NotFound => None,
+            Err(e) => return Err(CliError::file(target, plain(&e))),
+        };
+        if existing.as_ref().is_some_and(fs::Metadata::is_dir) || ends_with_slash(target) {
+            return Err(CliError::Usage(format!(
+                "{}: is a directory; name a file to write",
+                crate::text::shown(target)
+            )));
+        }
         // A device or a pipe (`-o /dev/null`, a FIFO) is written as it is:
         // renaming a file over it would replace the device itself.
-        if std::fs::metadata(&resolved).is_ok_and(|m| !m.is_file() && !m.is_dir()) {
-            let file = std::fs::OpenOptions::new()
+        if existing.as_ref().is_some_and(|m| !m.is_file()) {
+            let file = OpenOptions::new()
                 .write(true)
                 .open(&resolved)
-                .map_err(|e| CliError::file(target, e))?;
-            return Ok(Self {
-                sink: Sink::Device(BufWriter::with_capacity(BUFFER_LEN, file)),
-                name: target.to_path_buf(),
-                pipe_closed: false,
-            });
+                .map_err(|e| CliError::file(target, plain(&e)))?;
+            return Ok(Self::in_place(target, file));
         }
-        let temp = temp_beside(&resolved)
-            .map_err(|e| CliError::file(target, format!("cannot create the output: {e}")))?;
+        if let Some(meta) = &existing {
+            refuse_protected(target, meta)?;
+        }
+        remove_stale(&resolved);
+        let temp = temp_beside(&resolved, existing.as_ref()).map_err(|e| {
+            CliError::file(target, format!("cannot create the output: {}", plain(&e)))
+        })?;
         Ok(Self {
             sink: Sink::File {
-                temp: BufWriter::with_capacity(BUFFER_LEN, temp),
+                temp: BufWriter::with_capacity(BUFFER_LEN, Temp::new(temp)),
                 target: resolved,
             },
             name: target.to_path_buf(),
             pipe_closed: false,
         })
+    }
+
+    fn in_place(target: &Path, file: fs::File) -> Self {
+        Self {
+            sink: Sink::Device(BufWriter::with_capacity(BUFFER_LEN, file)),
+            name: target.to_path_buf(),
+            pipe_closed: false,
+        }
     }
 
     /// An output to standard output. A reader that goes away (`| head`)
@@ -97,9 +163,16 @@ impl Output {
         }
     }
 
-    /// [`Self::create`] for `Some(target)`, else [`Self::stdout`].
+    /// [`Self::create`] for `Some(target)`, else [`Self::stdout`], refused
+    /// when standard output is one of `inputs` (`decode LOG >> LOG`).
     pub fn create_or_stdout(target: Option<&Path>, inputs: &[&Path]) -> Result<Self, CliError> {
-        target.map_or_else(|| Ok(Self::stdout()), |t| Self::create(t, inputs))
+        match target {
+            Some(t) => Self::create(t, inputs),
+            None => {
+                refuse_stdout_input(inputs)?;
+                Ok(Self::stdout())
+            }
+        }
     }
 
     /// The output's name in messages: the target path, or `<stdout>`.
@@ -157,15 +230,20 @@ impl Output {
                 }
             }),
             Sink::File { temp, target } => {
-                let temp = temp
+                let mut temp = temp
                     .into_inner()
-                    .map_err(|e| CliError::file(&name, e.into_error()))?;
-                temp.as_file()
+                    .map_err(|e| CliError::file(&name, plain(&e.into_error())))?;
+                let file = temp
+                    .file
+                    .take()
+                    .ok_or_else(|| CliError::file(&name, "committed twice"))?;
+                file.as_file()
                     .sync_all()
-                    .map_err(|e| CliError::file(&name, e))?;
-                temp.persist(&target)
-                    .map(drop)
-                    .map_err(|e| CliError::file(&name, format!("cannot replace: {}", e.error)))
+                    .map_err(|e| CliError::file(&name, plain(&e)))?;
+                // `temp` is dropped (untracked) only after the rename.
+                file.persist(&target).map(drop).map_err(|e| {
+                    CliError::file(&name, format!("cannot replace: {}", plain(&e.error)))
+                })
             }
         }
     }
@@ -193,6 +271,49 @@ impl Write for Output {
     }
 }
 
+/// A temporary output file, removed if a signal ends the process before it
+/// is committed or dropped ([`crate::interrupt`]).
+struct Temp {
+    /// `None` once taken to be committed.
+    file: Option<NamedTempFile>,
+    path: PathBuf,
+}
+
+impl Temp {
+    /// Takes a temporary file made by [`crate::interrupt::make_tracked`].
+    fn new(file: NamedTempFile) -> Self {
+        let path = file.path().to_path_buf();
+        Self {
+            file: Some(file),
+            path,
+        }
+    }
+
+    fn file(&mut self) -> io::Result<&mut NamedTempFile> {
+        self.file
+            .as_mut()
+            .ok_or_else(|| io::Error::other("the output was committed"))
+    }
+}
+
+impl Write for Temp {
+    fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
+        self.file()?.write(buf)
+    }
+
+    fn flush(&mut self) -> io::Result<()> {
+        self.file()?.flush()
+    }
+}
+
+impl Drop for Temp {
+    fn drop(&mut self) {
+        // Removes the file unless it was committed, then stops tracking it.
+        drop(self.file.take());
+        crate::interrupt::untrack(&self.path);
+    }
+}
+
 /// Refuses `target` if it is the same file as one of `inputs`. A target or
 /// input that does not exist (yet) cannot be the same file.
 fn refuse_inputs(target: &Path, inputs: &[&Path]) -> Result<(), CliError> {
@@ -208,37 +329,202 @@ fn refuse_inputs(target: &Path, inputs: &[&Path]) -> Result<(), CliError> {
     Ok(())
 }
 
-/// The file a symlink points to (so writing through the link keeps it),
-/// or `target` itself.
-fn resolve_symlink(target: &Path) -> PathBuf {
-    let is_link = std::fs::symlink_metadata(target).is_ok_and(|m| m.file_type().is_symlink());
-    if is_link {
-        std::fs::canonicalize(target).unwrap_or_else(|_| target.to_path_buf())
+/// Refuses an input that is standard output (a regular file only: a
+/// terminal or pipe that is also read is left to the user, as `cat` does).
+fn refuse_stdout_input(inputs: &[&Path]) -> Result<(), CliError> {
+    let Ok(stdout) = same_file::Handle::stdout() else {
+        return Ok(());
+    };
+    let regular = stdout.as_file().metadata().is_ok_and(|m| m.is_file());
+    for input in inputs {
+        if regular && same_file::Handle::from_path(input).is_ok_and(|h| h == stdout) {
+            return Err(CliError::Usage(format!(
+                "{}: standard output is the input; refusing to write into it",
+                crate::text::shown(input)
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// Whether `path`, or a link on the way from it, names one of this
+/// process's open files (`/dev/stdout`, `/dev/fd/3`, `/proc/self/fd/1`).
+fn names_open_file(path: &Path) -> bool {
+    let mut path = path.to_path_buf();
+    for _ in 0..MAX_LINKS {
+        if is_descriptor_name(&path) {
+            return true;
+        }
+        match fs::read_link(&path) {
+            Ok(next) => path = beside(&path, next),
+            Err(_) => return false,
+        }
+    }
+    false
+}
+
+fn is_descriptor_name(path: &Path) -> bool {
+    let parts: Vec<String> = path
+        .components()
+        .map(|c| c.as_os_str().to_string_lossy().into_owned())
+        .collect();
+    let parts: Vec<&str> = parts.iter().map(String::as_str).collect();
+    let own =
+        |pid: &str| pid == "self" || pid == "thread-self" || pid == std::process::id().to_string();
+    match parts.as_slice() {
+        ["/", "dev", "stdin" | "stdout" | "stderr"] | ["/", "dev", "fd", _] => true,
+        ["/", "proc", pid, "fd", _] => own(pid),
+        ["/", "proc", pid, "task", _, "fd", _] => own(pid),
+        _ => false,
+    }
+}
+
+/// Where a link at `link` whose content is `next` points.
+fn beside(link: &Path, next: PathBuf) -> PathBuf {
+    if next.is_absolute() {
+        next
     } else {
-        target.to_path_buf()
+        link.parent().unwrap_or(Path::new("")).join(next)
+    }
+}
+
+/// The path at the end of `target`'s chain of symlinks (which may not
+/// exist: a dangling link's file is created where it points).
+fn follow_links(target: &Path) -> io::Result<PathBuf> {
+    let mut path = target.to_path_buf();
+    for _ in 0..MAX_LINKS {
+        match fs::symlink_metadata(&path) {
+            Ok(m) if m.file_type().is_symlink() => path = beside(&path, fs::read_link(&path)?),
+            _ => return Ok(path),
+        }
+    }
+    Err(io::Error::other("too many levels of symbolic links"))
+}
+
+fn ends_with_slash(path: &Path) -> bool {
+    path.as_os_str().to_string_lossy().ends_with('/')
+}
+
+/// Refuses to replace a write-protected file, or one with other hard links
+/// (the new file would have this name only), unless `--force`.
+fn refuse_protected(target: &Path, meta: &fs::Metadata) -> Result<(), CliError> {
+    if FORCE.load(Ordering::Relaxed) {
+        return Ok(());
+    }
+    let shown = crate::text::shown(target);
+    if meta.permissions().readonly() {
+        return Err(CliError::Usage(format!(
+            "{shown}: the file is write-protected; --force replaces it"
+        )));
+    }
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::MetadataExt;
+        if meta.nlink() > 1 {
+            return Err(CliError::Usage(format!(
+                "{shown}: the file has {} other hard links, which replacing it would split \
+                 from it; --force replaces this name only",
+                meta.nlink() - 1
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// An I/O error's reason without any path in it (the temporary file's
+/// name means nothing to the user; `tempfile` appends it as " at path").
+fn plain(e: &io::Error) -> String {
+    if let Some(code) = e.raw_os_error() {
+        return io::Error::from_raw_os_error(code).to_string();
+    }
+    let text = e.to_string();
+    match text.find(" at path ") {
+        Some(end) => text[..end].to_string(),
+        None => text,
+    }
+}
+
+/// The name part of a temporary file for `target`: its file name, cut at
+/// a character boundary so the whole temporary name fits `NAME_MAX`.
+fn temp_stem(target: &Path) -> String {
+    let name = target.file_name().unwrap_or_default().to_string_lossy();
+    // ".", ".", pid (at most 10 digits), ".", 6 random, ".tmp"
+    let room = NAME_MAX - (1 + 1 + 10 + 1 + 6 + 4);
+    let mut end = name.len().min(room);
+    while !name.is_char_boundary(end) {
+        end -= 1;
+    }
+    name[..end].to_string()
+}
+
+fn dir_of(target: &Path) -> &Path {
+    match target.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    }
+}
+
+/// Removes temporary files of `target` left by runs whose process is gone
+/// (killed before they could clean up), with a note for each; where
+/// processes cannot be looked up, only reports them.
+fn remove_stale(target: &Path) {
+    let dir = dir_of(target);
+    let prefix = format!(".{}.", temp_stem(target));
+    let Ok(entries) = fs::read_dir(dir) else {
+        return;
+    };
+    let can_look = Path::new("/proc/self").exists();
+    for entry in entries.flatten() {
+        let name = entry.file_name();
+        let name = name.to_string_lossy();
+        let Some(rest) = name
+            .strip_prefix(&prefix)
+            .and_then(|r| r.strip_suffix(".tmp"))
+        else {
+            continue;
+        };
+        let Some((pid, random)) = rest.split_once('.') else {
+            continue;
+        };
+        if random.len() != 6 || pid.is_empty() || !pid.bytes().all(|b| b.is_ascii_digit()) {
+            continue;
+        }
+        let path = entry.path();
+        if !can_look {
+            eprintln!(
+                "wobblog: note: {} may be left by an interrupted run",
+                crate::text::shown(&path)
+            );
+        } else if !Path::new("/proc").join(pid).exists() && fs::remove_file(&path).is_ok() {
+            eprintln!(
+                "wobblog: note: removed {}, left by an interrupted run",
+                crate::text::shown(&path)
+            );
+        }
     }
 }
 
 /// A new temporary file beside `target`, with a hidden name that says what
-/// it will become, readable by others as a file the user creates would be
-/// (the umask still applies).
-fn temp_beside(target: &Path) -> io::Result<NamedTempFile> {
-    let dir = match target.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d,
-        _ => Path::new("."),
-    };
-    let prefix = format!(
-        ".{}.",
-        target.file_name().unwrap_or_default().to_string_lossy()
-    );
+/// it will become and which process writes it, with the permission bits
+/// of the file it replaces (`existing`), or readable by others as a file
+/// the user creates would be (the umask still applies).
+fn temp_beside(target: &Path, existing: Option<&fs::Metadata>) -> io::Result<NamedTempFile> {
+    let prefix = format!(".{}.{}.", temp_stem(target), std::process::id());
     let mut builder = tempfile::Builder::new();
-    builder.prefix(&prefix).suffix(".tmp");
+    builder.prefix(&prefix).suffix(".tmp").rand_bytes(6);
     #[cfg(unix)]
     {
         use std::os::unix::fs::PermissionsExt;
-        builder.permissions(std::fs::Permissions::from_mode(0o666));
+        builder.permissions(fs::Permissions::from_mode(0o666));
     }
-    builder.tempfile_in(dir)
+    let temp = crate::interrupt::make_tracked(
+        || builder.tempfile_in(dir_of(target)),
+        NamedTempFile::path,
+    )?;
+    if let Some(meta) = existing {
+        temp.as_file().set_permissions(meta.permissions())?;
+    }
+    Ok(temp)
 }
 
 #[cfg(test)]

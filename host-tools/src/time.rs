@@ -88,6 +88,19 @@ impl std::str::FromStr for TimeBound {
     }
 }
 
+impl std::fmt::Display for TimeBound {
+    /// As `--from/--to` take it: seconds since boot, or ISO 8601 UTC.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match *self {
+            Self::Boot(s) => write!(f, "{s}"),
+            Self::Utc(ms) => match iso8601_unix_ms(ms) {
+                Some(text) => f.write_str(&text),
+                None => write!(f, "{ms} ms since 1970"),
+            },
+        }
+    }
+}
+
 /// A local time / UTC pair of the log: seconds since boot, ms since 1970.
 pub type SyncPair = (f64, i64);
 
@@ -116,6 +129,10 @@ pub fn utc_ms_at(pairs: &[SyncPair], t_s: f64) -> Option<i64> {
     let (pair_s, pair_ms) = *pairs.get(at)?;
     Some(pair_ms + ((t_s - pair_s) * 1e3).round() as i64)
 }
+
+/// Why a UTC bound cannot be placed in a log.
+const NO_UTC_FOR_WINDOW: &str =
+    "the log has no UTC time (no GPS sync pair), so a UTC --from/--to cannot be placed";
 
 /// The `--from/--to` of a command.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -148,6 +165,72 @@ impl TimeWindow {
         self.from.is_none_or(from_ok) && self.to.is_none_or(to_ok)
     }
 
+    /// The window as the command line gave it: `--from 10 --to 12`.
+    #[must_use]
+    pub fn describe(&self) -> String {
+        let parts: Vec<String> = [("--from", self.from), ("--to", self.to)]
+            .into_iter()
+            .filter_map(|(flag, b)| b.map(|b| format!("{flag} {b}")))
+            .collect();
+        parts.join(" ")
+    }
+
+    /// Whether a UTC time bounds the window.
+    #[must_use]
+    pub fn has_utc_bound(&self) -> bool {
+        matches!(self.from, Some(TimeBound::Utc(_))) || matches!(self.to, Some(TimeBound::Utc(_)))
+    }
+
+    /// Refuses, before any reading, a window whose bounds of one kind (both
+    /// seconds since boot, or both UTC) end before they start.
+    ///
+    /// # Errors
+    /// A usage error naming the window.
+    pub fn check_order(&self, log: &std::path::Path) -> Result<(), crate::CliError> {
+        let reversed = match (self.from, self.to) {
+            (Some(TimeBound::Boot(a)), Some(TimeBound::Boot(b))) => a > b,
+            (Some(TimeBound::Utc(a)), Some(TimeBound::Utc(b))) => a > b,
+            _ => false,
+        };
+        if reversed {
+            return Err(crate::CliError::Usage(format!(
+                "{}: the window {} ends before it starts, so it selects nothing",
+                log.display(),
+                self.describe()
+            )));
+        }
+        Ok(())
+    }
+
+    /// The error for a window that selected nothing of `log`: the one rule
+    /// of every command, so no empty output ever passes for a result.
+    /// `what` names what was selected ("frames", "GPS fixes"); `span_s` is
+    /// the time the log's `what` cover, s since boot; `has_utc` whether the
+    /// log has UTC at all.
+    #[must_use]
+    pub fn selects_nothing(
+        &self,
+        log: &std::path::Path,
+        what: &str,
+        span_s: Option<(f64, f64)>,
+        has_utc: bool,
+    ) -> crate::CliError {
+        if self.has_utc_bound() && !has_utc {
+            return crate::CliError::file(
+                log,
+                format!("{NO_UTC_FOR_WINDOW} (window {})", self.describe()),
+            );
+        }
+        let span = span_s.map_or_else(
+            || format!("the log has no {what}"),
+            |(a, b)| format!("the log's {what} span {a:.3} to {b:.3} s since boot"),
+        );
+        crate::CliError::file(
+            log,
+            format!("the window {} selects no {what}; {span}", self.describe()),
+        )
+    }
+
     /// The window in seconds since boot, through the sync pairs of `log`.
     ///
     /// # Errors
@@ -163,7 +246,7 @@ impl TimeWindow {
                 b.boot_s(pairs).ok_or_else(|| {
                     crate::CliError::file(
                         log,
-                        "the log has no UTC time (no GPS sync pair), so a UTC --from/--to cannot be placed",
+                        format!("{NO_UTC_FOR_WINDOW} (window {})", self.describe()),
                     )
                 })
             })
@@ -173,7 +256,9 @@ impl TimeWindow {
         if let (Some(a), Some(b)) = (from, to) {
             if a >= b {
                 return Err(crate::CliError::Usage(format!(
-                    "--from ({a:.3} s since boot) is not before --to ({b:.3} s)"
+                    "{}: the window {} ends before it starts ({a:.3} to {b:.3} s since boot), so it selects nothing",
+                    log.display(),
+                    self.describe()
                 )));
             }
         }

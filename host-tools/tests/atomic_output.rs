@@ -191,3 +191,33 @@ fn an_unwritable_output_is_reported_plainly() {
         );
     }
 }
+
+#[test]
+fn a_command_that_fails_commits_no_figure() {
+    let dir = tempfile::tempdir().unwrap();
+    let (_, log) = sample(dir.path());
+    let missing = dir.path().join("MISSING.WBL");
+    let params =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("bicycle-model/params/test-bicycle.toml");
+    for (name, mut cmd) in [("modes.png", wobblog()), ("fig8.svg", wobblog())] {
+        let fig = dir.path().join(name);
+        std::fs::write(&fig, b"good old figure").unwrap();
+        if name == "modes.png" {
+            cmd.arg("wobble")
+                .arg(&log)
+                .arg(&missing)
+                .arg("--plot")
+                .arg(&fig);
+        } else {
+            cmd.args(["model", "compare"])
+                .arg(&params)
+                .arg(&log)
+                .arg(&missing);
+            cmd.arg("-o").arg(&fig);
+        }
+        let before = listing(dir.path());
+        cmd.assert().code(1);
+        assert_eq!(std::fs::read(&fig).unwrap(), b"good old figure", "{name}");
+        assert_eq!(listing(dir.path()), before, "{name}");
+    }
+}

@@ -1,12 +1,13 @@
-//! `wobblog export`: a campaign as a Hive-partitioned Parquet dataset,
-//! queried through DuckDB (its Python wheel; the test command installs it).
+//! `wobblog export`: a campaign as Parquet datasets, one folder per table,
+//! opened with Polars, pyarrow and DuckDB as their users would, default
+//! options only (their Python packages; `hil-tests/install-tools.sh`
+//! installs them).
 
 mod analysis_support;
 
+use analysis_support::{python, standard_log, wobblog, write_log, Ride};
+use serde_json::json;
 use std::path::Path;
-use std::process::Command;
-
-use analysis_support::{standard_log, wobblog, write_log, Ride};
 
 /// A card with three runs of different lengths, each with one unstable
 /// wobble; returns their frame counts.
@@ -27,33 +28,6 @@ fn card(dir: &Path) -> Vec<usize> {
         .collect()
 }
 
-/// Runs `sql` in DuckDB; its rows as JSON arrays. `None` when the DuckDB
-/// wheel is missing outside CI; under CI (`CI=true`) that fails the test.
-fn duckdb(sql: &str) -> Option<Vec<serde_json::Value>> {
-    let script = "import duckdb, json, sys\n\
-        rows = duckdb.sql(sys.argv[1]).fetchall()\n\
-        print(json.dumps([list(r) for r in rows], default=str))";
-    let out = Command::new("python3").args(["-c", script, sql]).output();
-    let missing = out.as_ref().map_or(true, |o| {
-        String::from_utf8_lossy(&o.stderr).contains("No module named 'duckdb'")
-    });
-    if missing {
-        assert!(
-            std::env::var("CI").as_deref() != Ok("true"),
-            "DuckDB's Python wheel is missing: run `python3 -m pip install duckdb` (hil-tests/install-tools.sh does)"
-        );
-        eprintln!("SKIPPED: DuckDB's Python wheel is not installed (pip install duckdb)");
-        return None;
-    }
-    let out = out.unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    Some(serde_json::from_slice(&out.stdout).unwrap())
-}
-
 /// Runs `wobblog export DIR -o DS`.
 fn export(dir: &Path, ds: &Path) -> std::process::Output {
     wobblog()
@@ -65,8 +39,48 @@ fn export(dir: &Path, ds: &Path) -> std::process::Output {
         .unwrap()
 }
 
+/// Opens each table of the dataset `argv[1]` with Polars, pyarrow and
+/// DuckDB, every one with its default options, and reports what each sees.
+const READ_BACK: &str = r#"
+import json, sys
+import duckdb, polars as pl, pyarrow.parquet as pq
+ds = sys.argv[1]
+out = {}
+frames = pl.scan_parquet(ds + "/frames/")
+out["polars_run_type"] = str(frames.collect_schema()["run"])
+out["polars_counts"] = frames.group_by("run").len().sort("run").collect().rows()
+out["polars_utc_type"] = str(frames.collect_schema()["utc"])
+table = pq.read_table(ds + "/frames")
+out["pyarrow_run_type"] = str(table.schema.field("run").type)
+out["pyarrow_rows"] = table.num_rows
+out["duckdb_counts"] = duckdb.sql(
+    f"SELECT run, typeof(run), count(*) FROM '{ds}/frames/**/*.parquet' GROUP BY ALL ORDER BY run"
+).fetchall()
+runs = pl.scan_parquet(ds + "/runs/")
+episodes = pl.scan_parquet(ds + "/episodes/")
+out["episodes_schema"] = {k: str(v) for k, v in episodes.collect_schema().items()}
+out["runs_schema"] = {k: str(v) for k, v in runs.collect_schema().items()}
+out["unstable"] = (
+    episodes.filter(pl.col("stability") == "unstable")
+    .join(runs, on="run")
+    .select("run", pl.col("speed_at_onset_mps").round(2), "censored", "censored_episodes",
+            (pl.col("wobble_speed_mps") == pl.col("speed_at_onset_mps")).alias("same"))
+    .sort("run").collect().rows()
+)
+out["pyarrow_episodes"] = pq.read_table(ds + "/episodes").num_rows
+out["duckdb_runs"] = duckdb.sql(
+    f"SELECT count(*), min(first_utc)::VARCHAR FROM '{ds}/runs/*.parquet'"
+).fetchall()
+units = {}
+for table in ["frames/run=1", "runs", "episodes"]:
+    meta = pq.read_schema(f"{ds}/{table}/part-0.parquet").metadata
+    units[table] = {k.decode()[5:]: v.decode() for k, v in meta.items() if k.startswith(b"unit.")}
+out["units"] = units
+print(json.dumps(out, default=str))
+"#;
+
 #[test]
-fn duckdb_queries_a_dataset_of_several_runs() {
+fn each_table_opens_as_a_dataset_in_polars_pyarrow_and_duckdb() {
     let dir = tempfile::tempdir().unwrap();
     let frames = card(&dir.path().join("card"));
     let ds = dir.path().join("season");
@@ -78,46 +92,66 @@ fn duckdb_queries_a_dataset_of_several_runs() {
         .assert()
         .success();
     for run in 1..=3 {
-        assert!(ds.join(format!("run={run:05}/part-0.parquet")).is_file());
+        assert!(ds
+            .join(format!("frames/run={run}/part-0.parquet"))
+            .is_file());
     }
-    let q = |sql: &str| duckdb(&sql.replace("DS", &ds.display().to_string()));
-    let Some(counts) = q(
-        "SELECT run, count(*) FROM read_parquet('DS/**/run=*/*.parquet', \
-         hive_partitioning = true, hive_types = {'run': INTEGER}) GROUP BY run ORDER BY run",
-    ) else {
+    let Some(seen) = python(READ_BACK, &[ds.as_os_str()]) else {
         return;
     };
-    let expected: Vec<serde_json::Value> = frames
+    // Typed partitions: an integer run number in every reader.
+    assert_eq!(seen["polars_run_type"], "Int64");
+    // pyarrow dictionary-encodes partition values: of int32.
+    assert!(seen["pyarrow_run_type"]
+        .as_str()
+        .unwrap()
+        .contains("values=int32"));
+    let counts: Vec<serde_json::Value> = frames
         .iter()
         .enumerate()
-        .map(|(i, n)| serde_json::json!([i + 1, n]))
+        .map(|(i, n)| json!([i + 1, n]))
         .collect();
-    assert_eq!(counts, expected);
-    let unstable = q(
-        "SELECT e.run, round(e.speed_at_onset_mps, 2), r.wobble_speed_mps = e.speed_at_onset_mps \
-         FROM 'DS/episodes.parquet' e JOIN 'DS/runs.parquet' r USING (run) \
-         WHERE e.stability = 'unstable' ORDER BY e.run",
-    )
-    .unwrap();
+    assert_eq!(seen["polars_counts"], json!(counts));
+    let duck: Vec<serde_json::Value> = frames
+        .iter()
+        .enumerate()
+        .map(|(i, n)| json!([i + 1, "BIGINT", n]))
+        .collect();
+    assert_eq!(seen["duckdb_counts"], json!(duck));
+    assert_eq!(seen["pyarrow_rows"], frames.iter().sum::<usize>());
+    assert!(seen["polars_utc_type"]
+        .as_str()
+        .unwrap()
+        .starts_with("Datetime(time_unit='us', time_zone='UTC'"));
+    // The censoring columns, typed.
+    let episodes = &seen["episodes_schema"];
+    assert_eq!(episodes["censored"], "Boolean");
+    assert_eq!(episodes["cut_at_start"], "String");
+    assert_eq!(episodes["cut_at_end"], "String");
+    assert_eq!(seen["runs_schema"]["censored_episodes"], "Int64");
     assert_eq!(
-        unstable,
-        [
-            serde_json::json!([1, 5.0, true]),
-            serde_json::json!([2, 5.0, true]),
-            serde_json::json!([3, 5.0, true])
-        ]
+        seen["unstable"],
+        json!([
+            [1, 5.0, false, 0, true],
+            [2, 5.0, false, 0, true],
+            [3, 5.0, false, 0, true]
+        ])
     );
-    let utc =
-        q("SELECT any_value(typeof(utc)), min(utc) FROM read_parquet('DS/run=00001/*.parquet')")
-            .unwrap();
-    assert_eq!(utc[0][0], "TIMESTAMP WITH TIME ZONE");
+    assert_eq!(seen["pyarrow_episodes"], 3);
+    let runs = &seen["duckdb_runs"][0];
+    assert_eq!(runs[0], 3);
     assert!(
-        utc[0][1]
-            .as_str()
-            .unwrap()
-            .starts_with("2020-03-18 10:00:01"),
-        "{utc:?}"
+        runs[1].as_str().unwrap().starts_with("2020-03-18 10:00:01"),
+        "{runs}"
     );
+    // Units on every table.
+    let units = &seen["units"];
+    assert_eq!(units["frames/run=1"]["gz_dps"], "deg/s");
+    assert_eq!(units["runs"]["distance_m"], "m");
+    assert_eq!(units["runs"]["first_utc"], "UTC");
+    assert_eq!(units["episodes"]["sigma_per_s"], "1/s");
+    assert_eq!(units["episodes"]["freq_hz"], "Hz");
+    assert_eq!(units["episodes"]["censored"], "");
 }
 
 #[test]
@@ -138,10 +172,57 @@ fn a_folder_of_cards_is_partitioned_by_card_and_run() {
         .success();
     for name in ["blue", "red"] {
         assert!(ds
-            .join(format!("card={name}/run=00001/part-0.parquet"))
+            .join(format!("frames/card={name}/run=1/part-0.parquet"))
             .is_file());
     }
-    assert!(ds.join("runs.parquet").is_file() && ds.join("episodes.parquet").is_file());
+    assert!(ds.join("runs/part-0.parquet").is_file());
+    assert!(ds.join("episodes/part-0.parquet").is_file());
+    let script = r#"
+import json, sys
+import duckdb, polars as pl, pyarrow.parquet as pq
+ds = sys.argv[1]
+polars = pl.scan_parquet(ds + "/frames/").group_by("card", "run").len().sort("card").collect().rows()
+table = pq.read_table(ds + "/frames", columns=["card", "run"]).to_pylist()
+arrow = sorted({(r["card"], r["run"]) for r in table})
+duck = duckdb.sql(f"SELECT DISTINCT card, run FROM '{ds}/frames/**/*.parquet' ORDER BY card").fetchall()
+print(json.dumps({"polars": polars, "arrow": arrow, "duck": duck}))
+"#;
+    let Some(seen) = python(script, &[ds.as_os_str()]) else {
+        return;
+    };
+    let n = seen["polars"][0][2].as_u64().unwrap();
+    assert_eq!(seen["polars"], json!([["blue", 1, n], ["red", 1, n]]));
+    assert_eq!(seen["arrow"], json!([["blue", 1], ["red", 1]]));
+    assert_eq!(seen["duck"], json!([["blue", 1], ["red", 1]]));
+}
+
+#[test]
+fn a_bad_log_is_reported_and_left_out_unless_strict() {
+    let dir = tempfile::tempdir().unwrap();
+    let card_dir = dir.path().join("card");
+    let frames = card(&card_dir);
+    std::fs::write(card_dir.join("RUN00004.WBL"), b"").unwrap();
+    let ds = dir.path().join("season");
+    let out = export(&card_dir, &ds);
+    assert_eq!(out.status.code(), Some(1));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("RUN00004.WBL") && stderr.contains("left out"),
+        "{stderr}"
+    );
+    let script = r#"
+import json, sys
+import polars as pl
+ds = sys.argv[1]
+runs = pl.read_parquet(ds + "/runs/").get_column("run").to_list()
+frames = pl.scan_parquet(ds + "/frames/").select(pl.len()).collect().item()
+print(json.dumps({"runs": runs, "frames": frames}))
+"#;
+    assert!(!ds.join("frames/run=4").exists());
+    if let Some(seen) = python(script, &[ds.as_os_str()]) {
+        assert_eq!(seen["runs"], json!([1, 2, 3]));
+        assert_eq!(seen["frames"], frames.iter().sum::<usize>());
+    }
 }
 
 #[test]
@@ -151,7 +232,14 @@ fn the_dataset_appears_whole_or_not_at_all() {
     card(&card_dir);
     std::fs::write(card_dir.join("RUN00004.WBL"), vec![0u8; 4096]).unwrap();
     let ds = dir.path().join("season");
-    let out = export(&card_dir, &ds);
+    let out = wobblog()
+        .arg("export")
+        .arg(&card_dir)
+        .arg("-o")
+        .arg(&ds)
+        .arg("--strict")
+        .output()
+        .unwrap();
     assert_eq!(out.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&out.stderr).contains("RUN00004.WBL"));
     let left: Vec<_> = std::fs::read_dir(dir.path())

@@ -34,28 +34,43 @@ pub fn eigenvalues(a: &DMatrix<f64>) -> Option<Vec<Complex<f64>>> {
 #[must_use]
 pub fn eigen(a: &DMatrix<f64>) -> Option<Vec<Eigen>> {
     let values = eigenvalues(a)?;
-    let n = a.nrows();
-    let ac: DMatrix<Complex<f64>> = a.map(|v| Complex::new(v, 0.0));
-    let scale = a.iter().fold(1.0_f64, |m, v| m.max(v.abs()));
+    let ac = complex(a);
     Some(
         values
             .into_iter()
-            .map(|value| {
-                // A shift just off the eigenvalue keeps the LU regular.
-                let shift = value + Complex::new(1e-10 * scale, 1e-10 * scale);
-                let b = &ac - DMatrix::from_diagonal_element(n, n, shift);
-                let lu = b.lu();
-                let mut x = DVector::from_fn(n, |i, _| Complex::new(1.0 + 0.1 * i as f64, 0.0));
-                for _ in 0..2 {
-                    if let Some(y) = lu.solve(&x) {
-                        let norm = y.norm();
-                        if norm.is_finite() && norm > 0.0 {
-                            x = y / Complex::new(norm, 0.0);
-                        }
-                    }
-                }
-                Eigen { value, vector: x }
+            .map(|value| Eigen {
+                value,
+                vector: eigenvector_of(&ac, value),
             })
             .collect(),
     )
+}
+
+/// The (unit-norm) eigenvector of `a` for its eigenvalue `value`.
+#[must_use]
+pub fn eigenvector(a: &DMatrix<f64>, value: Complex<f64>) -> DVector<Complex<f64>> {
+    eigenvector_of(&complex(a), value)
+}
+
+fn complex(a: &DMatrix<f64>) -> DMatrix<Complex<f64>> {
+    a.map(|v| Complex::new(v, 0.0))
+}
+
+/// Two steps of inverse iteration on `ac - value I`.
+fn eigenvector_of(ac: &DMatrix<Complex<f64>>, value: Complex<f64>) -> DVector<Complex<f64>> {
+    let n = ac.nrows();
+    let scale = ac.iter().fold(1.0_f64, |m, v| m.max(v.norm()));
+    // A shift just off the eigenvalue keeps the LU regular.
+    let shift = value + Complex::new(1e-10 * scale, 1e-10 * scale);
+    let lu = (ac - DMatrix::from_diagonal_element(n, n, shift)).lu();
+    let mut x = DVector::from_fn(n, |i, _| Complex::new(1.0 + 0.1 * i as f64, 0.0));
+    for _ in 0..2 {
+        if let Some(y) = lu.solve(&x) {
+            let norm = y.norm();
+            if norm.is_finite() && norm > 0.0 {
+                x = y / Complex::new(norm, 0.0);
+            }
+        }
+    }
+    x
 }

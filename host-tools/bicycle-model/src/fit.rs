@@ -134,7 +134,13 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for EpisodeFit<'_> {
     }
 }
 
-/// Fits `keys` of `set` to `obs`.
+/// Fits `keys` of `set` to `obs`: the model's eigenvalue named `wobble`
+/// (followed from 0 m/s to each episode's speed) against each episode.
+///
+/// # Errors
+/// A key not in the set, too few episodes, a model with no wobble mode at
+/// the episodes' speeds, a search that did not converge, or parameters the
+/// episodes do not determine ([`Problem::NotFitted`]).
 pub fn fit(
     set: &ParamSet,
     keys: &[String],
@@ -173,14 +179,36 @@ pub fn fit(
     problem.residuals().ok_or_else(no_wobble)?;
     // A first step of at most a factor e^0.05 keeps the search on the
     // branch it starts on (the default bound of 100 is e^100 here).
-    let (problem, _report) = LevenbergMarquardt::new()
+    let (problem, report) = LevenbergMarquardt::new()
         .with_stepbound(0.05)
         .minimize(problem);
     let r = problem.residuals().ok_or_else(no_wobble)?;
+    if !report.termination.was_successful() {
+        return Err(set.error(
+            "",
+            Problem::NotFitted(format!(
+                "the least-squares search did not converge ({:?}) after {} model evaluations",
+                report.termination,
+                problem.evaluations.get()
+            )),
+        ));
+    }
     let j = problem.jacobian().ok_or_else(no_wobble)?;
     let dof = (r.len() - keys.len()).max(1) as f64;
     let s2 = r.norm_squared() / dof;
-    let cov = (j.transpose() * &j).try_inverse().map(|c| c * s2);
+    let cov = (j.transpose() * &j)
+        .try_inverse()
+        .filter(|c| c.iter().all(|v| v.is_finite()))
+        .map(|c| c * s2)
+        .ok_or_else(|| {
+            set.error(
+                "",
+                Problem::NotFitted(format!(
+                    "the episodes do not determine {} (the wobble does not depend on them independently)",
+                    keys.join(", ")
+                )),
+            )
+        })?;
     let fitted = problem.set_at(&problem.factors)?;
     let estimates = keys
         .iter()
@@ -190,9 +218,7 @@ pub fn fit(
             Estimate {
                 key: key.clone(),
                 value,
-                ci95: cov.as_ref().map_or(f64::INFINITY, |c| {
-                    Z_975 * c[(k, k)].max(0.0).sqrt() * value.abs()
-                }),
+                ci95: Z_975 * cov[(k, k)].max(0.0).sqrt() * value.abs(),
                 unit: set
                     .quantity(key)
                     .map(|q| q.unit.clone())

@@ -10,9 +10,11 @@ pub mod eig;
 pub mod fit;
 pub mod model;
 pub mod multibody;
+mod naming;
 pub mod params;
 pub mod simulate;
 pub mod sweep;
+mod track;
 pub mod whipple;
 pub mod wobble;
 

@@ -1,24 +1,13 @@
 //! Eigenvalues against speed, followed continuously from one speed to the
-//! next and named by mode.
-//!
-//! Tracking: each eigenvalue at a new speed is matched to the branch whose
-//! linear extrapolation from the two previous speeds lies nearest (pairs
-//! assigned greedily in order of distance, which is exact when the step is
-//! small against the gaps between eigenvalues).
-//!
-//! Naming, per branch, from its eigenvector at the middle of the speeds
-//! where it oscillates (or of all speeds, for a real branch): the angle
-//! (roll, steer, torso, twist, tyre) with the largest share decides.
-//! Oscillating roll/steer branches are the weave (the lowest frequency) and
-//! the wobble (the next); real ones are capsize (roll, the slowest) and
-//! castering (steer, the fastest decay). Torso branches are `lean`, twist
-//! branches `twist`, tyre lags and the rest `other`.
+//! next ([`crate::track`]: eigenvalues only) and named by mode from their
+//! participation over the whole speed range ([`crate::naming`]: eigenvectors
+//! at a few speeds).
 
 use std::fmt;
 
 use nalgebra::{Complex, DMatrix};
 
-use crate::eig::{eigen, Eigen};
+use crate::eig::eigenvalues;
 use crate::model::{Model, StateRole};
 
 /// The name of a mode.
@@ -125,20 +114,19 @@ impl Sweep {
         if speeds_mps.is_empty() {
             return Err(SweepError::NoSpeeds);
         }
-        let mut tracks: Vec<Vec<Eigen>> = Vec::new();
-        for (k, &u) in speeds_mps.iter().enumerate() {
-            let found = eigen(&state_matrix(u)).ok_or(SweepError::Eigen(u))?;
-            if tracks.is_empty() {
-                tracks = found.into_iter().map(|e| vec![e]).collect();
-            } else {
-                assign(&mut tracks, found, k);
-            }
-            progress(k);
-        }
-        let branches = name_branches(&tracks, roles);
+        let values = crate::track::track(
+            &|u| eigenvalues(&state_matrix(u)),
+            speeds_mps,
+            &mut progress,
+        )?;
+        let modes = crate::naming::name(&values, speeds_mps, &state_matrix, roles);
         Ok(Self {
             speeds_mps: speeds_mps.to_vec(),
-            branches,
+            branches: modes
+                .into_iter()
+                .zip(values)
+                .map(|(mode, values)| Branch { mode, values })
+                .collect(),
         })
     }
 
@@ -156,188 +144,6 @@ impl Sweep {
             sum(a).total_cmp(&sum(b))
         })
     }
-}
-
-/// Extends every track with the eigenvalue of `found` nearest its
-/// prediction.
-fn assign(tracks: &mut [Vec<Eigen>], found: Vec<Eigen>, k: usize) {
-    let predicted: Vec<Complex<f64>> = tracks
-        .iter()
-        .map(|t| {
-            let last = t[k - 1].value;
-            if k >= 2 {
-                last * 2.0 - t[k - 2].value
-            } else {
-                last
-            }
-        })
-        .collect();
-    let mut pairs: Vec<(f64, usize, usize)> = Vec::with_capacity(tracks.len() * found.len());
-    for (i, p) in predicted.iter().enumerate() {
-        for (j, f) in found.iter().enumerate() {
-            pairs.push(((f.value - p).norm(), i, j));
-        }
-    }
-    pairs.sort_by(|a, b| a.0.total_cmp(&b.0));
-    let mut slot: Vec<Option<Eigen>> = found.into_iter().map(Some).collect();
-    let mut done = vec![false; tracks.len()];
-    for (_, i, j) in pairs {
-        if done[i] {
-            continue;
-        }
-        if let Some(e) = slot[j].take() {
-            tracks[i].push(e);
-            done[i] = true;
-        }
-    }
-}
-
-/// What an eigenvector says about its mode: the largest of the mechanical
-/// angles (roll, steer, torso, twist), the roll-to-steer ratio, and whether
-/// the tyre lags dominate everything.
-#[derive(Clone, Copy)]
-struct Shape {
-    role: StateRole,
-    roll_over_steer: f64,
-    tyre_only: bool,
-}
-
-/// A mode whose tyre lags are this many times its largest angle is a tyre mode.
-const TYRE_DOMINANCE: f64 = 4.0;
-/// Weave rolls: at least this much roll per steer.
-const WEAVE_MIN_ROLL_PER_STEER: f64 = 0.2;
-/// Wobble is faster than this, rad/s (2 Hz; the weave stays below it in
-/// the speed range of interest).
-const WOBBLE_MIN_RAD_S: f64 = 4.0 * std::f64::consts::PI;
-
-fn shape(e: &Eigen, roles: &[StateRole]) -> Shape {
-    let size = |want: StateRole| {
-        roles
-            .iter()
-            .zip(e.vector.iter())
-            .filter(|(r, _)| **r == want)
-            .map(|(_, c)| c.norm())
-            .fold(0.0, f64::max)
-    };
-    let mech = [
-        StateRole::Roll,
-        StateRole::Steer,
-        StateRole::Torso,
-        StateRole::Twist,
-    ]
-    .map(|r| (r, size(r)));
-    let (role, largest) = mech
-        .iter()
-        .copied()
-        .max_by(|a, b| a.1.total_cmp(&b.1))
-        .unwrap_or((StateRole::Rate, 0.0));
-    let steer = size(StateRole::Steer);
-    Shape {
-        role,
-        roll_over_steer: if steer > 0.0 {
-            size(StateRole::Roll) / steer
-        } else {
-            f64::INFINITY
-        },
-        tyre_only: size(StateRole::Tyre) > TYRE_DOMINANCE * largest,
-    }
-}
-
-fn name_branches(tracks: &[Vec<Eigen>], roles: &[StateRole]) -> Vec<Branch> {
-    struct Seen {
-        shape: Shape,
-        oscillates: bool,
-        freq: f64,
-        re_at: f64,
-        mean_re: f64,
-    }
-    let seen: Vec<Seen> = tracks
-        .iter()
-        .map(|t| {
-            let complex: Vec<usize> = (0..t.len())
-                .filter(|&k| t[k].value.im.abs() > REAL_TOL)
-                .collect();
-            let at = complex
-                .get(complex.len() / 2)
-                .copied()
-                .unwrap_or(t.len() / 2);
-            Seen {
-                shape: shape(&t[at], roles),
-                oscillates: !complex.is_empty(),
-                freq: t[at].value.im.abs(),
-                re_at: t[at].value.re,
-                mean_re: t.iter().map(|e| e.value.re).sum::<f64>() / t.len() as f64,
-            }
-        })
-        .collect();
-    let planar =
-        |s: &Seen| !s.shape.tyre_only && matches!(s.shape.role, StateRole::Roll | StateRole::Steer);
-    let weave_like =
-        |s: &Seen| planar(s) && s.oscillates && s.shape.roll_over_steer >= WEAVE_MIN_ROLL_PER_STEER;
-    let wobble_like = |s: &Seen| {
-        planar(s) && s.oscillates && s.shape.role == StateRole::Steer && s.freq >= WOBBLE_MIN_RAD_S
-    };
-    // The lowest frequency of each kind; both members of a pair share it.
-    let lowest = |keep: &dyn Fn(&Seen) -> bool| {
-        seen.iter()
-            .filter(|s| keep(s))
-            .map(|s| s.freq)
-            .min_by(f64::total_cmp)
-    };
-    let weave_freq = lowest(&weave_like);
-    let wobble_freq = lowest(&|s: &Seen| wobble_like(s) && Some(s.freq) != weave_freq);
-    // The two members of an oscillating pair.
-    let partners = |a: &Seen, b: &Seen| {
-        a.oscillates
-            && (a.freq - b.freq).abs() <= 1e-9 * a.freq.max(1.0)
-            && (a.re_at - b.re_at).abs() <= 1e-9 * a.re_at.abs().max(1.0)
-    };
-    let same =
-        |s: &Seen, f: Option<f64>| f.is_some_and(|f| (s.freq - f).abs() <= 1e-9 * f.max(1.0));
-    let capsize = pick(
-        &seen,
-        |s| planar(s) && !s.oscillates && s.shape.role == StateRole::Roll,
-        |s| -s.mean_re.abs(),
-    );
-    let castering = pick(
-        &seen,
-        |s| {
-            planar(s)
-                && s.shape.role == StateRole::Steer
-                && s.freq < WOBBLE_MIN_RAD_S
-                && !weave_like(s)
-        },
-        |s| -s.mean_re,
-    );
-    seen.iter()
-        .zip(tracks)
-        .enumerate()
-        .map(|(i, (s, t))| {
-            let mode = match s.shape.role {
-                _ if s.shape.tyre_only => Mode::Other,
-                StateRole::Torso => Mode::Lean,
-                StateRole::Twist => Mode::Twist,
-                _ if weave_like(s) && same(s, weave_freq) => Mode::Weave,
-                _ if wobble_like(s) && same(s, wobble_freq) => Mode::Wobble,
-                _ if Some(i) == capsize => Mode::Capsize,
-                _ if castering.is_some_and(|c| i == c || partners(&seen[c], s)) => Mode::Castering,
-                _ => Mode::Other,
-            };
-            Branch {
-                mode,
-                values: t.iter().map(|e| e.value).collect(),
-            }
-        })
-        .collect()
-}
-
-/// The index of the branch passing `keep` with the largest `score`.
-fn pick<S>(seen: &[S], keep: impl Fn(&S) -> bool, score: impl Fn(&S) -> f64) -> Option<usize> {
-    seen.iter()
-        .enumerate()
-        .filter(|(_, s)| keep(s))
-        .max_by(|a, b| score(a.1).total_cmp(&score(b.1)))
-        .map(|(i, _)| i)
 }
 
 /// Grid step for following a mode up to given speeds, m/s.

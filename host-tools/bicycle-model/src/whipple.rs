@@ -122,17 +122,21 @@ impl Body {
         Ok(body)
     }
 
-    /// A rigid body's inertia tensor is positive definite (Sylvester's
-    /// criterion on the x-z block, and yy).
+    /// A rigid body's inertia tensor is positive semi-definite (the
+    /// principal minors of the x-z block, and yy, non-negative up to
+    /// round-off): a slender rod, with no inertia about its own axis, is a
+    /// body too.
     fn check_inertia(&self, set: &ParamSet, section: &str) -> Result<(), ParamError> {
-        let det = self.inertia_xx * self.inertia_zz - self.inertia_xz * self.inertia_xz;
-        if self.inertia_xx > 0.0 && self.inertia_yy > 0.0 && self.inertia_zz > 0.0 && det > 0.0 {
+        let (xx, zz, xz) = (self.inertia_xx, self.inertia_zz, self.inertia_xz);
+        let det = xx * zz - xz * xz;
+        let round_off = 1e-12 * (xx * xx + zz * zz + xz * xz).sqrt().max(f64::MIN_POSITIVE);
+        if xx >= 0.0 && self.inertia_yy >= 0.0 && zz >= 0.0 && det >= -round_off * (xx + zz) {
             return Ok(());
         }
         Err(set.error(
             &format!("{section}.inertia_xx"),
             Problem::Unphysical(format!(
-                "the inertia tensor of {section} is not positive definite \
+                "the inertia tensor of {section} is not positive semi-definite \
                  (xx {}, yy {}, zz {}, xz {} kg m^2)",
                 self.inertia_xx, self.inertia_yy, self.inertia_zz, self.inertia_xz
             )),

@@ -30,11 +30,14 @@ fn negative_mass_is_unphysical() {
 }
 
 #[test]
-fn inertia_that_is_not_positive_definite_is_unphysical() {
+fn inertia_that_is_not_positive_semi_definite_is_unphysical() {
     // I_xx I_zz = 25.76 < I_xz^2 = 36.
     let err = load_edited("inertia_xz = { value = 2.4", "inertia_xz = { value = 6.0").unwrap_err();
     assert_eq!(err.param, "rear_frame.inertia_xx");
-    assert!(err.to_string().contains("not positive definite"), "{err}");
+    assert!(
+        err.to_string().contains("not positive semi-definite"),
+        "{err}"
+    );
 }
 
 #[test]
@@ -93,4 +96,108 @@ proptest! {
             }
         }
     }
+}
+
+#[test]
+fn misspelt_keys_are_errors_naming_the_key() {
+    // An optional key misspelt would otherwise default in silence.
+    let text = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("params/test-bicycle.toml"),
+    )
+    .unwrap();
+    let edited = text.replacen(
+        "[front_tyre]",
+        "[front_tyre]\ncamber_relaxaton_length = { value = 0.1, unit = \"m\", source = \"x\" }",
+        1,
+    );
+    let err = ParamSet::from_toml(Path::new("t.toml"), &edited).unwrap_err();
+    assert_eq!(err.param, "front_tyre.camber_relaxaton_length");
+    assert!(
+        err.to_string().contains("camber_relaxation_length"),
+        "lists the keys: {err}"
+    );
+    let edited = text.replacen("[hip]", "[hips]", 1);
+    let err = ParamSet::from_toml(Path::new("t.toml"), &edited).unwrap_err();
+    assert!(err.to_string().contains("not a section"), "{err}");
+    // A wobble key in a Whipple file is not silently ignored either.
+    let err = ParamSet::from_toml(
+        Path::new("b.toml"),
+        &benchmark_text().replacen(
+            "[geometry]",
+            "[steer]\ndamping = { value = 1, unit = \"N m s/rad\", source = \"x\" }\n\n[geometry]",
+            1,
+        ),
+    )
+    .unwrap_err();
+    assert_eq!(err.param, "steer.damping");
+}
+
+#[test]
+fn a_defaulted_camber_relaxation_length_is_said() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("params/test-bicycle.toml");
+    let text = std::fs::read_to_string(&path).unwrap();
+    let set = ParamSet::from_toml(&path, &text).unwrap();
+    assert_eq!(set.notes.len(), 2, "{:?}", set.notes);
+    assert!(set.notes[0].contains("front_tyre.camber_relaxation_length not given"));
+    let given = text.replacen(
+        "[front_tyre]",
+        "[front_tyre]\ncamber_relaxation_length = { value = 0.1, unit = \"m\", source = \"x\" }",
+        1,
+    );
+    let set = ParamSet::from_toml(&path, &given).unwrap();
+    assert_eq!(set.notes.len(), 1);
+    assert!(set.notes[0].starts_with("rear_tyre"));
+    assert!(ParamSet::from_toml(&path, &benchmark_text())
+        .unwrap()
+        .notes
+        .is_empty());
+}
+
+#[test]
+fn bicycleparameters_lines_are_checked_and_noted() {
+    // Silver as BicycleParameters ships it: IRzz, IFzz, yB, yH.
+    let silver = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data/bicycleparameters/SilverBenchmark.txt");
+    let set = ParamSet::load(&silver).unwrap();
+    assert_eq!(set.notes.len(), 1, "{:?}", set.notes);
+    for s in ["IRzz", "IFzz", "yB", "yH"] {
+        assert!(set.notes[0].contains(s), "{}", set.notes[0]);
+    }
+    Model::from_set(&set).unwrap();
+    let text = std::fs::read_to_string(&silver).unwrap();
+    for (from, to, line) in [
+        ("yB = 0.0+/-0.0", "yB = 0.02+/-0.0", "line 11"),
+        ("IFzz = 0.081", "IFzz = 0.09", "line 30"),
+    ] {
+        assert!(text.contains(from));
+        let err = ParamSet::from_benchmark_txt(&silver, &text.replace(from, to)).unwrap_err();
+        assert_eq!(err.param, line, "{err}");
+        assert!(matches!(err.problem, Problem::Unphysical(_)), "{err}");
+    }
+}
+
+#[test]
+fn a_slender_rod_is_a_body() {
+    // A rod along z: no inertia about its own axis (positive semi-definite).
+    let text = benchmark_text();
+    let front = text.split("[front_frame]").nth(1).unwrap();
+    let zz = front.lines().find(|l| l.starts_with("inertia_zz")).unwrap();
+    let xz = front.lines().find(|l| l.starts_with("inertia_xz")).unwrap();
+    let rod = text
+        .replacen(
+            zz,
+            "inertia_zz = { value = 0.0, unit = \"kg m^2\", source = \"rod\" }",
+            1,
+        )
+        .replacen(
+            xz,
+            "inertia_xz = { value = 0.0, unit = \"kg m^2\", source = \"rod\" }",
+            1,
+        );
+    let set = ParamSet::from_toml(Path::new("rod.toml"), &rod).unwrap();
+    let model = Model::from_set(&set).unwrap();
+    assert!(wobble_model::eig::eigenvalues(&model.state_matrix(5.0))
+        .unwrap()
+        .iter()
+        .all(|v| v.re.is_finite()));
 }

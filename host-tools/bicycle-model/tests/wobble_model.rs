@@ -181,3 +181,47 @@ fn steering_head_damping_stabilises_wobble() {
     }
     assert!(damped_speed.is_none_or(|s| s > base_speed.unwrap()));
 }
+
+/// A tense rider (hip stiffness over the range where the torso lean mode
+/// moves from below to far above the wobble, through 5-6 Hz where it carries
+/// much steer): the wobble keeps its name, the lean stays the lean, and a
+/// coarse grid follows the same branch as a fine one.
+#[test]
+fn wobble_keeps_its_name_whatever_the_hip_stiffness() {
+    let mut set = set("test-bicycle.toml");
+    for hip in [
+        500.0, 1000.0, 2000.0, 3000.0, 5000.0, 8000.0, 12000.0, 20000.0,
+    ] {
+        set.set_value("hip.stiffness", hip, "test").unwrap();
+        let model = Model::from_set(&set).unwrap();
+        let grid = |step: f64| -> Vec<f64> {
+            let n = (14.0 / step).round() as usize;
+            (0..=n).map(|i| i as f64 * step).collect()
+        };
+        let (coarse, fine) = (grid(0.5), grid(0.05));
+        let wobble_on = |speeds: &[f64]| {
+            let sweep = Sweep::run(&model, speeds, |_| {}).unwrap();
+            assert_eq!(
+                sweep.of(Mode::Wobble).count(),
+                2,
+                "hip {hip}: one wobble pair"
+            );
+            assert!(sweep.of(Mode::Lean).count() >= 2, "hip {hip}: a lean mode");
+            sweep.upper(Mode::Wobble).unwrap().values.clone()
+        };
+        let (c, f) = (wobble_on(&coarse), wobble_on(&fine));
+        for (k, v) in c.iter().enumerate() {
+            assert!(
+                (4.5..7.0).contains(&hz(*v)),
+                "hip {hip}: {} Hz at {} m/s",
+                hz(*v),
+                coarse[k]
+            );
+            assert!(
+                (v - f[10 * k]).norm() < 1e-9,
+                "hip {hip}: grids differ at {} m/s",
+                coarse[k]
+            );
+        }
+    }
+}

@@ -4,6 +4,8 @@
 pub mod censor;
 pub mod episodes;
 pub mod filter;
+pub mod kicks;
+pub mod margin;
 pub mod ride;
 pub mod roll;
 pub mod run;
@@ -12,6 +14,7 @@ pub mod sinefit;
 
 pub use censor::Cut;
 pub use episodes::{find_episodes, wobble_speed_mps, Episode, Stability};
+pub use kicks::{find_kicks, Kick};
 pub use ride::Ride;
 pub use roll::estimate_roll_deg;
 pub use run::Run;

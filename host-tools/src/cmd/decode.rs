@@ -19,11 +19,17 @@ use wobble_core::format::{Event, GpsFix, Record};
 pub struct Args {
     /// The card log (`RUNnnnnn.WBL`).
     pub log: PathBuf,
-    /// Output format; by default the `-o` file's extension (`.csv`,
-    /// `.jsonl`, `.parquet`) names it, else CSV. Parquet is binary: it goes
-    /// to the `-o` file, or to standard output only when that is redirected.
+    /// Output format; by default the `-o` file's name gives it (`.csv`,
+    /// `.tsv`, `.jsonl`/`.ndjson`, `.parquet`/`.pq`, `.mcap`; `.gz` after a
+    /// text one compresses it), else CSV; an unknown extension is refused.
+    /// Parquet and MCAP are binary: they go to the `-o` file, or to
+    /// standard output only when that is redirected.
     #[arg(long, value_enum)]
     pub format: Option<Format>,
+    /// CSV field delimiter: one character, or `tab` (a `.tsv` name's
+    /// default). Default: a comma.
+    #[arg(long, value_name = "CHAR", value_parser = crate::export::parse_delimiter)]
+    pub delimiter: Option<u8>,
     /// Output file; standard output if absent.
     #[arg(short, long)]
     pub output: Option<PathBuf>,
@@ -43,6 +49,8 @@ pub struct Args {
 pub struct Export {
     /// Output format.
     pub format: Format,
+    /// CSV field delimiter.
+    pub delimiter: u8,
     /// Columns, in order.
     pub columns: Vec<Column>,
     /// Rows inside this window only.
@@ -55,6 +63,7 @@ impl Export {
     pub fn all(format: Format) -> Self {
         Self {
             format,
+            delimiter: b',',
             columns: columns::COLUMNS.to_vec(),
             window: TimeWindow::default(),
         }
@@ -63,11 +72,14 @@ impl Export {
 
 /// Runs `wobblog decode`.
 pub fn run(args: &Args) -> Result<(), CliError> {
+    let resolved = Format::resolve(args.format, args.output.as_deref(), args.delimiter)?;
     let export = Export {
-        format: Format::resolve(args.format, args.output.as_deref())?,
+        format: resolved.format,
+        delimiter: resolved.delimiter,
         columns: columns::select(args.columns.as_deref()).map_err(CliError::Usage)?,
         window: args.window.window(),
     };
+    export.window.check_order(&args.log)?;
     let binary = matches!(export.format, Format::Parquet | Format::Mcap);
     if binary && args.output.is_none() && std::io::stdout().is_terminal() {
         return Err(CliError::Usage(format!(
@@ -77,7 +89,17 @@ pub fn run(args: &Args) -> Result<(), CliError> {
     }
     let mut out = Output::create_or_stdout(args.output.as_deref(), &[&args.log])?;
     let name = out.name().to_path_buf();
-    let losses = match decode_to(&args.log, &export, &mut out, &name) {
+    let decoded = if resolved.gzip {
+        let mut gz = flate2::write::GzEncoder::new(&mut out, flate2::Compression::default());
+        decode_to(&args.log, &export, &mut gz, &name).and_then(|losses| {
+            gz.try_finish()
+                .map(|()| losses)
+                .map_err(|e| CliError::file(&name, e))
+        })
+    } else {
+        decode_to(&args.log, &export, &mut out, &name)
+    };
+    let losses = match decoded {
         Err(_) if out.pipe_closed() => return Err(CliError::PipeClosed),
         result => result?,
     };
@@ -96,10 +118,13 @@ pub fn decode_to(
     out_name: &Path,
 ) -> Result<Losses, CliError> {
     let mut sink = WindowedSink {
-        writer: RowWriter::new(export.format, export.columns.clone(), out),
+        writer: RowWriter::new(export.format, export.columns.clone(), export.delimiter, out),
         window: export.window,
         failure: None,
         sync: Vec::new(),
+        rows_kept: 0,
+        span_s: None,
+        has_utc: false,
     };
     let mut rows = RowAssembler::new();
     let mut losses = Losses::default();
@@ -122,10 +147,17 @@ pub fn decode_to(
                 }
                 _ => {}
             }
+            sink.has_utc |= matches!(record, Record::UtcSync(_));
             rows.push(&record, &mut |row: &Row| sink.row(row));
         }
     })?;
     rows.finish(&mut |row: &Row| sink.row(row));
+    if sink.rows_kept == 0 && !export.window.is_all() {
+        // Nothing is written: an empty file would pass for a result.
+        return Err(export
+            .window
+            .selects_nothing(log, "frames", sink.span_s, sink.has_utc));
+    }
     let WindowedSink {
         mut writer,
         failure,
@@ -147,6 +179,12 @@ struct WindowedSink<W: Write + Send> {
     failure: Option<std::io::Error>,
     /// The latest sync pair, which places events in UTC.
     sync: Vec<SyncPair>,
+    /// Rows inside the window.
+    rows_kept: u64,
+    /// First and last row time, s since boot.
+    span_s: Option<(f64, f64)>,
+    /// Whether the log has a sync pair.
+    has_utc: bool,
 }
 
 impl<W: Write + Send> WindowedSink<W> {
@@ -159,6 +197,10 @@ impl<W: Write + Send> WindowedSink<W> {
     fn row(&mut self, row: &Row) {
         let inside =
             self.window.is_all() || self.window.contains(row.t_s, row.utc_us.map(|u| u / 1000));
+        self.span_s = Some(self.span_s.map_or((row.t_s, row.t_s), |(a, b)| {
+            (a.min(row.t_s), b.max(row.t_s))
+        }));
+        self.rows_kept += u64::from(inside);
         self.keep(inside, |w| w.write(row));
     }
 

@@ -6,19 +6,26 @@ use std::path::PathBuf;
 use indicatif::ProgressBar;
 
 use crate::cmd::logs::warn_losses;
-use crate::dataset::{build, campaign_logs};
+use crate::dataset::{build, campaign_logs, Outcome};
 use crate::CliError;
 
 const AFTER_HELP: &str = "\
-Layout: DATASET/run=00001/part-0.parquet (one file per run, the columns of
-`wobblog decode`), DATASET/runs.parquet (one row per run, as `wobblog
-summary`) and DATASET/episodes.parquet (one row per wobble episode, as
-`wobblog wobble`). For a folder of cards, each card's runs go under
-DATASET/card=NAME/. Query it with DuckDB, for example:
-  SELECT run, max(steer_deg) FROM read_parquet('DATASET/**/run=*/*.parquet',
-    hive_partitioning = true, hive_types = {'run': INTEGER}) GROUP BY run;
-  SELECT * FROM 'DATASET/episodes.parquet' WHERE stability = 'unstable';
-The dataset appears whole or not at all; an existing DATASET is refused.";
+Layout: one folder per table, each a dataset of its own:
+  DATASET/frames/run=1/part-0.parquet   one file per run, the columns of
+                                        `wobblog decode` (under card=NAME/
+                                        too for a folder of cards)
+  DATASET/runs/part-0.parquet           one row per run, as `wobblog summary`
+  DATASET/episodes/part-0.parquet       one row per wobble episode, as
+                                        `wobblog wobble`, censoring included
+Partition values are plain (run=1), so readers type them; every file
+carries its columns' units as metadata (unit.NAME). Default options open it:
+  polars.scan_parquet('DATASET/frames/')
+  pyarrow.parquet.read_table('DATASET/frames')
+  duckdb: SELECT run, max(steer_deg) FROM 'DATASET/frames/**/*.parquet' GROUP BY run;
+          SELECT * FROM 'DATASET/episodes/*.parquet' WHERE stability = 'unstable';
+A log that cannot be read is reported and left out (exit code 1, the
+dataset holds the others) unless --strict. The dataset appears whole or not
+at all; an existing DATASET is refused.";
 
 /// Arguments of `wobblog export`.
 #[derive(clap::Args)]
@@ -29,6 +36,9 @@ pub struct Args {
     /// The dataset directory to create.
     #[arg(short, long, value_name = "DATASET")]
     pub output: PathBuf,
+    /// Write no dataset at all if any log cannot be read.
+    #[arg(long)]
+    pub strict: bool,
 }
 
 /// Runs `wobblog export`.
@@ -39,15 +49,27 @@ pub fn run(args: &Args) -> Result<(), CliError> {
     } else {
         ProgressBar::hidden()
     };
-    build(&entries, &args.output, |_, run| {
-        bar.suspend(|| warn_losses(&run.path, &run.summary));
+    let skipped = build(&entries, &args.output, args.strict, |_, outcome| {
+        match outcome {
+            Outcome::Written(ride) => bar.suspend(|| warn_losses(&ride.path, &ride.summary)),
+            Outcome::Skipped(err) => {
+                bar.suspend(|| eprintln!("wobblog: {err}; left out of the dataset"));
+            }
+        }
         bar.inc(1);
     })?;
     bar.finish_and_clear();
     eprintln!(
         "wobblog: {}: {} written",
         args.output.display(),
-        crate::words::plural(entries.len(), "run")
+        crate::words::plural(entries.len() - skipped, "run")
     );
+    if skipped > 0 {
+        return Err(CliError::Failed(format!(
+            "{} of {} logs could not be read (see above) and were left out; --strict writes no dataset then",
+            skipped,
+            entries.len()
+        )));
+    }
     Ok(())
 }

@@ -70,15 +70,17 @@ pub enum Step<'a> {
 /// `visit` ends the walk and is the inner result.
 ///
 /// # Errors
-/// The log cannot be read.
+/// The log cannot be read, or a window was given and holds no fix.
 pub fn track<E>(
     log: &Path,
     window: TimeWindow,
     mut visit: impl FnMut(Step<'_>) -> Result<(), E>,
 ) -> Result<Result<(), E>, CliError> {
+    window.check_order(log)?;
     // The time of the open segment's last point.
     let mut last_us: Option<u64> = None;
-    read_log_try(log, |event| {
+    let (mut points, mut span_s, mut has_utc) = (0u64, None::<(f64, f64)>, false);
+    let walked = read_log_try(log, |event| {
         let LogEvent::Record(Record::Gps(fix)) = event else {
             // A block lost from the file may have held fixes.
             if matches!(event, LogEvent::Gap(_)) && last_us.take().is_some() {
@@ -87,7 +89,13 @@ pub fn track<E>(
             return Ok(());
         };
         let utc_ms = fix.utc.and_then(|u| i64::try_from(u.unix_ms()).ok());
-        if GpsColumns::from_fix(&fix).is_none() || !window.contains(fix.t_us as f64 / 1e6, utc_ms) {
+        let t_s = fix.t_us as f64 / 1e6;
+        let positioned = GpsColumns::from_fix(&fix).is_some();
+        if positioned {
+            has_utc |= utc_ms.is_some();
+            span_s = Some(span_s.map_or((t_s, t_s), |(a, b): (f64, f64)| (a.min(t_s), b.max(t_s))));
+        }
+        if !positioned || !window.contains(t_s, utc_ms) {
             if last_us.take().is_some() {
                 visit(Step::Break)?;
             }
@@ -97,8 +105,13 @@ pub fn track<E>(
             visit(Step::Break)?;
         }
         last_us = Some(fix.t_us);
+        points += 1;
         visit(Step::Point(&fix))
-    })
+    })?;
+    if walked.is_ok() && points == 0 && !window.is_all() {
+        return Err(window.selects_nothing(log, "GPS fixes with a position", span_s, has_utc));
+    }
+    Ok(walked)
 }
 
 /// A GPX 1.1 document of one track, written as its points come; nothing

@@ -46,7 +46,18 @@ pub fn run(args: &Args) -> Result<(), CliError> {
             "--utc: the log has no UTC time (no GPS sync pair)",
         ));
     }
-    let no_frames = || CliError::file(&args.log, "no frames in the requested time window");
+    let no_frames = || {
+        if window.is_all() {
+            CliError::file(&args.log, "no frames in the log")
+        } else {
+            window.selects_nothing(
+                &args.log,
+                "frames",
+                summary.frame_range_s,
+                !pairs.is_empty(),
+            )
+        }
+    };
     let Some((span_s, narrowed)) = summary.plot_span_s() else {
         return Err(CliError::file(&args.log, "no frames in the log"));
     };

@@ -82,9 +82,10 @@ pub fn run(args: &Args) -> Result<(), CliError> {
             text.push_str(&render_text(report));
         }
     }
-    // The figure is drawn even when the table's reader went away.
+    // The figure is drawn even when the table's reader went away, and only
+    // when every log was read: a failed command leaves an old figure as it was.
     let printed = print_stdout(&text);
-    if let Some(out) = plot_out {
+    if let (Some(out), Ok(())) = (plot_out, &result) {
         let runs = names
             .into_iter()
             .zip(reports)

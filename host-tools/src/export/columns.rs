@@ -19,6 +19,8 @@ pub enum Kind {
     Integer,
     /// Free text (a file name).
     Text,
+    /// True or false.
+    Bool,
 }
 
 /// One cell.
@@ -34,6 +36,8 @@ pub enum Value {
     Integer(Option<i64>),
     /// Text, or none.
     Text(Option<String>),
+    /// True or false, or none.
+    Bool(Option<bool>),
 }
 
 /// A column of a table of `R`s: its name (unit in the name), type and

@@ -14,7 +14,7 @@ use super::columns::Column;
 use crate::rows::Row;
 
 /// How one row becomes text: appends its line to the string.
-pub type FormatLine = fn(&mut String, &[Column], &Row);
+pub type FormatLine = super::text::LineFormat;
 
 /// Rows per batch: about 300 KB of text on the widest rows, few enough
 /// hand-overs that the channels cost nothing, small enough to stay in cache.
@@ -159,7 +159,7 @@ impl<W: Write> LineWriter<W> {
 fn format_batch(format: FormatLine, columns: &[Column], rows: &[Row], text: &mut String) {
     text.clear();
     for row in rows {
-        format(text, columns, row);
+        format.line(text, columns, row);
     }
 }
 
@@ -172,7 +172,9 @@ fn stopped() -> std::io::Error {
 mod tests {
     use super::*;
     use crate::export::columns::COLUMNS;
-    use crate::export::text::csv_line;
+    use crate::export::text::{csv_line, LineFormat};
+
+    const CSV: LineFormat = LineFormat::Csv { delimiter: b',' };
 
     fn rows(n: usize) -> Vec<Row> {
         let any = Row {
@@ -206,7 +208,7 @@ mod tests {
             // No worker: the system started none, and the rows are
             // formatted where they are written.
             for workers in 0..=MAX_WORKERS {
-                let mut w = LineWriter::with_workers(Vec::new(), &COLUMNS, csv_line, workers);
+                let mut w = LineWriter::with_workers(Vec::new(), &COLUMNS, CSV, workers);
                 w.write_text("header\n").unwrap();
                 for row in &rows {
                     w.write(row).unwrap();
@@ -223,7 +225,7 @@ mod tests {
     #[test]
     fn rows_go_out_in_full_batches_to_every_worker() {
         for workers in 1..=MAX_WORKERS {
-            let mut w = LineWriter::with_workers(std::io::sink(), &COLUMNS, csv_line, workers);
+            let mut w = LineWriter::with_workers(std::io::sink(), &COLUMNS, CSV, workers);
             let rows = rows(BATCH_ROWS);
             for batch in 1..=2 * workers {
                 rows.iter().try_for_each(|row| w.write(row)).unwrap();
@@ -258,8 +260,7 @@ mod tests {
     #[test]
     fn a_failed_write_is_the_error_and_nothing_waits() {
         for workers in 0..=MAX_WORKERS {
-            let mut w =
-                LineWriter::with_workers(Closing { room: 1000 }, &COLUMNS, csv_line, workers);
+            let mut w = LineWriter::with_workers(Closing { room: 1000 }, &COLUMNS, CSV, workers);
             let rows = rows(20 * BATCH_ROWS);
             let written: std::io::Result<()> = rows.iter().try_for_each(|row| w.write(row));
             let err = written

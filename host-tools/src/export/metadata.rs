@@ -65,25 +65,61 @@ impl LogMetadata {
                 .filter_map(|(k, v)| v.map(|v| (k.to_string(), v))),
         );
         pairs.push(("config".to_string(), self.config.join("\n")));
-        for column in columns {
-            pairs.push((
-                format!("unit.{}", column.name),
-                unit_of(column.name).to_string(),
-            ));
-        }
+        pairs.extend(units(columns));
         pairs
     }
 }
 
-/// The unit a column's name ends with.
+/// `unit.NAME` metadata pairs, the unit each column's name ends with, for
+/// every table a log or a dataset writes.
+#[must_use]
+pub fn units<R>(columns: &[super::columns::Column<R>]) -> Vec<(String, String)> {
+    columns
+        .iter()
+        .map(|c| (format!("unit.{}", c.name), unit_of(c.name).to_string()))
+        .collect()
+}
+
+/// The unit a column's name ends with; empty for counts, names and text.
 fn unit_of(name: &str) -> &'static str {
+    if name.ends_with("_per_s") {
+        return "1/s";
+    }
     match name.rsplit('_').next() {
         Some("s") => "s",
         Some("g") => "g",
         Some("dps") => "deg/s",
         Some("deg") => "deg",
         Some("mps") => "m/s",
-        _ if name == "utc" => "UTC",
+        Some("hz") => "Hz",
+        Some("m") => "m",
+        Some("utc") => "UTC",
         _ => "",
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::unit_of;
+
+    #[test]
+    fn units_come_from_the_names() {
+        let cases = [
+            ("t_s", "s"),
+            ("sigma_per_s", "1/s"),
+            ("freq_hz", "Hz"),
+            ("distance_m", "m"),
+            ("gps_speed_mps", "m/s"),
+            ("gz_dps", "deg/s"),
+            ("peak_amp_deg", "deg"),
+            ("az_g", "g"),
+            ("first_utc", "UTC"),
+            ("utc", "UTC"),
+            ("episodes", ""),
+            ("gps_fix", ""),
+        ];
+        for (name, unit) in cases {
+            assert_eq!(unit_of(name), unit, "{name}");
+        }
     }
 }

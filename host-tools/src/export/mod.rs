@@ -15,6 +15,7 @@ use columns::Column;
 use lines::LineWriter;
 pub use metadata::LogMetadata;
 pub(crate) use text::json_object;
+use text::LineFormat;
 
 use crate::events::LogEvent;
 use crate::rows::Row;
@@ -53,37 +54,122 @@ pub enum Format {
     Mcap,
 }
 
-impl Format {
-    /// The format an output file's extension names, if any.
-    #[must_use]
-    pub fn of_extension(path: &Path) -> Option<Self> {
-        let ext = path.extension()?.to_string_lossy().to_ascii_lowercase();
-        match ext.as_str() {
-            "csv" => Some(Self::Csv),
-            "jsonl" | "ndjson" => Some(Self::Jsonl),
-            "parquet" => Some(Self::Parquet),
-            "mcap" => Some(Self::Mcap),
-            _ => None,
-        }
-    }
+/// What an output file's name asks for: `run.tsv.gz` is CSV, tab
+/// separated, gzip compressed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Named {
+    /// The format.
+    pub format: Format,
+    /// Tab-separated (`.tsv`).
+    pub tab: bool,
+    /// Gzip-compressed (`.gz` after a text format).
+    pub gzip: bool,
+}
 
-    /// The format to write: `--format` if given, else the output's
-    /// extension, else CSV.
+/// The output names `decode` knows, and what each asks for.
+const NAMES: [(&str, Format, bool, bool); 12] = [
+    (".csv", Format::Csv, false, false),
+    (".csv.gz", Format::Csv, false, true),
+    (".tsv", Format::Csv, true, false),
+    (".tsv.gz", Format::Csv, true, true),
+    (".jsonl", Format::Jsonl, false, false),
+    (".jsonl.gz", Format::Jsonl, false, true),
+    (".ndjson", Format::Jsonl, false, false),
+    (".ndjson.gz", Format::Jsonl, false, true),
+    (".parquet", Format::Parquet, false, false),
+    (".pq", Format::Parquet, false, false),
+    (".mcap", Format::Mcap, false, false),
+    // Last: a longer name above wins.
+    ("", Format::Csv, false, false),
+];
+
+/// The output as `decode` writes it: format, field delimiter (CSV) and
+/// compression.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Resolved {
+    /// The format.
+    pub format: Format,
+    /// The CSV field delimiter.
+    pub delimiter: u8,
+    /// Gzip the output.
+    pub gzip: bool,
+}
+
+impl Format {
+    /// What an output file's name asks for. `Ok(None)` for a name without
+    /// an extension (`-o /dev/stdout`).
     ///
     /// # Errors
-    /// A usage error when `--format` contradicts the extension.
-    pub fn resolve(given: Option<Self>, output: Option<&Path>) -> Result<Self, CliError> {
-        let implied = output.and_then(Self::of_extension);
-        match (given, implied) {
-            (Some(g), Some(i)) if g != i => Err(CliError::Usage(format!(
-                "--format {} contradicts the output file {} (a {} name)",
-                g.name(),
-                output.map_or(String::new(), |p| p.display().to_string()),
-                i.name()
-            ))),
-            (Some(f), _) | (None, Some(f)) => Ok(f),
-            (None, None) => Ok(Self::Csv),
+    /// An extension no format has (`.json`, `.txt`, `.gpx`): the known ones.
+    pub fn of_name(path: &Path) -> Result<Option<Named>, String> {
+        let name = path
+            .file_name()
+            .map_or_else(String::new, |n| n.to_string_lossy().to_ascii_lowercase());
+        if path.extension().is_none() {
+            return Ok(None);
         }
+        NAMES
+            .iter()
+            .filter(|(ext, ..)| !ext.is_empty())
+            .find(|(ext, ..)| name.ends_with(ext))
+            .map(|&(_, format, tab, gzip)| Some(Named { format, tab, gzip }))
+            .ok_or_else(|| {
+                let known: Vec<&str> = NAMES
+                    .iter()
+                    .map(|n| n.0)
+                    .filter(|e| !e.is_empty())
+                    .collect();
+                format!(
+                    "{}: no output format has this extension; the known ones are {} (or give --format)",
+                    path.display(),
+                    known.join(" ")
+                )
+            })
+    }
+
+    /// The output to write: `--format` if given, else what the output's
+    /// name asks for, else CSV; `--delimiter` over a `.tsv` name's tab.
+    ///
+    /// # Errors
+    /// A usage error when `--format` contradicts the name, when the name's
+    /// extension is unknown and no `--format` is given, or when a
+    /// delimiter is given for a format other than CSV.
+    pub fn resolve(
+        given: Option<Self>,
+        output: Option<&Path>,
+        delimiter: Option<u8>,
+    ) -> Result<Resolved, CliError> {
+        let named = match output.map(Self::of_name).transpose() {
+            Ok(named) => named.flatten(),
+            // An explicit --format is honoured whatever the name.
+            Err(_) if given.is_some() => None,
+            Err(e) => return Err(CliError::Usage(e)),
+        };
+        let format = match (given, named) {
+            (Some(g), Some(n)) if g != n.format => {
+                return Err(CliError::Usage(format!(
+                    "--format {} contradicts the output file {} (a {} name)",
+                    g.name(),
+                    output.map_or(String::new(), |p| p.display().to_string()),
+                    n.format.name()
+                )))
+            }
+            (Some(f), _) => f,
+            (None, Some(n)) => n.format,
+            (None, None) => Self::Csv,
+        };
+        if delimiter.is_some() && format != Self::Csv {
+            return Err(CliError::Usage(format!(
+                "--delimiter is for CSV, not {}",
+                format.name()
+            )));
+        }
+        let tab = named.is_some_and(|n| n.tab);
+        Ok(Resolved {
+            format,
+            delimiter: delimiter.unwrap_or(if tab { b'\t' } else { b',' }),
+            gzip: named.is_some_and(|n| n.gzip),
+        })
     }
 
     /// The name as `--format` takes it.
@@ -96,6 +182,26 @@ impl Format {
             Self::Mcap => "mcap",
         }
     }
+}
+
+/// Parses `--delimiter`: one ASCII character, or `tab` / `\t`.
+///
+/// # Errors
+/// Anything else, or a character CSV cannot delimit with (a quote, a line
+/// break).
+pub fn parse_delimiter(text: &str) -> Result<u8, String> {
+    let byte = match text {
+        "tab" | "\\t" | "\t" => b'\t',
+        _ if text.len() == 1 && text.is_ascii() => text.as_bytes()[0],
+        _ => return Err(format!("{text:?} is not one ASCII character (or `tab`)")),
+    };
+    // Nor a character of a number or a UTC time: cells are not quoted.
+    if matches!(byte, b'"' | b'\n' | b'\r' | b'.' | b'-' | b'+' | b':')
+        || byte.is_ascii_alphanumeric()
+    {
+        return Err(format!("{text:?} cannot delimit CSV fields"));
+    }
+    Ok(byte)
 }
 
 /// Writes rows in one format.
@@ -116,16 +222,18 @@ enum Sink<W: Write + Send> {
 }
 
 impl<W: Write + Send> RowWriter<W> {
-    /// A writer of `columns`. Nothing is written until the first row or
-    /// [`Self::finish`], so a log that cannot be read leaves no half output.
-    pub fn new(format: Format, columns: Vec<Column>, out: W) -> Self {
+    /// A writer of `columns`, CSV fields separated by `delimiter`. Nothing
+    /// is written until the first row or [`Self::finish`], so a log that
+    /// cannot be read leaves no half output.
+    pub fn new(format: Format, columns: Vec<Column>, delimiter: u8, out: W) -> Self {
         let sink = match format {
             Format::Csv => {
                 let names: Vec<&str> = columns.iter().map(|c| c.name).collect();
-                let header = format!("{}\n", names.join(","));
-                Sink::Lines(LineWriter::new(out, &columns, text::csv_line), Some(header))
+                let header = format!("{}\n", names.join(&char::from(delimiter).to_string()));
+                let line = LineFormat::Csv { delimiter };
+                Sink::Lines(LineWriter::new(out, &columns, line), Some(header))
             }
-            Format::Jsonl => Sink::Lines(LineWriter::new(out, &columns, text::json_line), None),
+            Format::Jsonl => Sink::Lines(LineWriter::new(out, &columns, LineFormat::Json), None),
             Format::Parquet => Sink::Parquet(parquet::ParquetWriter::new(out, &columns)),
             Format::Mcap => Sink::Mcap(None, Some(out)),
         };
@@ -212,22 +320,59 @@ mod tests {
     }
 
     #[test]
-    fn format_follows_the_extension_and_refuses_contradictions() {
-        fn p(s: &str) -> Option<&Path> {
-            Some(Path::new(s))
+    fn format_follows_the_name_and_refuses_contradictions_and_unknown_names() {
+        fn r(given: Option<Format>, name: &str) -> Result<Resolved, CliError> {
+            Format::resolve(given, Some(Path::new(name)), None)
+        }
+        let plain = |format, delimiter, gzip| Resolved {
+            format,
+            delimiter,
+            gzip,
+        };
+        assert_eq!(
+            r(None, "a.parquet").unwrap(),
+            plain(Format::Parquet, b',', false)
+        );
+        assert_eq!(r(None, "a.pq").unwrap().format, Format::Parquet);
+        assert_eq!(r(None, "a.JSONL").unwrap().format, Format::Jsonl);
+        assert_eq!(r(None, "a.tsv").unwrap(), plain(Format::Csv, b'\t', false));
+        assert_eq!(
+            r(None, "run.1.csv.gz").unwrap(),
+            plain(Format::Csv, b',', true)
+        );
+        assert_eq!(
+            r(None, "a.ndjson.gz").unwrap(),
+            plain(Format::Jsonl, b',', true)
+        );
+        assert_eq!(r(None, "a").unwrap().format, Format::Csv);
+        assert_eq!(
+            Format::resolve(None, None, None).unwrap().format,
+            Format::Csv
+        );
+        for unknown in ["a.txt", "a.json", "a.gpx", "a.gz", "a.parquet.gz"] {
+            assert_eq!(r(None, unknown).unwrap_err().exit_code(), 2, "{unknown}");
         }
         assert_eq!(
-            Format::resolve(None, p("a.parquet")).unwrap(),
-            Format::Parquet
-        );
-        assert_eq!(Format::resolve(None, p("a.JSONL")).unwrap(), Format::Jsonl);
-        assert_eq!(Format::resolve(None, p("a.txt")).unwrap(), Format::Csv);
-        assert_eq!(Format::resolve(None, None).unwrap(), Format::Csv);
-        assert_eq!(
-            Format::resolve(Some(Format::Jsonl), p("a.txt")).unwrap(),
+            r(Some(Format::Jsonl), "a.txt").unwrap().format,
             Format::Jsonl
         );
-        let err = Format::resolve(Some(Format::Csv), p("a.parquet")).unwrap_err();
-        assert_eq!(err.exit_code(), 2);
+        assert_eq!(
+            r(Some(Format::Csv), "a.parquet").unwrap_err().exit_code(),
+            2
+        );
+        let semicolon = Format::resolve(None, Some(Path::new("a.tsv")), Some(b';')).unwrap();
+        assert_eq!(semicolon.delimiter, b';');
+        let parquet = Format::resolve(None, Some(Path::new("a.pq")), Some(b';'));
+        assert_eq!(parquet.unwrap_err().exit_code(), 2);
+    }
+
+    #[test]
+    fn delimiters_are_one_safe_character() {
+        assert_eq!(parse_delimiter(";"), Ok(b';'));
+        assert_eq!(parse_delimiter("tab"), Ok(b'\t'));
+        assert_eq!(parse_delimiter("\t"), Ok(b'\t'));
+        for bad in ["", ";;", "\"", "a", "1", ".", "-", ":", "é"] {
+            assert!(parse_delimiter(bad).is_err(), "{bad:?}");
+        }
     }
 }

@@ -7,7 +7,7 @@ use std::io::Write;
 use std::sync::Arc;
 
 use parquet::basic::Compression;
-use parquet::data_type::{ByteArray, ByteArrayType, DoubleType, Int64Type};
+use parquet::data_type::{BoolType, ByteArray, ByteArrayType, DoubleType, Int64Type};
 use parquet::errors::ParquetError;
 use parquet::file::metadata::KeyValue;
 use parquet::file::properties::WriterProperties;
@@ -42,6 +42,7 @@ enum Buffer {
     Utc(Vec<i64>, Vec<i16>),
     Integer(Vec<i64>, Vec<i16>),
     Text(Vec<ByteArray>, Vec<i16>),
+    Bool(Vec<bool>, Vec<i16>),
 }
 
 enum State<W: Write + Send> {
@@ -63,6 +64,7 @@ impl<W: Write + Send, R> ParquetWriter<W, R> {
                 Kind::Utc => Buffer::Utc(Vec::new(), Vec::new()),
                 Kind::Integer => Buffer::Integer(Vec::new(), Vec::new()),
                 Kind::Text => Buffer::Text(Vec::new(), Vec::new()),
+                Kind::Bool => Buffer::Bool(Vec::new(), Vec::new()),
             })
             .collect();
         Self {
@@ -82,6 +84,7 @@ impl<W: Write + Send, R> ParquetWriter<W, R> {
                 Kind::OptNumber => "OPTIONAL DOUBLE",
                 Kind::Label | Kind::Text => "OPTIONAL BYTE_ARRAY",
                 Kind::Utc | Kind::Integer => "OPTIONAL INT64",
+                Kind::Bool => "OPTIONAL BOOLEAN",
             };
             let annotation = match c.kind {
                 Kind::Label | Kind::Text => " (UTF8)",
@@ -157,6 +160,10 @@ impl<W: Write + Send, R> ParquetWriter<W, R> {
                     levels.push(i16::from(v.is_some()));
                     values.extend(v.map(|s| ByteArray::from(s.into_bytes())));
                 }
+                (Buffer::Bool(values, levels), Value::Bool(v)) => {
+                    levels.push(i16::from(v.is_some()));
+                    values.extend(v);
+                }
                 _ => {
                     return Err(ParquetError::General(format!(
                         "{}: value of the wrong type",
@@ -185,6 +192,7 @@ impl<W: Write + Send, R> ParquetWriter<W, R> {
                 Buffer::Utc(v, l) => Buffer::Utc(std::mem::take(v), std::mem::take(l)),
                 Buffer::Integer(v, l) => Buffer::Integer(std::mem::take(v), std::mem::take(l)),
                 Buffer::Text(v, l) => Buffer::Text(std::mem::take(v), std::mem::take(l)),
+                Buffer::Bool(v, l) => Buffer::Bool(std::mem::take(v), std::mem::take(l)),
             })
             .collect();
         let file = self.file()?;
@@ -208,6 +216,11 @@ impl<W: Write + Send, R> ParquetWriter<W, R> {
                 Buffer::Utc(values, levels) | Buffer::Integer(values, levels) => {
                     column
                         .typed::<Int64Type>()
+                        .write_batch(values, Some(levels), None)?;
+                }
+                Buffer::Bool(values, levels) => {
+                    column
+                        .typed::<BoolType>()
                         .write_batch(values, Some(levels), None)?;
                 }
             }

@@ -10,28 +10,59 @@
 use super::columns::{Column, Value};
 use crate::rows::Row;
 
+/// How rows become lines of text.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LineFormat {
+    /// CSV records with this field delimiter.
+    Csv {
+        /// The field delimiter.
+        delimiter: u8,
+    },
+    /// JSON objects, `null` for an absent value.
+    Json,
+}
+
+impl LineFormat {
+    /// Appends the line of `row`'s `columns` to `line`.
+    pub fn line(self, line: &mut String, columns: &[Column], row: &Row) {
+        match self {
+            Self::Csv { delimiter } => csv_record(line, columns, row, delimiter),
+            Self::Json => json_line(line, columns, row),
+        }
+    }
+}
+
 /// Appends the CSV record of `row`'s `columns` to `line`, `\n` ended, as
 /// the `csv` writer's default settings write it.
+#[cfg(test)]
 pub fn csv_line<R>(line: &mut String, columns: &[Column<R>], row: &R) {
+    csv_record(line, columns, row, b',');
+}
+
+/// [`csv_line`] with fields separated by `delimiter`.
+fn csv_record<R>(line: &mut String, columns: &[Column<R>], row: &R, delimiter: u8) {
+    let delimiter = char::from(delimiter);
     let mut num = zmij::Buffer::new();
     let mut int = itoa::Buffer::new();
     let mut time = [0u8; UTC_LEN];
     let start = line.len();
     for (i, column) in columns.iter().enumerate() {
         if i > 0 {
-            line.push(',');
+            line.push(delimiter);
         }
         match (column.value)(row) {
             Value::Number(Some(v)) => line.push_str(num.format(v)),
-            Value::Label(Some(s)) => push_csv_text(line, s),
+            Value::Label(Some(s)) => push_csv_text(line, s, delimiter),
             Value::Utc(Some(us)) => line.push_str(utc_text(us, &mut time)),
             Value::Integer(Some(n)) => line.push_str(int.format(n)),
-            Value::Text(Some(s)) => push_csv_text(line, &s),
+            Value::Text(Some(s)) => push_csv_text(line, &s, delimiter),
+            Value::Bool(Some(b)) => line.push_str(if b { "true" } else { "false" }),
             Value::Number(None)
             | Value::Label(None)
             | Value::Utc(None)
             | Value::Integer(None)
-            | Value::Text(None) => {}
+            | Value::Text(None)
+            | Value::Bool(None) => {}
         }
     }
     // A record of one empty cell would read back as a blank line: the
@@ -42,10 +73,10 @@ pub fn csv_line<R>(line: &mut String, columns: &[Column<R>], row: &R) {
     line.push('\n');
 }
 
-/// `s` as a CSV cell: in quotes, with quotes doubled, if it holds a comma,
-/// a quote or a line break (the `csv` writer's "necessary" style).
-fn push_csv_text(line: &mut String, s: &str) {
-    if s.contains([',', '"', '\r', '\n']) {
+/// `s` as a CSV cell: in quotes, with quotes doubled, if it holds the
+/// delimiter, a quote or a line break (the `csv` writer's "necessary" style).
+fn push_csv_text(line: &mut String, s: &str, delimiter: char) {
+    if s.contains([delimiter, '"', '\r', '\n']) {
         line.push('"');
         line.push_str(&s.replace('"', "\"\""));
         line.push('"');
@@ -55,11 +86,18 @@ fn push_csv_text(line: &mut String, s: &str) {
 }
 
 /// Appends the JSON object of `row`'s `columns` to `line`; absent values
-/// are left out. Written by hand: every key is a plain column name and
+/// are left out (MCAP messages). Written by hand: every key is a plain column name and
 /// every string value a fixed name, an ISO time or a file name (escaped by
 /// serde), and nothing is allocated per number (the one-hour export is
 /// benchmarked).
 pub fn json_object(line: &mut String, columns: &[Column], row: &Row) {
+    json_fields(line, columns, row, false);
+}
+
+/// [`json_object`], absent values as `null` when `nulls` (every line of
+/// JSON lines has every key, so readers that infer a schema from the first
+/// lines see the columns a ride without an early GPS fix has).
+fn json_fields(line: &mut String, columns: &[Column], row: &Row, nulls: bool) {
     let mut num = zmij::Buffer::new();
     let mut int = itoa::Buffer::new();
     let mut time = [0u8; UTC_LEN];
@@ -72,8 +110,9 @@ pub fn json_object(line: &mut String, columns: &[Column], row: &Row) {
             Value::Label(v) => v.is_some(),
             Value::Utc(v) | Value::Integer(v) => v.is_some(),
             Value::Text(v) => v.is_some(),
+            Value::Bool(v) => v.is_some(),
         };
-        if !is_some {
+        if !is_some && !nulls {
             continue;
         }
         if line.len() > start + 1 {
@@ -99,15 +138,16 @@ pub fn json_object(line: &mut String, columns: &[Column], row: &Row) {
                 // Serialising a string cannot fail.
                 line.push_str(&serde_json::Value::String(s).to_string());
             }
-            _ => {}
+            Value::Bool(Some(b)) => line.push_str(if b { "true" } else { "false" }),
+            _ => line.push_str("null"),
         }
     }
     line.push('}');
 }
 
-/// A JSON object per line.
+/// A JSON object per line, `null` for an absent value.
 pub fn json_line(line: &mut String, columns: &[Column], row: &Row) {
-    json_object(line, columns, row);
+    json_fields(line, columns, row, true);
     line.push('\n');
 }
 
@@ -191,6 +231,7 @@ mod tests {
                 Value::Utc(us) => us.map(|us| utc_text(us, &mut time).to_owned()),
                 Value::Integer(n) => n.map(|n| n.to_string()),
                 Value::Text(s) => s,
+                Value::Bool(b) => b.map(|b| b.to_string()),
             };
             w.write_field(cell.unwrap_or_default()).unwrap();
         }
@@ -302,17 +343,19 @@ mod tests {
             let parsed: serde_json::Map<String, serde_json::Value> =
                 serde_json::from_str(&line).map_err(|e| TestCaseError::fail(format!("{e}: {line}")))?;
             let mut time = [0u8; UTC_LEN];
-            let mut present = 0;
             for column in &columns {
+                // Every key is there; an absent value is `null`.
                 let cell = parsed.get(column.name);
+                prop_assert!(cell.is_some(), "{} left out", column.name);
+                let cell = cell.filter(|v| !v.is_null());
                 let expected = match (column.value)(&row) {
                     Value::Number(v) => v.map(serde_json::Value::from),
                     Value::Label(s) => s.map(serde_json::Value::from),
                     Value::Utc(us) => us.map(|us| utc_text(us, &mut time).into()),
                     Value::Integer(n) => n.map(serde_json::Value::from),
                     Value::Text(s) => s.map(serde_json::Value::from),
+                    Value::Bool(b) => b.map(serde_json::Value::from),
                 };
-                present += usize::from(expected.is_some());
                 // serde_json reads a number to within an ulp, not to the bit.
                 let near = |a: &serde_json::Value, b: &serde_json::Value| match (a.as_f64(), b.as_f64()) {
                     (Some(x), Some(y)) if a.is_f64() => (x - y).abs() <= 1e-15 * y.abs(),
@@ -323,7 +366,7 @@ mod tests {
                     "{}: {:?} for {:?}", column.name, cell, expected
                 );
             }
-            prop_assert_eq!(parsed.len(), present);
+            prop_assert_eq!(parsed.len(), columns.len());
         }
     }
 }

@@ -418,3 +418,29 @@ pub fn assert_same_episode(a: &Episode, b: &Episode) {
         (b.cut_at_start, b.cut_at_end)
     );
 }
+
+/// Runs the Python `script` with `args` and parses what it prints as JSON:
+/// outputs read back by the tools researchers use (Polars, pyarrow,
+/// pandas, DuckDB, gpxpy). `None` when a package is missing outside CI;
+/// under CI (`CI=true`) a missing package fails the test, so a green run
+/// never hides a skipped check (`hil-tests/install-tools.sh` installs them).
+pub fn python(script: &str, args: &[&std::ffi::OsStr]) -> Option<serde_json::Value> {
+    let out = std::process::Command::new("python3")
+        .arg("-c")
+        .arg(script)
+        .args(args)
+        .output()
+        .expect("python3 runs");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    if let Some(at) = stderr.find("No module named") {
+        let missing = stderr[at..].lines().next().unwrap_or_default();
+        assert!(
+            std::env::var("CI").as_deref() != Ok("true"),
+            "{missing}: hil-tests/install-tools.sh installs the Python packages the tests read outputs with"
+        );
+        eprintln!("SKIPPED: {missing} (hil-tests/install-tools.sh installs it)");
+        return None;
+    }
+    assert!(out.status.success(), "{stderr}");
+    Some(serde_json::from_slice(&out.stdout).expect("the script prints JSON"))
+}

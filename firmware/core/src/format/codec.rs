@@ -349,6 +349,13 @@ impl<'a> Records<'a> {
         }
     }
 
+    /// Payload bytes read so far: where the next record (or an unknown one
+    /// skipped before it) starts.
+    #[must_use]
+    pub fn offset(&self) -> usize {
+        self.pos
+    }
+
     /// Length-prefixed records of unknown kinds skipped so far.
     #[must_use]
     pub fn skipped_unknown(&self) -> u32 {

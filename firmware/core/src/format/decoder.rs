@@ -8,17 +8,19 @@
 //! sequence numbers give the blocks, the frame counters give the frames, the
 //! time bases give the time span. Memory use is fixed; the caller feeds
 //! chunks of any size.
+//!
+//! A valid block is decoded unless it is a copy of one decoded shortly
+//! before (or an earlier flush of one): blocks are told apart by content
+//! ([`super::recent`]), never by sequence number alone. [`Decoder::feed`]
+//! decodes in file order; a reader that can seek decodes in sequence
+//! order instead: [`Decoder::scan`] finds the valid blocks and the skipped
+//! bytes, then [`Decoder::decode_block`] takes the blocks in order.
 
-use super::block::{Block, BlockError, BlockHeader, BLOCK_LEN, MAGIC};
+use super::block::{Block, BlockError, BlockHeader, BLOCK_LEN, MAGIC, PAYLOAD_LEN};
 use super::codec::{RecordError, Records};
 use super::limits::DEFAULT_SAMPLE_RATE_HZ;
+use super::recent::{Recent, Seen};
 use super::record::Record;
-
-/// A block at most this many numbers behind the last one decoded, out of
-/// its place, is a repeat or a stale copy. One much further behind means the
-/// earlier block was the odd one (a crafted or stray block numbered high),
-/// so it is decoded: a bad block in front can hide at most this many.
-pub const REPEAT_WINDOW_BLOCKS: u32 = 64;
 
 /// A forward step between frames longer than the frames known to be
 /// missing explain, by more than this, is a time jump (µs).
@@ -54,8 +56,8 @@ pub enum SkipCause {
     Garbage,
     /// The file ends inside a block.
     TruncatedTail,
-    /// A valid block that repeats or predates one already decoded, out of
-    /// its place in the file: its records were already counted, or are stale.
+    /// A valid block that is a copy of one already decoded, or an earlier
+    /// flush of one: its records were decoded once.
     Repeated,
 }
 
@@ -141,16 +143,20 @@ pub struct DecodeStats {
     pub time_jumps: u64,
     /// Frames whose time went forwards by more than missing frames explain.
     pub forward_time_jumps: u64,
-    /// Blocks whose sequence number did not follow (stale or reordered data).
+    /// Blocks whose sequence number did not follow the highest one before
+    /// them (reordered or copied data, or two blocks with one number).
     pub out_of_order_blocks: u64,
-    /// Of those, blocks skipped as repeats or stale copies (out of their
-    /// place in the file and not after the last block decoded).
+    /// Of those, copies of a decoded block (or earlier flushes of one),
+    /// skipped: their records were decoded once.
     pub repeated_blocks: u64,
+    /// Flushed blocks met again in a fuller version: the new records were
+    /// decoded, the block counted once.
+    pub rewritten_blocks: u64,
     /// Values the firmware cannot have written, dropped or replaced.
     pub out_of_range: u64,
 }
 
-/// What the decoder remembers of the last valid block.
+/// What the decoder remembers of the valid block numbered highest so far.
 #[derive(Clone, Copy, Debug)]
 struct Last {
     seq: u32,
@@ -174,6 +180,19 @@ pub struct Decoder {
     /// its first byte's stream offset and why. Reported once it ends, so
     /// one damaged stretch is one event whatever the chunks.
     open_skip: Option<(u64, SkipCause)>,
+    /// The blocks decoded last, to recognise copies and rewrites.
+    recent: Recent,
+}
+
+/// What [`Decoder::decode_block`] did with a block.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Outcome {
+    /// Its records were decoded (all of them, or those a flushed version
+    /// of it did not hold).
+    Decoded,
+    /// A copy of a block decoded already: nothing was decoded. The caller
+    /// reports its bytes ([`Decoder::skipped`]) as [`SkipCause::Repeated`].
+    Repeated,
 }
 
 impl Decoder {
@@ -191,14 +210,85 @@ impl Decoder {
     }
 
     /// Decodes what it can of `chunk`, the bytes of the stream from the first
-    /// byte not yet consumed. Returns how many bytes it consumed; the caller
-    /// passes the rest again, followed by more data. With `at_end` the chunk
-    /// is the end of the stream and everything is consumed.
+    /// byte not yet consumed, in file order. Returns how many bytes it
+    /// consumed; the caller passes the rest again, followed by more data.
+    /// With `at_end` the chunk is the end of the stream and everything is
+    /// consumed.
     pub fn feed<'c>(
         &mut self,
         chunk: &'c [u8],
         at_end: bool,
         visit: &mut impl FnMut(Event<'c>),
+    ) -> usize {
+        self.walk(chunk, at_end, visit, &mut |dec, _, header, block| {
+            Some(dec.recent.see(header, header.payload(block)))
+        })
+    }
+
+    /// The first pass of a decode in sequence order: finds the valid blocks
+    /// of `chunk` (passed to `found` with their stream offsets) and reports
+    /// and counts the bytes between them, without decoding any block.
+    /// Consumes like [`Self::feed`].
+    pub fn scan<'c>(
+        &mut self,
+        chunk: &'c [u8],
+        at_end: bool,
+        visit: &mut impl FnMut(Event<'c>),
+        found: &mut impl FnMut(u64, &BlockHeader),
+    ) -> usize {
+        self.walk(chunk, at_end, visit, &mut |_, offset, header, _| {
+            found(offset, header);
+            None
+        })
+    }
+
+    /// Decodes one valid block (at stream offset `offset`, for messages),
+    /// after the ones decoded before it: the second pass of a decode in
+    /// sequence order. A block that is not valid is reported as skipped.
+    pub fn decode_block<'b>(
+        &mut self,
+        offset: u64,
+        block: &'b Block,
+        visit: &mut impl FnMut(Event<'b>),
+    ) -> Outcome {
+        match BlockHeader::parse(block) {
+            Ok(header) => {
+                let seen = self.recent.see(&header, header.payload(block));
+                self.block(&header, block, seen, visit);
+                if seen == Seen::Repeat {
+                    Outcome::Repeated
+                } else {
+                    Outcome::Decoded
+                }
+            }
+            Err(err) => {
+                self.skipped(offset, BLOCK_LEN as u64, cause_of(err), visit);
+                Outcome::Decoded
+            }
+        }
+    }
+
+    /// Reports and counts `len` bytes from `offset` skipped for `cause`.
+    pub fn skipped<'c>(
+        &mut self,
+        offset: u64,
+        len: u64,
+        cause: SkipCause,
+        visit: &mut impl FnMut(Event<'c>),
+    ) {
+        self.stats.bytes_skipped += len;
+        visit(Event::Skipped { offset, len, cause });
+    }
+
+    /// Finds the valid blocks of `chunk`, hands each to `on_block` (which
+    /// says what it is to the blocks before it, if it is to be decoded),
+    /// decodes those, and reports the bytes between them (repeats included).
+    fn walk<'c>(
+        &mut self,
+        chunk: &'c [u8],
+        at_end: bool,
+        visit: &mut impl FnMut(Event<'c>),
+        on_block: &mut impl FnMut(&mut Self, u64, &BlockHeader, &'c Block) -> Option<Seen>,
     ) -> usize {
         let mut pos = 0;
         // A stretch of bytes being skipped (from this stream offset),
@@ -209,18 +299,19 @@ impl Decoder {
         while chunk.len() - pos >= BLOCK_LEN {
             let block = as_block(&chunk[pos..]);
             match BlockHeader::parse(block) {
-                Ok(header) if self.is_repeat(&header, pos) => {
-                    self.stats.out_of_order_blocks += 1;
-                    self.stats.repeated_blocks += 1;
-                    if skip.is_some_and(|(_, c)| c != SkipCause::Repeated) {
+                Ok(header) => {
+                    let seen = on_block(self, at(pos), &header, block);
+                    if seen == Some(Seen::Repeat) {
+                        if skip.is_some_and(|(_, c)| c != SkipCause::Repeated) {
+                            self.flush_skip(&mut skip, chunk, pos, visit);
+                        }
+                        skip.get_or_insert((at(pos), SkipCause::Repeated));
+                    } else {
                         self.flush_skip(&mut skip, chunk, pos, visit);
                     }
-                    skip.get_or_insert((at(pos), SkipCause::Repeated));
-                    pos += BLOCK_LEN;
-                }
-                Ok(header) => {
-                    self.flush_skip(&mut skip, chunk, pos, visit);
-                    self.block(&header, block, visit);
+                    if let Some(seen) = seen {
+                        self.block(&header, block, seen, visit);
+                    }
                     pos += BLOCK_LEN;
                 }
                 Err(err) => {
@@ -238,6 +329,9 @@ impl Decoder {
             }
         }
         if at_end && pos < chunk.len() {
+            if skip.is_some_and(|(_, c)| c == SkipCause::Repeated) {
+                self.flush_skip(&mut skip, chunk, pos, visit);
+            }
             skip.get_or_insert((at(pos), SkipCause::TruncatedTail));
             pos = chunk.len();
         }
@@ -272,22 +366,49 @@ impl Decoder {
         });
     }
 
+    /// Decodes a valid block `seen` relates so to the blocks before it:
+    /// a repeat is only counted, a fuller rewrite gives only the records
+    /// its flushed version did not hold.
     fn block<'c>(
         &mut self,
         header: &BlockHeader,
         block: &'c Block,
+        seen: Seen,
         visit: &mut impl FnMut(Event<'c>),
     ) {
-        self.stats.blocks += 1;
-        self.account_gap(header, visit);
+        let decoded_len = match seen {
+            Seen::Repeat => {
+                self.stats.out_of_order_blocks += 1;
+                self.stats.repeated_blocks += 1;
+                return;
+            }
+            Seen::New => {
+                self.stats.blocks += 1;
+                self.account_gap(header, visit);
+                0
+            }
+            Seen::Fuller { decoded_len } => {
+                self.stats.rewritten_blocks += 1;
+                decoded_len
+            }
+        };
+        let payload = header.payload(block);
         let mut frames = 0u32;
-        let mut records = Records::new(header.payload(block), header.t0_us);
-        for item in records.by_ref() {
+        let mut records = Records::new(payload, header.t0_us);
+        loop {
+            let old = records.offset() < decoded_len;
+            let Some(item) = records.next() else { break };
+            if let Ok(Record::Frame(_)) = item {
+                frames += 1;
+            }
+            if old {
+                continue;
+            }
             match item {
                 Ok(mut record) => {
                     self.stats.records += 1;
                     if let Record::Frame(f) = &record {
-                        frames += 1;
+                        self.stats.frames += 1;
                         self.check_time(f.t_us, visit);
                     }
                     if !self.check_values(header.seq, &mut record, visit) {
@@ -304,25 +425,19 @@ impl Decoder {
                 }
             }
         }
-        self.stats.frames += u64::from(frames);
-        self.stats.unknown_records += u64::from(records.skipped_unknown());
-        self.last = Some(Last {
-            seq: header.seq,
-            frames_end: header.first_frame.wrapping_add(frames),
-        });
-    }
-
-    /// Whether a valid block at `pos` in the current chunk repeats or
-    /// predates what was decoded: not after the last block (and within
-    /// [`REPEAT_WINDOW_BLOCKS`] of it), and not at its own place in the file
-    /// (block `seq` sits at `seq` x 512; one there is always decoded).
-    fn is_repeat(&self, header: &BlockHeader, pos: usize) -> bool {
-        let at = self.offset + pos as u64;
-        let in_place = u64::from(header.seq) * BLOCK_LEN as u64 == at;
-        !in_place
-            && self.last.is_some_and(|last| {
-                header.seq <= last.seq && last.seq - header.seq < REPEAT_WINDOW_BLOCKS
-            })
+        let mut prefix = Records::new(&payload[..decoded_len.min(payload.len())], header.t0_us);
+        prefix.by_ref().for_each(drop);
+        self.stats.unknown_records += u64::from(
+            records
+                .skipped_unknown()
+                .saturating_sub(prefix.skipped_unknown()),
+        );
+        if self.last.is_none_or(|last| header.seq >= last.seq) {
+            self.last = Some(Last {
+                seq: header.seq,
+                frames_end: header.first_frame.wrapping_add(frames),
+            });
+        }
     }
 
     /// Reports a frame at `t_us` that jumps back, or forward by more than
@@ -432,20 +547,30 @@ fn cause_of(err: BlockError) -> SkipCause {
     }
 }
 
-/// Position of the next sync marker at or after `from`, or the point from
-/// which fewer than a block's bytes remain (the caller then needs more data).
+/// Position of the next sync marker at or after `from` that can start a
+/// block, or the point from which fewer than a block's bytes remain (the
+/// caller then needs more data).
+///
+/// A marker whose payload length field exceeds the payload area cannot
+/// start a valid block whatever its CRC, so it is passed over without
+/// one: a stretch of back-to-back markers costs a memchr search, not a
+/// CRC per marker.
 fn next_marker(chunk: &[u8], from: usize) -> usize {
     let limit = chunk.len().saturating_sub(BLOCK_LEN - 1);
-    if from >= limit {
-        return limit.max(from.min(chunk.len()));
+    let mut from = from;
+    while from < limit {
+        let window = &chunk[from..limit + MAGIC.len() - 1];
+        let Some(i) = memchr::memmem::find(window, &MAGIC) else {
+            return limit;
+        };
+        let at = from + i;
+        let len = u16::from_le_bytes([chunk[at + 6], chunk[at + 7]]);
+        if usize::from(len) <= PAYLOAD_LEN {
+            return at;
+        }
+        from = at + 1;
     }
-    // The marker's first byte is rare in records; memchr-like scanning on it
-    // keeps resynchronisation fast through long garbage.
-    let window = &chunk[from..limit + MAGIC.len() - 1];
-    window
-        .windows(MAGIC.len())
-        .position(|w| w == MAGIC)
-        .map_or(limit, |i| from + i)
+    limit.max(from.min(chunk.len()))
 }
 
 fn as_block(bytes: &[u8]) -> &Block {

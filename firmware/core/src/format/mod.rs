@@ -7,11 +7,12 @@ pub mod decoder;
 pub mod encoder;
 pub mod header;
 pub mod limits;
+pub mod recent;
 pub mod record;
 mod varint;
 
 pub use block::{Block, BlockError, BlockHeader, BLOCK_LEN};
 pub use codec::{EncodeError, RecordError, Records};
-pub use decoder::{DecodeStats, Decoder, Event, Gap, OutOfRange, SkipCause};
+pub use decoder::{DecodeStats, Decoder, Event, Gap, OutOfRange, Outcome, SkipCause};
 pub use encoder::BlockEncoder;
 pub use record::*;

@@ -26,6 +26,15 @@ use wobble_model::ParamSet;
 /// over 2.5-8 m/s, with no steer-rate gain (which would damp or feed the
 /// wobble through the lag). `tests` check the result on both bicycles.
 pub const GAINS: [f64; 4] = [12.5, 2.0, -13.0, 0.0];
+/// Below [`LOW_SPEED_MPS`] the rider balances harder on roll and steer
+/// (found likewise, for 1.9-2.4 m/s, where [`GAINS`] let the bicycle
+/// fall): the wobble's growth rate moves by less than 0.01/s and its
+/// frequency by less than 0.02 Hz.
+pub const LOW_SPEED_GAINS: [f64; 4] = [25.0, 0.0, -14.0, 0.0];
+/// See [`LOW_SPEED_GAINS`], m/s.
+pub const LOW_SPEED_MPS: f64 = 2.4;
+/// The slowest speed the rider balances at, m/s.
+pub const MIN_BALANCED_MPS: f64 = 1.9;
 /// The rider's lag, s.
 pub const RIDER_LAG_S: f64 = 0.1;
 /// The rider's active posture: hip stiffness and damping added to the
@@ -116,11 +125,15 @@ impl Bike {
     /// # Errors
     /// The file does not load.
     pub fn new(name: &str, step_s: f64) -> Result<Self, String> {
-        let path = Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("../host-tools/bicycle-model/params")
-            .join(name);
-        let set = ParamSet::load(&path).map_err(|e| e.to_string())?;
-        let model = WobbleModel::from_set(&set).map_err(|e| e.to_string())?;
+        Self::from_set(&load_params(name)?, step_s)
+    }
+
+    /// The bicycle of a parameter set, sampled every `step_s`.
+    ///
+    /// # Errors
+    /// The set is not a wobble model.
+    pub fn from_set(set: &ParamSet, step_s: f64) -> Result<Self, String> {
+        let model = WobbleModel::from_set(set).map_err(|e| e.to_string())?;
         Ok(Self {
             gains: GAINS,
             posture: POSTURE,
@@ -171,7 +184,12 @@ impl Bike {
         // The rider's torque drives the steer; it follows the command with
         // the rider's lag.
         a.view_mut((0, n), (n, 1)).copy_from(&torque);
-        for (k, name) in self.gains.iter().zip(["phi", "dphi", "delta", "ddelta"]) {
+        let gains = if u < LOW_SPEED_MPS {
+            LOW_SPEED_GAINS
+        } else {
+            self.gains
+        };
+        for (k, name) in gains.iter().zip(["phi", "dphi", "delta", "ddelta"]) {
             a[(n, state(name))] = k / RIDER_LAG_S;
         }
         a[(n, n)] = -1.0 / RIDER_LAG_S;
@@ -214,6 +232,17 @@ impl Bike {
         self.modes.insert(key, found.clone());
         found
     }
+}
+
+/// The parameter file `name` of the model crate's `params/`.
+///
+/// # Errors
+/// The file does not load.
+pub fn load_params(name: &str) -> Result<ParamSet, String> {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../host-tools/bicycle-model/params")
+        .join(name);
+    ParamSet::load(&path).map_err(|e| e.to_string())
 }
 
 fn wobble_of(a: &DMatrix<f64>) -> Option<WobbleMode> {
@@ -300,6 +329,35 @@ mod tests {
                     assert!(ev.re < 0.5, "{file} at {u} m/s, gripping: {ev}");
                 }
             }
+        }
+    }
+
+    /// Down to the slowest balanced speed the rider's harder low-speed
+    /// gains keep every mode but the wobble decaying, and the wobble where
+    /// the usual gains have it.
+    #[test]
+    fn the_rider_balances_slowly_too() {
+        let mut bike = Bike::new("test-bicycle.toml", 0.01).unwrap();
+        let mut u = MIN_BALANCED_MPS;
+        while u < LOW_SPEED_MPS {
+            let (a, _) = bike.matrices(u, false);
+            let wobble = bike.wobble(u, false).unwrap().value;
+            for ev in wobble_model::eig::eigenvalues(&a).unwrap() {
+                if (ev - wobble).norm() > 1e-6 && (ev - wobble.conj()).norm() > 1e-6 {
+                    assert!(ev.re < -0.05, "at {u} m/s: {ev}");
+                }
+            }
+            // The usual gains at this speed (they would let it fall).
+            let mut usual = a.clone();
+            for (k, name) in GAINS.iter().zip(["phi", "dphi", "delta", "ddelta"]) {
+                usual[(STATES.len(), state(name))] = k / RIDER_LAG_S;
+            }
+            let other = wobble_of(&usual).unwrap().value;
+            assert!(
+                (other.re - wobble.re).abs() < 0.01 && (other.im - wobble.im).abs() < 0.1,
+                "at {u} m/s: {other} vs {wobble}"
+            );
+            u += 0.1;
         }
     }
 }

@@ -32,6 +32,7 @@ fn through(
             "speeds up from {from} to {to} m/s through the wobble speed; grips the bar at {grip_deg} deg and brakes"
         ),
         bike: TEST_BIKE,
+        changes: Vec::new(),
         seed,
         duration_s: 45.0,
         road,
@@ -39,6 +40,8 @@ fn through(
         grip_at_deg: Some((grip_deg, from)),
         rider_nm: RIDER_NM,
         kicks: Vec::new(),
+        kick_s: super::KICK_S,
+        ripple_deg: 0.0,
         committed,
     }
 }
@@ -64,6 +67,7 @@ fn below(
         name: name.into(),
         description: format!("below the wobble speed, a handlebar kick every {kick_every_s} s"),
         bike: TEST_BIKE,
+        changes: Vec::new(),
         seed,
         duration_s,
         road,
@@ -71,6 +75,8 @@ fn below(
         grip_at_deg: None,
         rider_nm: RIDER_NM,
         kicks,
+        kick_s: super::KICK_S,
+        ripple_deg: 0.0,
         committed,
     }
 }

@@ -2,6 +2,14 @@
 //! `name = value` or `name = value+/-uncertainty` line per parameter, in SI
 //! units with the benchmark's symbols (`IBxx`, `lam`, `rR`, ...). They
 //! describe the Whipple model.
+//!
+//! BicycleParameters also writes what the Whipple model has no place for: a
+//! wheel's inertia about its vertical diameter (`IRzz`, `IFzz`, equal to
+//! `IRxx`, `IFxx` for a disc) and the lateral mass-centre offsets and
+//! lateral products of inertia of the frames (`yB`, `yH`, `IBxy`, `IByz`,
+//! ...), zero for a bicycle symmetric about its plane. Those lines are read,
+//! checked (a wheel's `zz` must equal its `xx`, an offset or product must be
+//! zero) and left out, with one note naming them.
 
 use std::path::Path;
 
@@ -37,6 +45,21 @@ const SYMBOLS: [(&str, &str, Unit); 26] = [
     ("IFyy", "front_wheel.inertia_yy", Unit::Inertia),
 ];
 
+/// Lines the model checks but does not use: symbol, and for a wheel the
+/// symbol it must equal (else the symbol must be zero).
+const CHECKED: [(&str, Option<&str>); 10] = [
+    ("IRzz", Some("IRxx")),
+    ("IFzz", Some("IFxx")),
+    ("yB", None),
+    ("yH", None),
+    ("IBxy", None),
+    ("IByz", None),
+    ("IHxy", None),
+    ("IHyz", None),
+    ("yR", None),
+    ("yF", None),
+];
+
 pub(super) fn parse(path: &Path, text: &str) -> Result<ParamSet, ParamError> {
     let name = path
         .file_stem()
@@ -47,6 +70,7 @@ pub(super) fn parse(path: &Path, text: &str) -> Result<ParamSet, ParamError> {
         ModelKind::Whipple,
         "BicycleParameters benchmark file",
     );
+    let mut checked: Vec<(usize, String, f64, Option<&str>)> = Vec::new();
     for (n, raw) in text.lines().enumerate() {
         let line = raw.trim();
         if line.is_empty() || line.starts_with('#') {
@@ -63,14 +87,6 @@ pub(super) fn parse(path: &Path, text: &str) -> Result<ParamSet, ParamError> {
             )))
         })?;
         let symbol = symbol.trim();
-        let (_, key, unit) = SYMBOLS
-            .iter()
-            .find(|(s, _, _)| *s == symbol)
-            .ok_or_else(|| {
-                at(Problem::Syntax(format!(
-                    "{symbol:?} is not a benchmark parameter"
-                )))
-            })?;
         let (nominal, uncertainty) = value
             .split_once("+/-")
             .map_or((value, None), |(v, u)| (v, Some(u.trim())));
@@ -82,6 +98,18 @@ pub(super) fn parse(path: &Path, text: &str) -> Result<ParamSet, ParamError> {
             .ok_or_else(|| {
                 at(Problem::Syntax(format!(
                     "{symbol}: {nominal:?} is not a number"
+                )))
+            })?;
+        if let Some((_, equal_to)) = CHECKED.iter().find(|(s, _)| *s == symbol) {
+            checked.push((n + 1, symbol.to_owned(), value, *equal_to));
+            continue;
+        }
+        let (_, key, unit) = SYMBOLS
+            .iter()
+            .find(|(s, _, _)| *s == symbol)
+            .ok_or_else(|| {
+                at(Problem::Syntax(format!(
+                    "{symbol:?} is not a benchmark parameter"
                 )))
             })?;
         let source = match uncertainty {
@@ -97,5 +125,43 @@ pub(super) fn parse(path: &Path, text: &str) -> Result<ParamSet, ParamError> {
             },
         );
     }
+    check_ignored(&mut set, &checked)?;
     Ok(set)
+}
+
+/// Checks the lines the model leaves out and notes them.
+fn check_ignored(
+    set: &mut ParamSet,
+    checked: &[(usize, String, f64, Option<&str>)],
+) -> Result<(), ParamError> {
+    for (line, symbol, value, equal_to) in checked {
+        let (want, what) = match equal_to {
+            Some(other) => {
+                let key = SYMBOLS
+                    .iter()
+                    .find(|(s, _, _)| s == other)
+                    .map_or("", |(_, k, _)| *k);
+                let want = set.quantity(key).map_or(*value, |q| q.value);
+                (want, format!("{other} (a wheel is a disc)"))
+            }
+            None => (0.0, "0 (the model is symmetric about its plane)".to_owned()),
+        };
+        if (value - want).abs() > 1e-9 * want.abs().max(1e-3) {
+            return Err(ParamError {
+                path: set.path.clone(),
+                param: format!("line {line}"),
+                problem: Problem::Unphysical(format!(
+                    "{symbol} = {value}: the model needs it to equal {what}"
+                )),
+            });
+        }
+    }
+    if !checked.is_empty() {
+        let names: Vec<&str> = checked.iter().map(|c| c.1.as_str()).collect();
+        set.notes.push(format!(
+            "left out (checked: a wheel's zz equals its xx, lateral offsets and products are 0): {}",
+            names.join(", ")
+        ));
+    }
+    Ok(())
 }

@@ -7,6 +7,7 @@
 //! through [`ParamSet::set_si`] and can write the set back as TOML.
 
 mod benchmark_txt;
+pub mod keys;
 mod toml_file;
 
 use std::collections::BTreeMap;
@@ -57,6 +58,8 @@ pub struct ParamSet {
     pub model: ModelKind,
     /// Where the set as a whole comes from.
     pub source: String,
+    /// What the reader wants the user to know: lines ignored, defaults taken.
+    pub notes: Vec<String>,
     values: BTreeMap<String, Quantity>,
 }
 
@@ -140,6 +143,9 @@ pub enum Problem {
     /// A name given on the command line is not in the set.
     #[error("no such parameter in the file")]
     Unknown,
+    /// A fit found no answer.
+    #[error("not fitted: {0}")]
+    NotFitted(String),
 }
 
 /// A problem with one parameter (or the whole file) of a parameter file.
@@ -178,6 +184,7 @@ impl ParamSet {
             name: name.to_owned(),
             model,
             source: source.to_owned(),
+            notes: Vec::new(),
             values: BTreeMap::new(),
         }
     }

@@ -16,7 +16,7 @@ use std::path::Path;
 
 use toml::{Table, Value};
 
-use super::{ModelKind, ParamError, ParamSet, Problem, Quantity};
+use super::{keys, ModelKind, ParamError, ParamSet, Problem, Quantity};
 
 pub(super) fn parse(path: &Path, text: &str) -> Result<ParamSet, ParamError> {
     let syntax = |param: &str, msg: String| ParamError {
@@ -57,8 +57,21 @@ pub(super) fn parse(path: &Path, text: &str) -> Result<ParamSet, ParamError> {
         };
         for (key, entry) in entries {
             let name = format!("{section}.{key}");
+            if let Some(why) = keys::unknown(model, section, key) {
+                return Err(syntax(&name, why));
+            }
             let q = quantity(entry).map_err(|msg| syntax(&name, msg))?;
             set.insert(&name, q);
+        }
+    }
+    if model == ModelKind::Wobble {
+        for tyre in ["front_tyre", "rear_tyre"] {
+            let own = format!("{tyre}.camber_relaxation_length");
+            if set.quantity(&own).is_none() {
+                set.notes.push(format!(
+                    "{own} not given: the slip relaxation length {tyre}.relaxation_length is used"
+                ));
+            }
         }
     }
     Ok(set)

@@ -52,7 +52,9 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         .ok_or_else(|| CliError::file(&args.params, "the model has no wobble mode"))?;
     let text = residual_table(&found, &wobble);
     print_stdout(&text)?;
-    if let Some(out) = out {
+    // A log that could not be read fails the command: the figure is not
+    // committed then, and an old one stays as it was.
+    if let (Some(out), Ok(())) = (out, &loaded) {
         let figure = EigenFigure {
             title: format!("{}: wobble mode and measured episodes", set.name),
             layers: vec![Layer {

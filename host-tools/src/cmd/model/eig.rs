@@ -150,6 +150,7 @@ fn jsonl_text(sweep: &Sweep, critical: &[CriticalSpeed]) -> String {
                 "critical_speed_mps": c.speed_mps,
                 "mode": c.mode.name(),
                 "unstable_above": c.unstable_above,
+                "kind": c.kind(),
                 "im_rad_per_s": c.im_rad_per_s,
             })
             .to_string(),
@@ -159,11 +160,11 @@ fn jsonl_text(sweep: &Sweep, critical: &[CriticalSpeed]) -> String {
     o
 }
 
-/// `weave speed 4.292382536 m/s (stable above, 2.97 Hz)`.
+/// `weave speed 4.292382536 m/s (stable above, oscillatory, 2.97 Hz)`.
 #[must_use]
 pub fn describe(c: &CriticalSpeed) -> String {
     format!(
-        "{} speed {:.9} m/s ({} above, {:.2} Hz)",
+        "{} speed {:.9} m/s ({} above, {}, {:.2} Hz)",
         c.mode.name(),
         c.speed_mps,
         if c.unstable_above {
@@ -171,6 +172,7 @@ pub fn describe(c: &CriticalSpeed) -> String {
         } else {
             "stable"
         },
+        c.kind(),
         c.im_rad_per_s / std::f64::consts::TAU
     )
 }

@@ -8,7 +8,6 @@ use std::path::{Path, PathBuf};
 
 use wobble_model::fit::{fit, Weights};
 use wobble_model::params::to_toml;
-use wobble_model::ParamSet;
 
 use super::episodes;
 use super::param_error;
@@ -45,7 +44,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
             "--freq-sd and --sigma-sd must be positive".into(),
         ));
     }
-    let set = ParamSet::load(&args.params).map_err(|e| param_error(&e))?;
+    let set = super::load_set(&args.params)?;
     for key in &args.params_to_fit {
         set.value(key).map_err(|e| param_error(&e))?;
     }

@@ -98,10 +98,20 @@ pub fn param_error(e: &ParamError) -> CliError {
     }
 }
 
+/// Reads a parameter file, printing its notes (lines left out, defaults
+/// taken) on stderr.
+pub fn load_set(path: &Path) -> Result<ParamSet, CliError> {
+    let set = ParamSet::load(path).map_err(|e| param_error(&e))?;
+    for note in &set.notes {
+        eprintln!("wobblog: {}: {note}", path.display());
+    }
+    Ok(set)
+}
+
 /// Reads a parameter file and builds its model (its Whipple limit with
 /// `whipple`).
 pub fn load(path: &Path, whipple: bool) -> Result<(ParamSet, Model), CliError> {
-    let set = ParamSet::load(path).map_err(|e| param_error(&e))?;
+    let set = load_set(path)?;
     let model = if whipple {
         Model::whipple_of(&set)
     } else {

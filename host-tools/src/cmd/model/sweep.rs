@@ -51,7 +51,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
     if args.factors.iter().any(|f| !f.is_finite() || *f <= 0.0) {
         return Err(CliError::Usage("--factors must be positive numbers".into()));
     }
-    let set = ParamSet::load(&args.params).map_err(|e| param_error(&e))?;
+    let set = super::load_set(&args.params)?;
     let out = args
         .output
         .as_deref()

@@ -1,0 +1,177 @@
+//! Simulated kick-test campaigns with a known answer
+//! (`hil-tests/src/corpus/simulated/campaign.rs`): the host's kick
+//! extractor against every kick's true eigenvalue, and the campaign's
+//! prediction against the bicycle's true wobble speed.
+
+use std::sync::OnceLock;
+
+use wobble_hil::corpus::signal::WHEEL_CIRCUMFERENCE_M;
+use wobble_hil::corpus::simulated::campaign::{self, Campaign, KickTruth, Plan};
+use wobblog::analysis::margin::{predict, KickPoint};
+use wobblog::analysis::{find_kicks, Kick, Run};
+
+/// One campaign per variant, knocks and pushes, written and read back.
+struct Loaded {
+    campaign: Campaign,
+    runs: Vec<Run>,
+}
+
+fn loaded() -> &'static [Loaded] {
+    static L: OnceLock<Vec<Loaded>> = OnceLock::new();
+    L.get_or_init(|| {
+        let tmp = tempfile::tempdir().unwrap();
+        let mut out = Vec::new();
+        for (k, v) in campaign::variants().unwrap().iter().enumerate() {
+            for (p, plan) in [Plan::default(), Plan::default().with_push()]
+                .into_iter()
+                .enumerate()
+            {
+                let seed = 10 + 2 * k as u64 + p as u64;
+                let c = campaign::simulate(v, &plan, seed).unwrap();
+                let dir = tmp.path().join(format!("{}_{seed}", v.name));
+                let runs = c
+                    .write(&dir)
+                    .unwrap()
+                    .iter()
+                    .map(|log| Run::load(log).unwrap())
+                    .collect();
+                out.push(Loaded { campaign: c, runs });
+            }
+        }
+        out
+    })
+}
+
+/// The measured kick matching a true one (within 0.5 s of its start).
+fn matching<'a>(kicks: &'a [Kick], truth: &KickTruth) -> Option<&'a Kick> {
+    kicks.iter().find(|k| (k.t_s - truth.t_s).abs() < 0.5)
+}
+
+#[test]
+fn each_variant_has_a_wobble_speed_and_rides_below_it() {
+    for l in loaded() {
+        let c = &l.campaign;
+        assert!(
+            (2.5..8.0).contains(&c.wobble_speed_mps),
+            "{}: {}",
+            c.variant,
+            c.wobble_speed_mps
+        );
+        for k in &c.kicks {
+            assert!(
+                k.sigma_per_s < 0.0 && k.speed_mps < c.wobble_speed_mps,
+                "{k:?}"
+            );
+        }
+    }
+}
+
+#[test]
+fn kick_extractor_meets_its_accuracy() {
+    let (mut n, mut good, mut found) = (0, 0, 0);
+    let mut z = Vec::new();
+    let mut errors = Vec::new();
+    let mut table = String::new();
+    for l in loaded() {
+        for (pass, run) in l.campaign.passes.iter().zip(&l.runs) {
+            let kicks = find_kicks(run, WHEEL_CIRCUMFERENCE_M);
+            let log = format!("{}.wbl", pass.fixture.truth.name);
+            for truth in l.campaign.kicks.iter().filter(|k| k.log == log) {
+                if !(1.5..=6.0).contains(&truth.speed_mps) {
+                    continue;
+                }
+                n += 1;
+                let m = matching(&kicks, truth);
+                let ok = m.is_some_and(|m| {
+                    (m.sigma_per_s - truth.sigma_per_s).abs() <= 0.3
+                        && (m.freq_hz - truth.freq_hz).abs() <= 0.2
+                });
+                found += usize::from(m.is_some());
+                if let Some(m) = m {
+                    z.push((m.sigma_per_s - truth.sigma_per_s) / m.sigma_sd_per_s);
+                    errors.push((
+                        (m.sigma_per_s - truth.sigma_per_s).abs(),
+                        (m.freq_hz - truth.freq_hz).abs(),
+                    ));
+                }
+                good += usize::from(ok);
+                table.push_str(&format!(
+                    "{log} u {:.2} true s {:.2} f {:.2} amp {:.2} | {}\n",
+                    truth.speed_mps,
+                    truth.sigma_per_s,
+                    truth.freq_hz,
+                    truth.amp_deg,
+                    m.map_or("missed".into(), |m| format!(
+                        "s {:.2} ± {:.2} f {:.2} amp {:.2} fit {:.2}-{:.2} res {:.2}{}",
+                        m.sigma_per_s,
+                        m.sigma_sd_per_s,
+                        m.freq_hz,
+                        m.amp_deg,
+                        m.fit_s[0],
+                        m.fit_s[1],
+                        m.residual_rel,
+                        if ok { "" } else { "  <<" }
+                    ))
+                ));
+            }
+        }
+    }
+    let within_2sd = z.iter().filter(|z| z.abs() <= 2.0).count();
+    let mut es: Vec<f64> = errors.iter().map(|e| e.0).collect();
+    let mut ef: Vec<f64> = errors.iter().map(|e| e.1).collect();
+    es.sort_by(f64::total_cmp);
+    ef.sort_by(f64::total_cmp);
+    let q = |v: &[f64], p: f64| v[((v.len() - 1) as f64 * p).round() as usize];
+    eprintln!(
+        "{table}{good} of {n} within 0.3 1/s and 0.2 Hz, {found} found; \
+         |sigma error| median {:.3} 90 % {:.3} 1/s; |f error| median {:.3} 90 % {:.3} Hz; \
+         {within_2sd} of {} within 2 stated SD",
+        q(&es, 0.5),
+        q(&es, 0.9),
+        q(&ef, 0.5),
+        q(&ef, 0.9),
+        z.len()
+    );
+    assert!(n >= 100, "{n} kicks");
+    assert!(good * 10 >= n * 8, "{good} of {n}\n{table}");
+}
+
+/// Every kick the extractor finds in a campaign, as the regression takes it.
+fn points(l: &Loaded) -> Vec<KickPoint> {
+    l.runs
+        .iter()
+        .flat_map(|run| find_kicks(run, WHEEL_CIRCUMFERENCE_M))
+        .map(|k| KickPoint {
+            speed_mps: k.speed_mps,
+            sigma_per_s: k.sigma_per_s,
+            sigma_sd_per_s: k.sigma_sd_per_s,
+            freq_hz: k.freq_hz,
+        })
+        .collect()
+}
+
+#[test]
+fn margin_predicts_each_bicycle_within_5_percent() {
+    let mut table = String::new();
+    let mut bad = 0;
+    for l in loaded() {
+        let truth = l.campaign.wobble_speed_mps;
+        let m = predict(&points(l));
+        let ok = m
+            .wobble_speed_mps
+            .is_some_and(|w| (w / truth - 1.0).abs() <= 0.05);
+        bad += usize::from(!ok);
+        table.push_str(&format!(
+            "{} seed {}: true {truth:.3} predicted {:?} ci {:?} used {} rejected {} {:?}\n",
+            l.campaign.variant,
+            l.campaign.seed,
+            m.wobble_speed_mps,
+            m.ci95_mps,
+            m.kicks_used,
+            m.kicks_rejected,
+            m.warnings
+        ));
+    }
+    eprintln!("{table}");
+    assert_eq!(bad, 0, "{table}");
+}

@@ -1,0 +1,308 @@
+//! Naming followed branches by mode, from their participation over the whole
+//! speed range.
+//!
+//! Branches that are complex conjugates of each other over at least
+//! [`OSCILLATING_SHARE`] of the speeds form one mode (a weave that splits into
+//! two real roots at low speed is one mode with two branches); a mode
+//! oscillates if it is complex over that share of its speeds. Real roots that
+//! meet briefly and part again (capsize and castering of some bicycles near
+//! 1 m/s) stay two real modes. At up to [`SAMPLES`] speeds spread over the sweep each
+//! branch's eigenvector is computed (inverse iteration) and the squared
+//! magnitudes of its angle states are shared out: roll, steer, torso, twist,
+//! tyre lags (rates and velocities left out: they scale with the eigenvalue).
+//! A mode's participation is the mean over its branches and those speeds.
+//!
+//! - tyre lags more than [`TYRE_DOMINANCE`] times its largest angle: `other`;
+//! - torso the largest angle: `lean`; twist: `twist`; and the mode with the
+//!   largest torso share (at least [`LEAN_MIN_TORSO`]) is `lean` too: a tense
+//!   rider's lean oscillation carries much steer, but it is not the wobble;
+//! - roll or steer the largest, oscillating somewhere, with at least
+//!   [`WEAVE_MIN_ROLL_PER_STEER`] roll per steer and below 2 Hz on average: the
+//!   lowest-frequency one is the `weave`;
+//! - steer the largest, oscillating at 2 Hz or more on average: the lowest such
+//!   is the `wobble`;
+//! - real throughout with roll the largest: the slowest (smallest mean
+//!   `|re|`) is `capsize`;
+//! - steer the largest and below 2 Hz, not the weave: the fastest decaying is
+//!   `castering`;
+//! - anything else `other`.
+
+use nalgebra::{Complex, DMatrix};
+
+use crate::eig::eigenvector;
+use crate::model::StateRole;
+use crate::sweep::{Mode, REAL_TOL};
+
+/// Share of the speeds over which two branches are conjugate to be one
+/// mode, and over which a mode is complex to oscillate.
+pub const OSCILLATING_SHARE: f64 = 0.25;
+/// The mode with the largest torso share is the lean if it has this much.
+pub const LEAN_MIN_TORSO: f64 = 0.1;
+/// Speeds at which eigenvectors are computed.
+pub const SAMPLES: usize = 16;
+/// A mode whose tyre lags are this many times its largest angle is a tyre mode.
+pub const TYRE_DOMINANCE: f64 = 4.0;
+/// Weave rolls: at least this much roll per steer (amplitudes).
+pub const WEAVE_MIN_ROLL_PER_STEER: f64 = 0.2;
+/// Wobble is faster than this on average, rad/s (2 Hz).
+pub const WOBBLE_MIN_RAD_S: f64 = 4.0 * std::f64::consts::PI;
+
+/// Shares of the angles in a mode: roll, steer, torso, twist, tyre.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+struct Shares([f64; 5]);
+
+const ANGLES: [StateRole; 4] = [
+    StateRole::Roll,
+    StateRole::Steer,
+    StateRole::Torso,
+    StateRole::Twist,
+];
+
+/// A mode: its branches and what they do over the sweep.
+struct Group {
+    members: Vec<usize>,
+    shares: Shares,
+    oscillates: bool,
+    /// Mean `|im|` over the speeds where it is complex, rad/s.
+    freq: f64,
+    /// Mean real part, 1/s.
+    mean_re: f64,
+    /// Mean `|re|`, 1/s.
+    mean_abs_re: f64,
+}
+
+impl Group {
+    fn largest_angle(&self) -> (StateRole, f64) {
+        ANGLES
+            .iter()
+            .zip(self.shares.0)
+            .map(|(r, s)| (*r, s))
+            .max_by(|a, b| a.1.total_cmp(&b.1))
+            .unwrap_or((StateRole::Rate, 0.0))
+    }
+
+    fn share(&self, role: StateRole) -> f64 {
+        ANGLES
+            .iter()
+            .position(|r| *r == role)
+            .map_or(self.shares.0[4], |i| self.shares.0[i])
+    }
+
+    fn tyre_only(&self) -> bool {
+        self.shares.0[4] > TYRE_DOMINANCE * TYRE_DOMINANCE * self.largest_angle().1
+    }
+
+    fn planar(&self) -> bool {
+        !self.tyre_only() && matches!(self.largest_angle().0, StateRole::Roll | StateRole::Steer)
+    }
+
+    fn weave_like(&self) -> bool {
+        let (roll, steer) = (self.share(StateRole::Roll), self.share(StateRole::Steer));
+        self.planar()
+            && self.oscillates
+            && self.freq < WOBBLE_MIN_RAD_S
+            && roll >= WEAVE_MIN_ROLL_PER_STEER * WEAVE_MIN_ROLL_PER_STEER * steer
+    }
+
+    fn wobble_like(&self) -> bool {
+        self.planar()
+            && self.oscillates
+            && self.freq >= WOBBLE_MIN_RAD_S
+            && self.largest_angle().0 == StateRole::Steer
+    }
+}
+
+/// Disjoint sets of branch indices.
+fn find(parent: &mut [usize], i: usize) -> usize {
+    let mut r = i;
+    while parent[r] != r {
+        r = parent[r];
+    }
+    parent[i] = r;
+    r
+}
+
+/// Branches that are conjugates of each other over at least
+/// [`OSCILLATING_SHARE`] of the speeds, as groups.
+fn conjugate_groups(branches: &[Vec<Complex<f64>>]) -> Vec<Vec<usize>> {
+    let n = branches.len();
+    let mut parent: Vec<usize> = (0..n).collect();
+    let speeds = branches.first().map_or(0, Vec::len);
+    let mut count = vec![0_usize; n * n];
+    for (i, branch) in branches.iter().enumerate() {
+        for (k, &v) in branch.iter().enumerate() {
+            if v.im <= REAL_TOL {
+                continue;
+            }
+            let tol = 1e-9 * v.norm().max(1.0);
+            if let Some(j) = (0..n)
+                .filter(|&j| j != i)
+                .min_by(|&a, &b| {
+                    (branches[a][k] - v.conj())
+                        .norm()
+                        .total_cmp(&(branches[b][k] - v.conj()).norm())
+                })
+                .filter(|&j| (branches[j][k] - v.conj()).norm() <= tol)
+            {
+                count[i * n + j] += 1;
+            }
+        }
+    }
+    for i in 0..n {
+        for j in 0..n {
+            if count[i * n + j] as f64 >= OSCILLATING_SHARE * speeds as f64 {
+                let (a, b) = (find(&mut parent, i), find(&mut parent, j));
+                parent[a] = b;
+            }
+        }
+    }
+    let mut groups: Vec<Vec<usize>> = Vec::new();
+    let mut root_of: Vec<Option<usize>> = vec![None; n];
+    for i in 0..n {
+        let r = find(&mut parent, i);
+        match root_of[r] {
+            Some(g) => groups[g].push(i),
+            None => {
+                root_of[r] = Some(groups.len());
+                groups.push(vec![i]);
+            }
+        }
+    }
+    groups
+}
+
+/// The indices of up to [`SAMPLES`] speeds spread over `n`.
+fn sample_indices(n: usize) -> Vec<usize> {
+    if n <= SAMPLES {
+        return (0..n).collect();
+    }
+    let mut v: Vec<usize> = (0..SAMPLES)
+        .map(|i| (i * (n - 1) + (SAMPLES - 1) / 2) / (SAMPLES - 1))
+        .collect();
+    v.dedup();
+    v
+}
+
+fn shares_of(vector: &nalgebra::DVector<Complex<f64>>, roles: &[StateRole]) -> Shares {
+    let mut s = [0.0; 5];
+    for (role, c) in roles.iter().zip(vector.iter()) {
+        let slot = match role {
+            StateRole::Roll => 0,
+            StateRole::Steer => 1,
+            StateRole::Torso => 2,
+            StateRole::Twist => 3,
+            StateRole::Tyre => 4,
+            StateRole::Rate => continue,
+        };
+        s[slot] += c.norm_sqr();
+    }
+    let total: f64 = s.iter().sum();
+    if total > 0.0 {
+        for x in &mut s {
+            *x /= total;
+        }
+    }
+    Shares(s)
+}
+
+/// The mode of each branch (`branches[b][k]` at `speeds[k]`).
+pub(crate) fn name(
+    branches: &[Vec<Complex<f64>>],
+    speeds: &[f64],
+    state_matrix: &dyn Fn(f64) -> DMatrix<f64>,
+    roles: &[StateRole],
+) -> Vec<Mode> {
+    let n = speeds.len();
+    let mut shares = vec![Shares::default(); branches.len()];
+    let samples = sample_indices(n);
+    for &k in &samples {
+        let a = state_matrix(speeds[k]);
+        for (b, s) in branches.iter().zip(shares.iter_mut()) {
+            let got = shares_of(&eigenvector(&a, b[k]), roles);
+            for (x, y) in s.0.iter_mut().zip(got.0) {
+                *x += y / samples.len() as f64;
+            }
+        }
+    }
+    let groups: Vec<Group> = conjugate_groups(branches)
+        .into_iter()
+        .map(|members| {
+            let mut sh = [0.0; 5];
+            for &m in &members {
+                for (x, y) in sh.iter_mut().zip(shares[m].0) {
+                    *x += y / members.len() as f64;
+                }
+            }
+            let values = || members.iter().flat_map(|&m| branches[m].iter());
+            let complex: Vec<f64> = values()
+                .filter(|v| v.im.abs() > REAL_TOL)
+                .map(|v| v.im.abs())
+                .collect();
+            let count = (members.len() * n) as f64;
+            Group {
+                shares: Shares(sh),
+                oscillates: complex.len() as f64 >= OSCILLATING_SHARE * count,
+                freq: complex.iter().sum::<f64>() / complex.len().max(1) as f64,
+                mean_re: values().map(|v| v.re).sum::<f64>() / count,
+                mean_abs_re: values().map(|v| v.re.abs()).sum::<f64>() / count,
+                members,
+            }
+        })
+        .collect();
+    let lean = pick(
+        &groups,
+        |g| !g.tyre_only() && g.share(StateRole::Torso) >= LEAN_MIN_TORSO,
+        |g| g.share(StateRole::Torso),
+    );
+    // The lean is neither weave nor wobble.
+    let not_lean = |g: &Group| lean.is_none_or(|l| !std::ptr::eq(g, &groups[l]));
+    let weave = pick(&groups, |g| g.weave_like() && not_lean(g), |g| -g.freq);
+    let wobble = pick(&groups, |g| g.wobble_like() && not_lean(g), |g| -g.freq);
+    let capsize = pick(
+        &groups,
+        |g| g.planar() && !g.oscillates && g.largest_angle().0 == StateRole::Roll,
+        |g| -g.mean_abs_re,
+    );
+    let castering = pick(
+        &groups,
+        |g| {
+            g.planar()
+                && g.largest_angle().0 == StateRole::Steer
+                && g.freq < WOBBLE_MIN_RAD_S
+                && !g.weave_like()
+        },
+        |g| -g.mean_re,
+    );
+    let mut modes = vec![Mode::Other; branches.len()];
+    for (i, g) in groups.iter().enumerate() {
+        let mode = match g.largest_angle().0 {
+            _ if g.tyre_only() => Mode::Other,
+            StateRole::Torso => Mode::Lean,
+            _ if Some(i) == lean => Mode::Lean,
+            StateRole::Twist => Mode::Twist,
+            _ if Some(i) == weave => Mode::Weave,
+            _ if Some(i) == wobble => Mode::Wobble,
+            _ if Some(i) == capsize => Mode::Capsize,
+            _ if Some(i) == castering => Mode::Castering,
+            _ => Mode::Other,
+        };
+        for &m in &g.members {
+            modes[m] = mode;
+        }
+    }
+    modes
+}
+
+/// The index of the group passing `keep` with the largest `score`.
+fn pick(
+    groups: &[Group],
+    keep: impl Fn(&Group) -> bool,
+    score: impl Fn(&Group) -> f64,
+) -> Option<usize> {
+    groups
+        .iter()
+        .enumerate()
+        .filter(|(_, g)| keep(g))
+        .max_by(|a, b| score(a.1).total_cmp(&score(b.1)))
+        .map(|(i, _)| i)
+}

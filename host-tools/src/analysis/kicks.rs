@@ -1,0 +1,257 @@
+//! Handlebar kicks found in a run's steering angle, each ring-down fitted
+//! for the wobble mode's eigenvalue at the speed of the kick: the data of
+//! a kick-test campaign (`wobblog margin`).
+//!
+//! 1. The steering angle is band-passed around the wobble band (zero
+//!    phase, as for episodes) and its envelope taken as a moving RMS over
+//!    [`ENVELOPE_WINDOW_S`]. The background is the envelope's median over
+//!    the stretch.
+//! 2. A kick is a stretch where the envelope exceeds [`KICK_MIN_DEG`] and
+//!    [`KICK_OVER_BACKGROUND`] times the background, reached within
+//!    [`MAX_RISE_S`] of rising above it: a struck mode rises within a
+//!    cycle or two, a wobble that grows by itself takes longer and is not a
+//!    kick; and out of at least [`QUIET_BEFORE_S`] below it (a ring's
+//!    tail crossing the threshold again is no new kick).
+//! 3. The push (the hand's short, large transient, and the filter's
+//!    answer to it) is skipped: the fit starts [`SKIP_AFTER_PEAK_S`] after
+//!    the envelope's peak.
+//! 4. The samples of the ring-down (not their envelope) are fitted with a
+//!    decaying sinusoid plus, when one of the wheel's harmonics lies within
+//!    [`TONE_SEARCH_HZ`] and the fit spans [`MIN_TONE_BEATS`] beats with
+//!    it, a steady tone for it (see [`super::sinefit`]),
+//!    until the envelope is back at [`FIT_END_OVER_BACKGROUND`] times the
+//!    background or [`MAX_FIT_S`] has passed.
+//! 5. sigma's uncertainty is the fit's standard error, corrected for what
+//!    the residuals hold near the ring's frequency (the band-pass colours
+//!    them, and the road keeps the mode ringing): see
+//!    [`super::sinefit::SineFit::sigma_se_per_s`].
+
+use std::f64::consts::TAU;
+
+use serde::Serialize;
+
+use super::filter::{contiguous_spans, wobble_band};
+use super::run::Run;
+use super::sinefit::fit_mode;
+
+/// Envelope a kick's ring must reach, degrees.
+pub const KICK_MIN_DEG: f64 = 0.3;
+/// ... and this many times the stretch's background.
+const KICK_OVER_BACKGROUND: f64 = 4.0;
+/// A kick rises out of at least this long below the threshold, s.
+const QUIET_BEFORE_S: f64 = 0.5;
+/// A kick's envelope reaches its peak within this of rising above the
+/// threshold, s.
+const MAX_RISE_S: f64 = 0.4;
+/// Moving-RMS window of the envelope, s (about a cycle at 7 Hz).
+const ENVELOPE_WINDOW_S: f64 = 0.15;
+/// The fit starts this long after the envelope's peak, s: past a push of
+/// up to 0.15 s and the band-pass's answer to its edges (the zero-phase
+/// 4 Hz high-pass rings down at about 18/s on either side of an edge).
+const SKIP_AFTER_PEAK_S: f64 = 0.3;
+/// The background is this quantile of the stretch's envelope (the quiet
+/// between kicks, not their long ring-downs).
+const BACKGROUND_QUANTILE: f64 = 0.2;
+/// The fit ends where the envelope is back at this many times the
+/// background...
+const FIT_END_OVER_BACKGROUND: f64 = 2.0;
+/// ... and lasts no longer than this, s.
+const MAX_FIT_S: f64 = 5.0;
+/// A wheel harmonic is fitted as a tone only if the fit spans this many
+/// beats between it and the ring (fewer cannot tell them apart).
+const MIN_TONE_BEATS: f64 = 1.5;
+/// A fit spans at least this long, s (three cycles at 6 Hz).
+const MIN_FIT_S: f64 = 0.5;
+/// Stretches shorter than this (between gaps) are not searched, s.
+const MIN_STRETCH_S: f64 = 2.0;
+/// Largest unexplained share (RMS) of the samples for a fit to count.
+const MAX_RESIDUAL_REL: f64 = 0.6;
+/// A wheel harmonic within this of the ring's frequency is fitted beside
+/// it, Hz.
+const TONE_SEARCH_HZ: f64 = 1.0;
+/// Fits are trusted for frequencies in this band, Hz.
+const FREQ_BAND_HZ: (f64, f64) = (4.0, 12.0);
+
+/// One kick's ring-down.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Kick {
+    /// When the ring rose above the threshold, s since boot.
+    pub t_s: f64,
+    /// Mean wheel speed over the fit, m/s.
+    pub speed_mps: f64,
+    /// Frequency of the ring, Hz.
+    pub freq_hz: f64,
+    /// Growth rate of the ring (negative: it decays), 1/s.
+    pub sigma_per_s: f64,
+    /// Standard uncertainty of `sigma_per_s`, 1/s.
+    pub sigma_sd_per_s: f64,
+    /// Amplitude at the fit's start, degrees.
+    pub amp_deg: f64,
+    /// The stretch fitted, s since boot.
+    pub fit_s: [f64; 2],
+    /// Unexplained share (RMS) of the fitted samples.
+    pub residual_rel: f64,
+}
+
+/// Every kick of `run`, in time order. Each evenly sampled stretch between
+/// gaps is searched alone, so no fit reaches across a gap.
+#[must_use]
+pub fn find_kicks(run: &Run, wheel_circumference_m: f64) -> Vec<Kick> {
+    let fs = run.sample_rate_hz();
+    if fs.is_nan() || fs <= 0.0 {
+        return Vec::new();
+    }
+    contiguous_spans(&run.t_s, 1.0 / fs)
+        .into_iter()
+        .flat_map(|span| {
+            let stretch = Stretch {
+                t_s: &run.t_s[span.clone()],
+                steer_deg: &run.steer_deg[span.clone()],
+                speed_mps: &run.speed_mps[span],
+                fs,
+            };
+            stretch.kicks(wheel_circumference_m)
+        })
+        .collect()
+}
+
+/// One evenly sampled stretch.
+struct Stretch<'a> {
+    t_s: &'a [f64],
+    steer_deg: &'a [f64],
+    speed_mps: &'a [f64],
+    fs: f64,
+}
+
+/// Moving RMS over `window` samples (centred), times sqrt 2: the amplitude
+/// of a sinusoid.
+fn envelope(x: &[f64], window: usize) -> Vec<f64> {
+    let half = window / 2;
+    let mut prefix = Vec::with_capacity(x.len() + 1);
+    prefix.push(0.0);
+    for v in x {
+        prefix.push(prefix.last().copied().unwrap_or(0.0) + v * v);
+    }
+    (0..x.len())
+        .map(|i| {
+            let (lo, hi) = (i.saturating_sub(half), (i + half + 1).min(x.len()));
+            (2.0 * (prefix[hi] - prefix[lo]).max(0.0) / (hi - lo) as f64).sqrt()
+        })
+        .collect()
+}
+
+fn quantile(mut v: Vec<f64>, q: f64) -> f64 {
+    v.sort_by(f64::total_cmp);
+    let i = ((v.len() as f64 - 1.0) * q).round() as usize;
+    v.get(i).copied().unwrap_or(0.0)
+}
+
+impl Stretch<'_> {
+    fn samples(&self, s: f64) -> usize {
+        (s * self.fs).round() as usize
+    }
+
+    fn kicks(&self, circumference_m: f64) -> Vec<Kick> {
+        let n = self.t_s.len();
+        if n < self.samples(MIN_STRETCH_S) {
+            return Vec::new();
+        }
+        let band = wobble_band(self.steer_deg, self.fs);
+        let env = envelope(&band, self.samples(ENVELOPE_WINDOW_S).max(3));
+        let background = quantile(env.clone(), BACKGROUND_QUANTILE);
+        let threshold = KICK_MIN_DEG.max(KICK_OVER_BACKGROUND * background);
+        let mut kicks = Vec::new();
+        let mut i = 0;
+        let mut last_end: Option<usize> = None;
+        while i < n {
+            if env[i] <= threshold {
+                i += 1;
+                continue;
+            }
+            // A stretch above the threshold: where it rose, its peak, its end.
+            let rise = i;
+            let end = (rise..n).find(|&k| env[k] <= threshold).unwrap_or(n);
+            let peak = (rise..end)
+                .max_by(|&a, &b| env[a].total_cmp(&env[b]))
+                .unwrap_or(rise);
+            i = end;
+            let quiet_before = last_end.is_none_or(|e| rise >= e + self.samples(QUIET_BEFORE_S));
+            last_end = Some(end);
+            if peak - rise > self.samples(MAX_RISE_S) || rise == 0 || !quiet_before {
+                // Grew by itself, was already ringing at the start, or is
+                // the tail of the last ring rising out of the noise again.
+                continue;
+            }
+            let next_rise = (end..n).find(|&k| env[k] > threshold).unwrap_or(n);
+            if let Some(kick) = self.fit(
+                &band,
+                &env,
+                background,
+                (rise, peak, next_rise),
+                circumference_m,
+            ) {
+                kicks.push(kick);
+            }
+        }
+        kicks
+    }
+
+    /// Fits the ring-down of the kick that rose at `rise`, peaked at `peak`;
+    /// the next kick rises at `next`.
+    fn fit(
+        &self,
+        band: &[f64],
+        env: &[f64],
+        background: f64,
+        (rise, peak, next): (usize, usize, usize),
+        circumference_m: f64,
+    ) -> Option<Kick> {
+        let start = peak + self.samples(SKIP_AFTER_PEAK_S);
+        let floor = FIT_END_OVER_BACKGROUND * background;
+        let last = (start + self.samples(MAX_FIT_S)).min(next.saturating_sub(1));
+        let stop = (start..last).find(|&k| env[k] <= floor).unwrap_or(last);
+        if stop < start + self.samples(MIN_FIT_S) {
+            return None;
+        }
+        let t = &self.t_s[start..stop];
+        let x = &band[start..stop];
+        let duration = t[t.len() - 1] - t[0];
+        let sigma0 = ((env[stop].max(1e-3) / env[start].max(1e-3)).ln() / duration).min(-0.05);
+        // Zero crossings of the first second, where the ring stands well
+        // above the noise.
+        let head = &x[..x.len().min(self.samples(1.0))];
+        let crossings = head
+            .windows(2)
+            .filter(|w| (w[0] < 0.0) != (w[1] < 0.0))
+            .count();
+        let freq0 = crossings as f64 * self.fs / (2.0 * head.len() as f64);
+        if !(FREQ_BAND_HZ.0..FREQ_BAND_HZ.1).contains(&freq0) {
+            return None;
+        }
+        let speed = self.speed_mps[start..stop].iter().sum::<f64>() / t.len() as f64;
+        let wheel_hz = speed / circumference_m;
+        let tone = (1..=8)
+            .map(|h| f64::from(h) * wheel_hz)
+            .filter(|f| {
+                let beat = (f - freq0).abs();
+                beat < TONE_SEARCH_HZ && beat * duration >= MIN_TONE_BEATS
+            })
+            .min_by(|a, b| (a - freq0).abs().total_cmp(&(b - freq0).abs()))
+            .filter(|_| wheel_hz > 0.0);
+        let fit = fit_mode(t, x, sigma0, TAU * freq0, tone.map(|f| TAU * f))?;
+        let freq = fit.omega_rad_s / TAU;
+        let plausible = fit.residual_rel <= MAX_RESIDUAL_REL
+            && (FREQ_BAND_HZ.0..FREQ_BAND_HZ.1).contains(&freq)
+            && fit.sigma_se_per_s.is_finite();
+        plausible.then(|| Kick {
+            t_s: self.t_s[rise],
+            speed_mps: speed,
+            freq_hz: freq,
+            sigma_per_s: fit.sigma_per_s,
+            sigma_sd_per_s: fit.sigma_se_per_s,
+            amp_deg: fit.log_amp.exp(),
+            fit_s: [t[0], t[t.len() - 1]],
+            residual_rel: fit.residual_rel,
+        })
+    }
+}
