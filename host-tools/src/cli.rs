@@ -41,6 +41,8 @@ enum Command {
     Plot(cmd::plot::Args),
     /// Measure every wobble episode (frequency, growth rate, speed); Figure 8 with --plot.
     Wobble(cmd::wobble::Args),
+    /// Predict the wobble speed from handlebar kicks below it, with its 95 % interval.
+    Margin(cmd::margin::Args),
     /// Write a run's GPS track as GPX.
     Gpx(cmd::gpx::Args),
     /// One row per run in a directory: duration, distance, episodes, wobble speed, losses.
@@ -73,6 +75,7 @@ pub fn main() -> ExitCode {
         Command::Nmea(args) => cmd::nmea::run(&args),
         Command::Plot(args) => cmd::plot::run(&args),
         Command::Wobble(args) => cmd::wobble::run(&args),
+        Command::Margin(args) => cmd::margin::run(&args),
         Command::Gpx(args) => cmd::gpx::run(&args),
         Command::Summary(args) => cmd::summary::run(&args),
         Command::Model(command) => cmd::model::run(&command),

@@ -93,7 +93,7 @@ pub fn campaign_logs(dir: &Path) -> Result<Vec<LogEntry>, CliError> {
             if let Some(twin) = entries.iter().find(|e| e.partition() == entry.partition()) {
                 return Err(CliError::file(
                     &entry.path,
-                    format!("the same run number as {}", twin.path.display()),
+                    format!("the same run number as {}", crate::text::shown(&twin.path)),
                 ));
             }
             entries.push(entry);

@@ -7,7 +7,6 @@ use wobble_core::format::{DecodeStats, Event, Record};
 
 use crate::losses::Losses;
 use crate::rows::{Row, RowAssembler};
-use crate::text::escape_controls;
 
 /// One wobble alert, from its switching on to its switching off.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
@@ -194,13 +193,14 @@ impl SummaryBuilder {
                 *s.faults.entry(f.source.as_str()).or_default() += u64::from(f.count.max(1))
             }
             Record::LogInfo(info) => {
-                s.firmware = Some(escape_controls(info.firmware).into_owned());
+                // Kept as written; text output escapes it (JSON has its own escapes).
+                s.firmware = Some(info.firmware.to_string());
                 s.device_id = Some(info.device_id.iter().map(|b| format!("{b:02x}")).collect());
                 s.run = Some(info.run);
                 s.sample_rate_hz = Some(info.sample_rate_hz);
             }
             Record::Channel(_) => {}
-            Record::Config(line) => s.config.push(escape_controls(line.text).into_owned()),
+            Record::Config(line) => s.config.push(line.text.to_string()),
         }
         let with_gps = &mut self.rows_with_gps;
         self.rows.push(record, &mut |row: &Row| {

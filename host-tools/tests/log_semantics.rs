@@ -202,7 +202,8 @@ fn gps_values_off_the_globe_never_reach_gpx_or_info() {
         Record::Gps(GpsFix {
             t_us,
             utc: Some(UtcTime {
-                days_since_2000: 7_000,
+                // 2016-12-31, a day that ended with a leap second.
+                days_since_2000: 6_209,
                 ms_of_day,
             }),
             lat_e7: Some(lat_e7),

@@ -105,7 +105,10 @@ pub fn run(args: &Args) -> Result<(), CliError> {
     };
     out.commit()?;
     for line in crate::cmd::logs::warnings(&losses) {
-        eprintln!("wobblog: {}: warning: {line}", args.log.display());
+        eprintln!(
+            "wobblog: {}: warning: {line}",
+            crate::text::shown(&args.log)
+        );
     }
     Ok(())
 }

@@ -34,10 +34,10 @@ const SEGMENT_GAP_US: u64 = 5_000_000;
 /// Runs `wobblog gpx`.
 pub fn run(args: &Args) -> Result<(), CliError> {
     let mut out = Output::create_or_stdout(args.output.as_deref(), &[&args.log])?;
-    let name = args
-        .log
-        .file_stem()
-        .map_or_else(String::new, |s| s.to_string_lossy().into_owned());
+    // Control characters are not XML: a name holding them is escaped.
+    let name = args.log.file_stem().map_or_else(String::new, |s| {
+        crate::text::escape_controls(&s.to_string_lossy()).into_owned()
+    });
     let mut points = 0usize;
     let mut gpx = Gpx::new(&mut out, &name);
     let walked = track(&args.log, args.window.window(), |step| {
@@ -50,7 +50,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
     if points == 0 {
         eprintln!(
             "wobblog: {}: warning: no GPS fix with a position; the track is empty",
-            args.log.display()
+            crate::text::shown(&args.log)
         );
     }
     out.commit()

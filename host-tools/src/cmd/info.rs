@@ -5,6 +5,7 @@ use std::path::PathBuf;
 use crate::cmd::logs::print_stdout;
 use crate::reader::read_log;
 use crate::summary::{Summary, SummaryBuilder};
+use crate::text::escape_controls;
 use crate::CliError;
 
 /// Arguments of `wobblog info`.
@@ -40,8 +41,11 @@ pub fn summarise(path: &std::path::Path) -> Result<Summary, CliError> {
 fn render(path: &std::path::Path, s: &Summary) -> String {
     use std::fmt::Write;
     let mut o = String::new();
-    let opt = |v: &Option<String>| v.clone().unwrap_or_else(|| "unknown".into());
-    let _ = writeln!(o, "log:          {}", path.display());
+    let opt = |v: &Option<String>| {
+        v.as_deref()
+            .map_or_else(|| "unknown".into(), |t| escape_controls(t).into_owned())
+    };
+    let _ = writeln!(o, "log:          {}", crate::text::shown(path));
     let _ = writeln!(
         o,
         "firmware:     {}  device {}  run {}",
@@ -90,7 +94,7 @@ fn render(path: &std::path::Path, s: &Summary) -> String {
     if s.repeated_blocks + s.out_of_range > 0 {
         let _ = writeln!(
             o,
-            "invalid:      {} repeated or stale blocks decoded once, {} impossible values dropped or replaced",
+            "invalid:      {} copies of blocks skipped (decoded once), {} impossible values dropped, replaced or flagged",
             s.repeated_blocks, s.out_of_range
         );
     }
@@ -123,7 +127,7 @@ fn render(path: &std::path::Path, s: &Summary) -> String {
     );
     let _ = writeln!(o, "config:       {} lines", s.config.len());
     for line in &s.config {
-        let _ = writeln!(o, "  {line}");
+        let _ = writeln!(o, "  {}", escape_controls(line));
     }
     let losses = s.losses.describe();
     if !losses.is_empty() {

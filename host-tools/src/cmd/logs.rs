@@ -54,7 +54,7 @@ const WARNINGS_SHOWN: usize = 10;
 /// with care.
 pub fn warn_losses(log: &Path, summary: &Summary) {
     for line in warnings(&summary.losses) {
-        eprintln!("wobblog: {}: warning: {line}", log.display());
+        eprintln!("wobblog: {}: warning: {line}", crate::text::shown(log));
     }
 }
 

@@ -10,6 +10,7 @@ pub mod export;
 pub mod gpx;
 pub mod info;
 pub mod logs;
+pub mod margin;
 pub mod model;
 pub mod nmea;
 pub mod plot;

@@ -107,7 +107,7 @@ fn render_text(r: &RunEpisodes) -> String {
     let _ = writeln!(
         o,
         "{}: {}, wobble speed {speed}",
-        r.log,
+        crate::text::escape_controls(&r.log),
         crate::words::plural(r.episodes.len(), "episode")
     );
     // The same names as the JSON fields.

@@ -121,7 +121,7 @@ impl Format {
                     .collect();
                 format!(
                     "{}: no output format has this extension; the known ones are {} (or give --format)",
-                    path.display(),
+                    crate::text::shown(path),
                     known.join(" ")
                 )
             })
@@ -150,7 +150,7 @@ impl Format {
                 return Err(CliError::Usage(format!(
                     "--format {} contradicts the output file {} (a {} name)",
                     g.name(),
-                    output.map_or(String::new(), |p| p.display().to_string()),
+                    output.map_or(String::new(), crate::text::shown),
                     n.format.name()
                 )))
             }

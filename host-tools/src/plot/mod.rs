@@ -4,6 +4,7 @@
 //! Text is drawn with the DejaVu Sans font compiled into the program, so
 //! plotting needs no system font libraries; an SVG carries the font with it.
 
+pub mod margin;
 pub mod modes;
 mod svg_font;
 pub mod timeplot;
@@ -51,7 +52,7 @@ impl ImageKind {
             Some("svg") => Ok(Self::Svg),
             _ => Err(CliError::Usage(format!(
                 "{}: plot files must end in .png or .svg",
-                path.display()
+                crate::text::shown(path)
             ))),
         }
     }

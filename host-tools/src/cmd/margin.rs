@@ -1,0 +1,261 @@
+//! `wobblog margin`: the wobble speed predicted from a kick-test campaign
+//! below it (damping extrapolation, `analysis::margin`), with its 95 %
+//! interval, as a table in words or one JSON object, and the damping trend
+//! as a figure.
+
+use std::path::{Path, PathBuf};
+
+use serde::Serialize;
+
+use crate::analysis::margin::{predict, KickPoint, Margin};
+use crate::analysis::{find_kicks, Kick, Run};
+use crate::cmd::detect::log_config;
+use crate::cmd::logs::{for_each_log, print_stdout, warn_losses};
+use crate::cmd::summary::logs_in;
+use crate::output::Output;
+use crate::plot::margin::{KickDot, MarginPlot};
+use crate::plot::{render, ImageKind};
+use crate::CliError;
+
+/// Arguments of `wobblog margin`.
+#[derive(clap::Args)]
+pub struct Args {
+    /// Card logs (`RUNnnnnn.WBL`) or directories of them: every kick of
+    /// every log is one point of the campaign.
+    #[arg(required = true, value_name = "LOGS|DIRS")]
+    pub inputs: Vec<PathBuf>,
+    /// Print one JSON object instead of the table.
+    #[arg(long)]
+    pub json: bool,
+    /// Draw sigma against speed with every kick, the fit and its band and
+    /// the predicted crossing into this `.png` or `.svg` file.
+    #[arg(long, value_name = "OUT")]
+    pub plot: Option<PathBuf>,
+}
+
+/// One kick as reported.
+#[derive(Clone, Debug, Serialize)]
+pub struct KickRow {
+    /// The log it is in.
+    pub log: String,
+    /// Where its measurement comes from: `host` (the steering signal).
+    pub source: &'static str,
+    /// The kick's ring-down.
+    #[serde(flatten)]
+    pub kick: Kick,
+    /// Whether the regression used it (an outlier gets no weight).
+    pub used: bool,
+}
+
+/// What `wobblog margin` prints.
+#[derive(Serialize)]
+pub struct Report {
+    /// Predicted wobble speed, m/s (`null` when the kicks give none).
+    pub wobble_speed_mps: Option<f64>,
+    /// Its 95 % interval `[lo, hi]`, `hi` null when the data cannot bound it.
+    pub ci95_mps: [Option<f64>; 2],
+    /// Kicks the fit used.
+    pub kicks_used: usize,
+    /// Kicks it rejected.
+    pub kicks_rejected: usize,
+    /// How the prediction and interval were made.
+    pub method: String,
+    /// Speeds of the kicks used, m/s.
+    pub speed_range_mps: Option<[f64; 2]>,
+    /// The line `sigma = a + b u`: `[a (1/s), b (1/s per m/s)]`.
+    pub line: Option<[f64; 2]>,
+    /// Why the answer is weaker than it looks.
+    pub warnings: Vec<String>,
+    /// Every kick, in the order of the logs.
+    pub kicks: Vec<KickRow>,
+}
+
+/// The logs named by `inputs`: files as given, directories' `*.WBL` files
+/// in name order.
+fn expand(inputs: &[PathBuf]) -> Result<Vec<PathBuf>, CliError> {
+    let mut logs = Vec::new();
+    for input in inputs {
+        if input.is_dir() {
+            let found = logs_in(input)?;
+            if found.is_empty() {
+                return Err(CliError::file(input, "no *.WBL logs in this directory"));
+            }
+            logs.extend(found);
+        } else {
+            logs.push(input.clone());
+        }
+    }
+    Ok(logs)
+}
+
+/// Every kick of `log`, measured from its steering signal with the wheel
+/// the log was recorded with.
+fn kicks_of(log: &Path) -> Result<Vec<Kick>, CliError> {
+    let run = Run::load(log)?;
+    warn_losses(log, &run.summary);
+    let config = log_config(&run.summary.config, &[])?;
+    Ok(find_kicks(&run, f64::from(config.wheel.circumference_m)))
+}
+
+/// Gathers the kicks of `logs` behind a progress bar; a log that cannot be
+/// read is reported and the rest still count.
+fn gather(logs: &[PathBuf]) -> (Vec<KickRow>, Result<(), CliError>) {
+    let mut rows = Vec::new();
+    let result = for_each_log(logs, "measuring kicks", |log| {
+        let name = log.display().to_string();
+        rows.extend(kicks_of(log)?.into_iter().map(|kick| KickRow {
+            log: name.clone(),
+            source: "host",
+            kick,
+            used: false,
+        }));
+        Ok(())
+    });
+    (rows, result)
+}
+
+/// The report of `rows` and the prediction made from them.
+#[must_use]
+pub fn report(mut rows: Vec<KickRow>) -> (Report, Margin) {
+    let points: Vec<KickPoint> = rows
+        .iter()
+        .map(|r| KickPoint {
+            speed_mps: r.kick.speed_mps,
+            sigma_per_s: r.kick.sigma_per_s,
+            sigma_sd_per_s: r.kick.sigma_sd_per_s,
+            freq_hz: r.kick.freq_hz,
+        })
+        .collect();
+    let margin = predict(&points);
+    for (row, w) in rows.iter_mut().zip(&margin.weights) {
+        row.used = *w > 0.0;
+    }
+    let report = Report {
+        wobble_speed_mps: margin.wobble_speed_mps,
+        ci95_mps: margin.ci95_mps,
+        kicks_used: margin.kicks_used,
+        kicks_rejected: margin.kicks_rejected,
+        method: margin.method.clone(),
+        speed_range_mps: margin.speed_range_mps,
+        line: margin.line,
+        warnings: margin.warnings.clone(),
+        kicks: rows,
+    };
+    (report, margin)
+}
+
+/// Runs `wobblog margin`.
+pub fn run(args: &Args) -> Result<(), CliError> {
+    if let Some(plot) = &args.plot {
+        ImageKind::of(plot)?;
+    }
+    let logs = expand(&args.inputs)?;
+    let inputs: Vec<&Path> = logs.iter().map(PathBuf::as_path).collect();
+    let plot_out = args
+        .plot
+        .as_deref()
+        .map(|p| Output::create(p, &inputs))
+        .transpose()?;
+    let (rows, result) = gather(&logs);
+    if rows.is_empty() && result.is_err() {
+        return result;
+    }
+    let (report, margin) = report(rows);
+    let text = if args.json {
+        let mut line = serde_json::to_string(&report)
+            .map_err(|e| CliError::Failed(format!("cannot write the report: {e}")))?;
+        line.push('\n');
+        line
+    } else {
+        render_text(&report, logs.len())
+    };
+    let printed = print_stdout(&text);
+    if let Some(out) = plot_out {
+        let figure = MarginPlot {
+            kicks: report
+                .kicks
+                .iter()
+                .map(|r| KickDot {
+                    speed_mps: r.kick.speed_mps,
+                    sigma_per_s: r.kick.sigma_per_s,
+                    sd_per_s: r.kick.sigma_sd_per_s,
+                    used: r.used,
+                })
+                .collect(),
+            margin,
+            model_curve: None,
+            model_speed: None,
+        };
+        render(&figure, out)?;
+    }
+    result.and(printed)
+}
+
+/// `v` to two decimals, or `what` for none.
+fn speed_text(v: Option<f64>, what: &str) -> String {
+    v.map_or(what.into(), |v| format!("{v:.2} m/s"))
+}
+
+/// The table form: the answer in words, then every kick.
+fn render_text(r: &Report, logs: usize) -> String {
+    use std::fmt::Write;
+    let mut o = String::new();
+    let kicks = crate::words::plural(r.kicks.len(), "kick");
+    let _ = writeln!(
+        o,
+        "{kicks} in {}: {} used, {} rejected",
+        crate::words::plural(logs, "log"),
+        r.kicks_used,
+        r.kicks_rejected
+    );
+    match (r.wobble_speed_mps, r.ci95_mps) {
+        (Some(w), [lo, hi]) => {
+            let _ = writeln!(
+                o,
+                "predicted wobble speed {w:.2} m/s, 95 % interval {} to {}",
+                speed_text(lo, "unbounded"),
+                speed_text(hi, "unbounded (the data cannot bound it)")
+            );
+        }
+        (None, [Some(lo), _]) => {
+            let _ = writeln!(
+                o,
+                "no predicted wobble speed; the data only say it is above {lo:.2} m/s"
+            );
+        }
+        (None, _) => {
+            let _ = writeln!(o, "no predicted wobble speed");
+        }
+    }
+    if let Some([lo, hi]) = r.speed_range_mps {
+        let _ = writeln!(o, "kicks used between {lo:.2} and {hi:.2} m/s");
+    }
+    if let Some([a, b]) = r.line {
+        let _ = writeln!(o, "sigma = {a:.3} + {b:.3} * speed (1/s, speed in m/s)");
+    }
+    for w in &r.warnings {
+        let _ = writeln!(o, "warning: {w}");
+    }
+    let _ = writeln!(o, "method: {}", r.method);
+    if !r.kicks.is_empty() {
+        let _ = writeln!(
+            o,
+            "  t_s       speed_mps  freq_hz  sigma_per_s  sigma_sd_per_s  amp_deg  used  log"
+        );
+    }
+    for k in &r.kicks {
+        let _ = writeln!(
+            o,
+            "  {:8.2}  {:9.2}  {:7.2}  {:11.3}  {:14.3}  {:7.2}  {:4}  {}",
+            k.kick.t_s,
+            k.kick.speed_mps,
+            k.kick.freq_hz,
+            k.kick.sigma_per_s,
+            k.kick.sigma_sd_per_s,
+            k.kick.amp_deg,
+            if k.used { "yes" } else { "no" },
+            k.log
+        );
+    }
+    o
+}

@@ -1,0 +1,235 @@
+//! The campaign's damping trend: every kick's sigma against its speed with
+//! its error bar (two standard uncertainties), the robust line and its
+//! 95 % band carried forward to zero, the predicted wobble speed with its
+//! interval, and the model's curve when one was fitted: the seed paper's
+//! Figure 8 (left panel) extended forward.
+
+use plotters::coord::Shift;
+use plotters::prelude::*;
+
+use super::modes::{DOT_PX, ZERO_LINE_COLOUR};
+use super::{padded_range, tick_label, Figure, FONT};
+use crate::analysis::margin::{t_975, Margin};
+
+/// One kick as drawn.
+#[derive(Clone, Debug, PartialEq)]
+pub struct KickDot {
+    /// Speed, m/s.
+    pub speed_mps: f64,
+    /// Growth rate, 1/s.
+    pub sigma_per_s: f64,
+    /// Standard uncertainty, 1/s.
+    pub sd_per_s: f64,
+    /// Whether the fit used it.
+    pub used: bool,
+}
+
+/// The figure.
+pub struct MarginPlot {
+    /// The kicks.
+    pub kicks: Vec<KickDot>,
+    /// The prediction.
+    pub margin: Margin,
+    /// The fitted model's sigma against speed, if any: `(u, sigma)`.
+    pub model_curve: Option<Vec<(f64, f64)>>,
+    /// The fitted model's wobble speed and interval, if any.
+    pub model_speed: Option<(f64, [Option<f64>; 2])>,
+}
+
+const SIZE_PX: (u32, u32) = (1000, 640);
+const USED: RGBColor = RGBColor(0x1f, 0x4e, 0x9a);
+const REJECTED: RGBColor = RGBColor(0xd6, 0x27, 0x28);
+const FIT: RGBColor = RGBColor(0x20, 0x20, 0x20);
+const BAND: RGBColor = RGBColor(0xc8, 0xd4, 0xe8);
+const MODEL: RGBColor = RGBColor(0x2c, 0xa0, 0x2c);
+const CROSSING: RGBColor = RGBColor(0xff, 0x7f, 0x0e);
+/// Points on the line and band.
+const STEPS: usize = 120;
+
+impl MarginPlot {
+    /// The speed axis: the kicks, the prediction and its interval (an open
+    /// end drawn to the axis' edge), the model's crossing.
+    fn x_range(&self) -> std::ops::Range<f64> {
+        let m = &self.margin;
+        let kicks = self.kicks.iter().map(|k| k.speed_mps);
+        let top = self.kicks.iter().map(|k| k.speed_mps).fold(0.0, f64::max);
+        // Never more than twice the fastest kick: a far prediction is
+        // written, not drawn.
+        let cap = 2.0 * top.max(1.0);
+        let ahead = [
+            m.wobble_speed_mps,
+            m.ci95_mps[0],
+            m.ci95_mps[1],
+            self.model_speed.map(|s| s.0),
+        ]
+        .into_iter()
+        .flatten()
+        .map(|v| v.min(cap));
+        let r = padded_range(kicks.chain(ahead), 1.0);
+        r.start.max(0.0)..r.end
+    }
+
+    fn band(&self, u: f64) -> Option<(f64, f64, f64)> {
+        let [a, b] = self.margin.line?;
+        let [vaa, vab, vbb] = self.margin.covariance?;
+        let t = t_975(self.margin.dof);
+        let y = a + b * u;
+        let half = t * (vaa + 2.0 * u * vab + u * u * vbb).max(0.0).sqrt();
+        Some((y, y - half, y + half))
+    }
+}
+
+impl Figure for MarginPlot {
+    fn size_px(&self) -> (u32, u32) {
+        SIZE_PX
+    }
+
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String> {
+        let err = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
+        root.fill(&WHITE).map_err(err)?;
+        let root = root
+            .titled("Damping trend of the wobble mode", (FONT, 20))
+            .map_err(err)?;
+        let x_range = self.x_range();
+        let us: Vec<f64> = (0..=STEPS)
+            .map(|i| x_range.start + (x_range.end - x_range.start) * i as f64 / STEPS as f64)
+            .collect();
+        let band: Vec<(f64, (f64, f64, f64))> = us
+            .iter()
+            .filter_map(|&u| self.band(u).map(|b| (u, b)))
+            .collect();
+        // The kicks, the line and zero set the scale; an error bar longer
+        // than that is cut at the edge.
+        let dots = self.kicks.iter().map(|k| k.sigma_per_s);
+        let model = self.model_curve.iter().flatten().map(|p| p.1);
+        let line = band.iter().map(|b| b.1 .0);
+        let y_range = padded_range(dots.chain(model).chain(line).chain([0.0]), 1.0);
+        let mut chart = ChartBuilder::on(&root)
+            .margin(16)
+            .x_label_area_size(44)
+            .y_label_area_size(64)
+            .build_cartesian_2d(x_range.clone(), y_range.clone())
+            .map_err(err)?;
+        chart
+            .configure_mesh()
+            .x_desc("speed (m/s)")
+            .y_desc("growth rate sigma (1/s)")
+            .x_label_formatter(&|v| tick_label(*v))
+            .y_label_formatter(&|v| tick_label(*v))
+            .label_style((FONT, 13))
+            .axis_desc_style((FONT, 15))
+            .draw()
+            .map_err(err)?;
+        let clip = |y: f64| y.clamp(y_range.start, y_range.end);
+        // The 95 % band of the line, then the interval of the crossing.
+        if !band.is_empty() {
+            let mut outline: Vec<(f64, f64)> = band.iter().map(|(u, b)| (*u, clip(b.2))).collect();
+            outline.extend(band.iter().rev().map(|(u, b)| (*u, clip(b.1))));
+            chart
+                .draw_series(std::iter::once(Polygon::new(
+                    outline,
+                    BAND.mix(0.6).filled(),
+                )))
+                .map_err(err)?
+                .label("fit, 95 % band")
+                .legend(|(x, y)| Rectangle::new([(x, y - 5), (x + 20, y + 5)], BAND.filled()));
+        }
+        if let [Some(lo), hi] = self.margin.ci95_mps {
+            let hi = hi.unwrap_or(x_range.end).min(x_range.end);
+            let lo = lo.max(x_range.start);
+            if hi > lo {
+                chart
+                    .draw_series(std::iter::once(Rectangle::new(
+                        [(lo, y_range.start), (hi, y_range.end)],
+                        CROSSING.mix(0.12).filled(),
+                    )))
+                    .map_err(err)?
+                    .label("wobble speed, 95 % interval")
+                    .legend(|(x, y)| {
+                        Rectangle::new([(x, y - 5), (x + 20, y + 5)], CROSSING.mix(0.3).filled())
+                    });
+            }
+        }
+        chart
+            .draw_series(std::iter::once(PathElement::new(
+                vec![(x_range.start, 0.0), (x_range.end, 0.0)],
+                ZERO_LINE_COLOUR.stroke_width(1),
+            )))
+            .map_err(err)?;
+        if !band.is_empty() {
+            let fit: Vec<(f64, f64)> = band.iter().map(|(u, b)| (*u, b.0)).collect();
+            chart
+                .draw_series(LineSeries::new(fit, FIT.stroke_width(2)))
+                .map_err(err)?
+                .label("robust straight line")
+                .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], FIT.stroke_width(2)));
+        }
+        if let Some(w) = self.margin.wobble_speed_mps.filter(|w| x_range.contains(w)) {
+            chart
+                .draw_series(std::iter::once(PathElement::new(
+                    vec![(w, y_range.start), (w, y_range.end)],
+                    CROSSING.stroke_width(2),
+                )))
+                .map_err(err)?
+                .label(format!("predicted wobble speed {w:.2} m/s"))
+                .legend(|(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 20, y)], CROSSING.stroke_width(2))
+                });
+        }
+        if let Some(curve) = &self.model_curve {
+            let label = self.model_speed.map_or("fitted model".to_string(), |s| {
+                format!("fitted model, wobble speed {:.2} m/s", s.0)
+            });
+            chart
+                .draw_series(LineSeries::new(
+                    curve.iter().map(|&(u, s)| (u, clip(s))),
+                    MODEL.stroke_width(2),
+                ))
+                .map_err(err)?
+                .label(label)
+                .legend(|(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 20, y)], MODEL.stroke_width(2))
+                });
+        }
+        for (colour, used, label) in [
+            (USED, true, "kick (±2 SD)"),
+            (REJECTED, false, "kick rejected"),
+        ] {
+            let kicks: Vec<&KickDot> = self.kicks.iter().filter(|k| k.used == used).collect();
+            if kicks.is_empty() {
+                continue;
+            }
+            chart
+                .draw_series(kicks.iter().map(|k| {
+                    PathElement::new(
+                        vec![
+                            (k.speed_mps, clip(k.sigma_per_s - 2.0 * k.sd_per_s)),
+                            (k.speed_mps, clip(k.sigma_per_s + 2.0 * k.sd_per_s)),
+                        ],
+                        colour.stroke_width(1),
+                    )
+                }))
+                .map_err(err)?;
+            chart
+                .draw_series(kicks.iter().map(|k| {
+                    Circle::new(
+                        (k.speed_mps, clip(k.sigma_per_s)),
+                        DOT_PX - 1,
+                        colour.filled(),
+                    )
+                }))
+                .map_err(err)?
+                .label(label)
+                .legend(move |(x, y)| Circle::new((x + 10, y), DOT_PX - 1, colour.filled()));
+        }
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::UpperLeft)
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .label_font((FONT, 13))
+            .draw()
+            .map_err(err)?;
+        Ok(())
+    }
+}

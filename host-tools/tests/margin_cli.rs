@@ -1,0 +1,170 @@
+//! `wobblog margin`: a hand-made campaign whose answer is written down
+//! (ring-downs decaying at `sigma = 0.5 (u - 4)`, so the wobble speed is
+//! 4 m/s), its JSON and table forms, the figure, refusals and errors.
+
+mod analysis_support;
+
+use std::f64::consts::TAU;
+use std::path::Path;
+
+use analysis_support::{wobblog, Extras, Ride};
+use serde_json::Value;
+
+/// The wobble speed of the hand-made campaign, m/s.
+const WOBBLE_MPS: f64 = 4.0;
+/// Its ring's frequency, Hz.
+const FREQ_HZ: f64 = 6.5;
+
+/// A 10 s pass at `speed` with one kick at 3 s: a 0.1 s push of 4 degrees,
+/// then a ring of 1.5 degrees decaying at `0.5 (u - 4)`, plus a weave and
+/// small deterministic noise.
+fn pass(path: &Path, speed: f64, seed: u32) {
+    let mut ride = Ride::new(10.0, speed, 0.0, 0.5, 0.0);
+    let sigma = 0.5 * (speed - WOBBLE_MPS);
+    let mut state = 0x9E37_79B9u32 ^ seed;
+    for (t, s) in ride.t_s.iter().zip(ride.steer_deg.iter_mut()) {
+        state ^= state << 13;
+        state ^= state >> 17;
+        state ^= state << 5;
+        let noise = 0.02 * (f64::from(state) / f64::from(u32::MAX) - 0.5);
+        let tau = t - 3.0;
+        let push = if (0.0..0.1).contains(&tau) {
+            4.0 * (TAU / 0.2 * tau).sin()
+        } else {
+            0.0
+        };
+        let ring = if tau >= 0.1 {
+            1.5 * (sigma * (tau - 0.1)).exp() * (TAU * FREQ_HZ * (tau - 0.1)).sin()
+        } else {
+            0.0
+        };
+        *s += push + ring + noise;
+    }
+    analysis_support::write_log(path, &ride, &Extras::default());
+}
+
+/// `speeds.len()` passes in a new directory.
+fn campaign(speeds: &[f64]) -> tempfile::TempDir {
+    let dir = tempfile::tempdir().unwrap();
+    for (i, &u) in speeds.iter().enumerate() {
+        pass(&dir.path().join(format!("RUN{i:05}.WBL")), u, i as u32);
+    }
+    dir
+}
+
+fn speeds(from: f64, to: f64, n: usize) -> Vec<f64> {
+    (0..n)
+        .map(|i| from + (to - from) * i as f64 / (n - 1) as f64)
+        .collect()
+}
+
+fn margin_json(args: &[&std::ffi::OsStr]) -> (Option<i32>, Value, String) {
+    let out = wobblog()
+        .arg("margin")
+        .args(args)
+        .arg("--json")
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+    let v = serde_json::from_slice(&out.stdout).unwrap_or(Value::Null);
+    (out.status.code(), v, stderr)
+}
+
+#[test]
+fn predicts_the_written_down_wobble_speed() {
+    let dir = campaign(&speeds(2.0, 3.4, 12));
+    let (code, v, stderr) = margin_json(&[dir.path().as_os_str()]);
+    assert_eq!(code, Some(0), "{stderr}");
+    let w = v["wobble_speed_mps"].as_f64().unwrap();
+    assert!((w - WOBBLE_MPS).abs() < 0.1, "{v}");
+    let lo = v["ci95_mps"][0].as_f64().unwrap();
+    let hi = v["ci95_mps"][1].as_f64().unwrap();
+    assert!(lo < WOBBLE_MPS && WOBBLE_MPS < hi && hi - lo < 0.6, "{v}");
+    assert_eq!(v["kicks_used"], 12);
+    assert_eq!(v["kicks_rejected"], 0);
+    assert!(v["method"].as_str().unwrap().contains("Fieller"));
+    let kicks = v["kicks"].as_array().unwrap();
+    assert_eq!(kicks.len(), 12);
+    for k in kicks {
+        let u = k["speed_mps"].as_f64().unwrap();
+        let s = k["sigma_per_s"].as_f64().unwrap();
+        assert!((s - 0.5 * (u - WOBBLE_MPS)).abs() < 0.05, "{k}");
+        assert!(
+            (k["freq_hz"].as_f64().unwrap() - FREQ_HZ).abs() < 0.05,
+            "{k}"
+        );
+        assert_eq!(k["source"], "host");
+    }
+}
+
+#[test]
+fn table_says_it_in_words_and_the_figure_is_drawn() {
+    let dir = campaign(&speeds(2.0, 3.4, 8));
+    let png = dir.path().join("trend.png");
+    let out = wobblog()
+        .arg("margin")
+        .arg(dir.path())
+        .arg("--plot")
+        .arg(&png)
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(0));
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert!(
+        text.contains("predicted wobble speed 3.9") || text.contains("predicted wobble speed 4.0"),
+        "{text}"
+    );
+    assert!(text.contains("95 % interval"), "{text}");
+    let bytes = std::fs::read(&png).unwrap();
+    assert!(bytes.starts_with(b"\x89PNG"));
+}
+
+#[test]
+fn refuses_to_pretend() {
+    // Three kicks: too few.
+    let few = campaign(&speeds(2.0, 3.0, 3));
+    let (code, v, _) = margin_json(&[few.path().as_os_str()]);
+    assert_eq!(code, Some(0));
+    assert!(v["wobble_speed_mps"].is_null(), "{v}");
+    assert!(
+        v["warnings"][0].as_str().unwrap().contains("too few"),
+        "{v}"
+    );
+    // Kicks far below it over a narrow range: a long extrapolation, open.
+    let far = campaign(&speeds(1.6, 2.1, 8));
+    let (code, v, _) = margin_json(&[far.path().as_os_str()]);
+    assert_eq!(code, Some(0));
+    assert!(v["ci95_mps"][1].is_null(), "{v}");
+    let warnings = v["warnings"].to_string();
+    assert!(
+        warnings.contains("narrow") && warnings.contains("extrapolation"),
+        "{v}"
+    );
+}
+
+#[test]
+fn errors_name_the_input() {
+    let dir = tempfile::tempdir().unwrap();
+    // An empty directory, a missing file: runtime failures naming them.
+    let (code, _, stderr) = margin_json(&[dir.path().as_os_str()]);
+    assert_eq!(code, Some(1));
+    assert!(stderr.contains("no *.WBL logs"), "{stderr}");
+    let missing = dir.path().join("RUN00001.WBL");
+    let (code, _, stderr) = margin_json(&[missing.as_os_str()]);
+    assert_eq!(code, Some(1));
+    assert!(stderr.contains("RUN00001.WBL"), "{stderr}");
+    // A figure of an unknown kind: a usage error before any work.
+    let out = wobblog()
+        .args(["margin", "x.wbl", "--plot", "trend.jpg"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    // One unreadable log among good ones: the others still count, the
+    // exit code says one failed.
+    let good = campaign(&speeds(2.0, 3.4, 8));
+    std::fs::write(good.path().join("RUN09999.WBL"), b"not a log").unwrap();
+    let (code, v, stderr) = margin_json(&[good.path().as_os_str()]);
+    assert_eq!(code, Some(1));
+    assert!(stderr.contains("RUN09999.WBL"), "{stderr}");
+    assert_eq!(v["kicks_used"], 8, "{v}");
+}
