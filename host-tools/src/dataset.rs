@@ -325,7 +325,7 @@ pub fn write_dataset(
         runs.push(RunsRow {
             entry: entry.clone(),
             row: RunRow::of(&ride),
-            first_utc_us: ride.summary.utc_syncs.first().map(|p| p.1 * 1000),
+            first_utc_us: ride.summary.first_utc_us,
             firmware: ride.summary.firmware.clone(),
         });
     }

@@ -147,6 +147,15 @@ pub fn utc_ms_at(pairs: &[SyncPair], t_s: f64) -> Option<i64> {
 const NO_UTC_FOR_WINDOW: &str =
     "the log has no UTC time (no GPS sync pair), so a UTC --from/--to cannot be placed";
 
+/// UTC at `t_s` since boot as ISO 8601, through the latest pair at or
+/// before it: what `decode`'s `utc` column gives a frame there (none before
+/// the first pair).
+#[must_use]
+pub fn utc_text_at(pairs: &[SyncPair], t_s: f64) -> Option<String> {
+    let earlier = pairs.partition_point(|p| p.0 <= t_s);
+    utc_ms_at(&pairs[..earlier], t_s).and_then(iso8601_unix_ms)
+}
+
 /// The `--from/--to` of a command.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct TimeWindow {

@@ -80,6 +80,9 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         window: args.window.window(),
     };
     export.window.check_order(&args.log)?;
+    if export.format == Format::Mcap && args.columns.is_some() {
+        say_mcap_homes(&export.columns);
+    }
     let binary = matches!(export.format, Format::Parquet | Format::Mcap);
     if binary && args.output.is_none() && std::io::stdout().is_terminal() {
         return Err(CliError::Usage(format!(
@@ -113,6 +116,21 @@ pub fn run(args: &Args) -> Result<(), CliError> {
     Ok(())
 }
 
+/// Says where each chosen column that is not a sensor field goes in MCAP,
+/// and which have no home there.
+fn say_mcap_homes(columns: &[Column]) {
+    for column in columns {
+        match crate::export::mcap::home_of(column.name) {
+            Some("its sensor channel") => {}
+            Some(home) => eprintln!("wobblog: --columns {}: in MCAP it is {home}", column.name),
+            None => eprintln!(
+                "wobblog: warning: --columns {}: MCAP has no field for it; left out",
+                column.name
+            ),
+        }
+    }
+}
+
 /// Decodes `log` into `out`; returns what could not be recovered.
 pub fn decode_to(
     log: &Path,
@@ -134,11 +152,21 @@ pub fn decode_to(
     let mut meta = LogMetadata::default();
     // Fixes and events have messages of their own only in MCAP.
     let mut events = (export.format == Format::Mcap).then(EventConverter::new);
+    if events.is_some() {
+        // MCAP log times are UTC from the first row on, placed through the
+        // first sync pair: find it before writing.
+        if let Some((t_us, unix_ms)) = first_sync_pair(log)? {
+            sink.sync_pair(t_us, unix_ms);
+        }
+    }
+    let log_name = log
+        .file_name()
+        .map_or_else(String::new, |n| n.to_string_lossy().into_owned());
     read_log(log, |event| {
         losses.observe(&event);
         meta.observe(&event);
         if let Some(e) = events.as_mut().and_then(|c| c.convert(&event)) {
-            sink.event(&e);
+            sink.event(&e, &log_name);
         }
         if let Event::Record(record) = event {
             match (&events, &record) {
@@ -147,6 +175,7 @@ pub fn decode_to(
                     if let Ok(ms) = i64::try_from(pair.unix_ms) {
                         sink.sync = vec![(pair.t_us as f64 / 1e6, ms)];
                     }
+                    sink.sync_pair(pair.t_us, pair.unix_ms);
                 }
                 _ => {}
             }
@@ -213,10 +242,24 @@ impl<W: Write + Send> WindowedSink<W> {
         self.keep(inside, |w| w.gps(fix));
     }
 
-    fn event(&mut self, event: &LogEvent) {
+    fn event(&mut self, event: &LogEvent, log_name: &str) {
         let inside = self
             .window
             .contains(event.t_s, utc_ms_at(&self.sync, event.t_s));
-        self.keep(inside, |w| w.event(event));
+        self.keep(inside, |w| w.event(event, log_name));
     }
+
+    fn sync_pair(&mut self, t_us: u64, unix_ms: u64) {
+        self.keep(true, |w| w.sync(t_us, unix_ms));
+    }
+}
+
+/// The log's first GPS sync pair (µs since boot, ms since 1970), reading
+/// only up to it.
+fn first_sync_pair(log: &Path) -> Result<Option<(u64, u64)>, CliError> {
+    let found = crate::reader::read_log_try(log, |event| match event {
+        Event::Record(Record::UtcSync(pair)) => Err((pair.t_us, pair.unix_ms)),
+        _ => Ok(()),
+    })?;
+    Ok(found.err())
 }

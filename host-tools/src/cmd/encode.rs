@@ -76,6 +76,22 @@ impl Columns {
     }
 }
 
+/// Refuses a header naming a column the log has no place for: a misspelt
+/// one (`steer` for `steer_deg`) would otherwise be silently zero.
+fn refuse_unknown_columns(header: &csv::StringRecord, in_name: &Path) -> Result<(), CliError> {
+    let known = |name: &str| CSV_COLUMNS.contains(&name) || name == UTC_COLUMN;
+    match header.iter().map(str::trim).find(|name| !known(name)) {
+        Some(name) => Err(CliError::file(
+            in_name,
+            format!(
+                "no column {name:?} in a log; the columns are {},{UTC_COLUMN} (missing ones are zero)",
+                CSV_COLUMNS.join(",")
+            ),
+        )),
+        None => Ok(()),
+    }
+}
+
 /// The sync pairs that give every row its CSV UTC back: a pair at a row
 /// whenever the last pair does not already give that row's UTC, to the
 /// millisecond as `decode` prints it (so a log decoded and encoded again
@@ -131,6 +147,7 @@ pub fn encode(
         .headers()
         .map_err(|e| CliError::file(in_name, e))?
         .clone();
+    refuse_unknown_columns(&header, in_name)?;
     let columns = Columns::new(&header);
     if columns.0[0].is_none() {
         return Err(CliError::file(

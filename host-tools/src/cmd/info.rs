@@ -100,10 +100,14 @@ fn render(path: &std::path::Path, s: &Summary) -> String {
     }
     let _ = writeln!(
         o,
-        "gps:          {} fixes, {:.1} % of samples with a position, first UTC {}",
-        s.gps_fixes,
-        s.gps_coverage_pct,
-        opt(&s.first_utc)
+        "gps:          {} fixes, {:.1} % of samples with a position",
+        s.gps_fixes, s.gps_coverage_pct,
+    );
+    let _ = writeln!(
+        o,
+        "utc:          {} to {} (frames, through the GPS sync pairs)",
+        opt(&s.first_utc),
+        opt(&s.last_utc)
     );
     let _ = writeln!(o, "alerts:       {}", s.alerts.len());
     for a in &s.alerts {

@@ -10,7 +10,7 @@ use crate::cmd::logs::{for_each_log, print_stdout, warn_losses};
 use crate::output::Output;
 use crate::plot::modes::ModePlot;
 use crate::plot::{render, ImageKind};
-use crate::time::WindowArgs;
+use crate::time::{utc_text_at, WindowArgs};
 use crate::CliError;
 
 /// Arguments of `wobblog wobble`.
@@ -39,7 +39,19 @@ pub struct RunEpisodes {
     /// Lowest speed at onset of an unstable episode, m/s.
     pub wobble_speed_mps: Option<f64>,
     /// Every episode, in time order.
-    pub episodes: Vec<Episode>,
+    pub episodes: Vec<EpisodeUtc>,
+}
+
+/// An episode and the UTC of its onset.
+#[derive(Serialize)]
+pub struct EpisodeUtc {
+    /// The episode.
+    #[serde(flatten)]
+    pub episode: Episode,
+    /// UTC at onset, ISO 8601, through the log's sync pairs (as `decode`'s
+    /// `utc` column); absent before the first pair.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub onset_utc: Option<String>,
 }
 
 /// Runs `wobblog wobble`. A log that cannot be read is reported and
@@ -63,10 +75,17 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         let mut episodes = ride.episodes.clone();
         episodes
             .retain(|e| from.is_none_or(|a| e.onset_s >= a) && to.is_none_or(|b| e.onset_s <= b));
+        let pairs = &ride.summary.utc_syncs;
         reports.push(RunEpisodes {
             log: log.display().to_string(),
             wobble_speed_mps: wobble_speed_mps(&episodes),
-            episodes,
+            episodes: episodes
+                .into_iter()
+                .map(|episode| EpisodeUtc {
+                    onset_utc: utc_text_at(pairs, episode.onset_s),
+                    episode,
+                })
+                .collect(),
         });
         names.push(ride.name());
         Ok(())
@@ -89,7 +108,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         let runs = names
             .into_iter()
             .zip(reports)
-            .map(|(name, r)| (name, r.episodes))
+            .map(|(name, r)| (name, r.episodes.into_iter().map(|e| e.episode).collect()))
             .collect();
         render(&ModePlot::new(runs), out)?;
     }
@@ -114,17 +133,22 @@ fn render_text(r: &RunEpisodes) -> String {
     if !r.episodes.is_empty() {
         let _ = writeln!(
             o,
-            "  onset_s    end_s  freq_hz  sigma_per_s  peak_amp_deg  speed_at_onset_mps  stability  censored"
+            "  onset_s  onset_utc                   end_s  freq_hz  sigma_per_s  peak_amp_deg  speed_at_onset_mps  stability  censored"
         );
     }
-    for e in &r.episodes {
+    for EpisodeUtc {
+        episode: e,
+        onset_utc,
+    } in &r.episodes
+    {
         let stability = match e.stability {
             Stability::Stable => "stable",
             Stability::Unstable => "unstable",
         };
         let line = format!(
-            "  {:7.2}  {:7.2}  {:7.2}  {:11.2}  {:12.2}  {:18.2}  {stability:<9}  {}",
+            "  {:7.2}  {:<24}  {:7.2}  {:7.2}  {:11.2}  {:12.2}  {:18.2}  {stability:<9}  {}",
             e.onset_s,
+            onset_utc.as_deref().unwrap_or("-"),
             e.end_s,
             e.freq_hz,
             e.sigma_per_s,
