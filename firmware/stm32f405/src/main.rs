@@ -27,14 +27,13 @@ use embedded_hal_bus::spi::ExclusiveDevice;
 use embedded_sdmmc::VolumeManager;
 use static_cell::StaticCell;
 use wobble_core::app::sampler::{Sampler, SamplerPorts};
-use wobble_core::app::{gps, gps_setup, sampler, writer};
+use wobble_core::app::{gps, sampler, writer};
 use wobble_core::boot;
 use wobble_core::channels::{RecordQueue, SharedStatus};
 use wobble_core::config::{self, Config, Loaded, KEY_COUNT, MAX_TEXT_LEN};
 use wobble_core::drivers::icm42688::{self, Icm42688};
-use wobble_core::format::{Fault, FaultSource, Record};
+use wobble_core::format::Record;
 use wobble_core::frame_assembly::FrameConfig;
-use wobble_core::gps::{GpsConfig, GpsReceiver};
 use wobble_core::imu::Imu;
 use wobble_core::logger::{CardLogger, FixedTime, HeaderSpec, LoggerConfig};
 use wobble_core::steering::Steering;
@@ -45,7 +44,7 @@ use wobble_stm32f405::adapters::card::SdCard;
 use wobble_stm32f405::adapters::gps::GpsAdapter;
 use wobble_stm32f405::adapters::imu::ImuAdapter;
 use wobble_stm32f405::adapters::rider::{AlertPins, MarkerButton, StatusLight};
-use wobble_stm32f405::adapters::steering::{SteeringAdapter, DMA_SAMPLES};
+use wobble_stm32f405::adapters::steering::SteeringAdapter;
 use wobble_stm32f405::adapters::wheel::WheelAdapter;
 use wobble_stm32f405::pins::{Board, Irqs};
 
@@ -61,8 +60,6 @@ static EXECUTOR_THREAD: StaticCell<Executor> = StaticCell::new();
 /// The configuration in force as text, and its lines for the log header.
 static CONFIG_TEXT: StaticCell<heapless::String<MAX_TEXT_LEN>> = StaticCell::new();
 static CONFIG_LINES: StaticCell<heapless::Vec<&'static str, KEY_COUNT>> = StaticCell::new();
-static ADC_RING: StaticCell<[u16; DMA_SAMPLES]> = StaticCell::new();
-static GPS_RING: StaticCell<[u8; adapters::gps::RING_BYTES]> = StaticCell::new();
 
 const FIRMWARE: &str = concat!(env!("CARGO_PKG_NAME"), " ", env!("CARGO_PKG_VERSION"));
 /// 100 Hz, from the sampler's period.
@@ -87,6 +84,7 @@ unsafe fn UART5() {
 
 #[entry]
 fn main() -> ! {
+    startup::guard_stack();
     // RTT needs no clock: this line appears even if the clocks never come up.
     defmt::info!("{} starting", FIRMWARE);
     let reset = startup::take_reset_cause();
@@ -100,9 +98,12 @@ fn main() -> ! {
     }
     let mut board = Board::new(embassy_stm32::init(clocks::config(crystal)));
     startup::enable_flash_accelerator();
-    let bor = startup::ensure_bor_level3();
+    let bor = boot::bor_fault(startup::bor_level());
     if let Some(code) = bor {
-        defmt::warn!("brown-out reset level 3: system fault {}", code);
+        defmt::warn!(
+            "brown-out reset below 2.7 V (system fault {}): run the self-test to program it",
+            code
+        );
     }
     let boot_faults = [
         Some(reset.fault_code()),
@@ -141,7 +142,7 @@ fn main() -> ! {
             imu: ports.imu,
             steering: ports.steering,
             wheel: ports.wheel,
-            gps: GpsAdapter::new(board.gps, GPS_RING.init([0; adapters::gps::RING_BYTES])),
+            gps: GpsAdapter::new(board.gps),
             card,
             buzzer: ports.alert.buzzer,
             alert_led: ports.alert.led,
@@ -166,7 +167,7 @@ fn main() -> ! {
 
     let _wheel_timer = adapters::wheel::start(board.wheel);
     let (sampler, ports) = sampler_parts(board.imu, board.steering, board.rider, &config);
-    let gps_port = GpsAdapter::new(board.gps, GPS_RING.init([0; adapters::gps::RING_BYTES]));
+    let gps_port = GpsAdapter::new(board.gps);
 
     interrupt::UART4.set_priority(Priority::P6);
     let high = EXECUTOR_HIGH.start(interrupt::UART4);
@@ -286,7 +287,7 @@ fn steering_adc(
 ) -> RingBufferedAdc<'static, ADC1> {
     Adc::new(adc).into_ring_buffered(
         dma,
-        ADC_RING.init([0; DMA_SAMPLES]),
+        adapters::steering::ring(),
         Irqs,
         [(wiper.degrade_adc(), SampleTime::CYCLES480)].into_iter(),
         CONTINUOUS,
@@ -312,19 +313,10 @@ async fn sampler_task(mut sampler: Sampler, mut ports: Ports) {
 
 #[embassy_executor::task]
 async fn gps_task(mut port: GpsAdapter) {
-    let outcome = gps_setup::run(&mut port, &mut |step| defmt::info!("GPS set-up: {}", step)).await;
-    defmt::info!("GPS: {}", outcome);
-    if let Some(code) = outcome.fault() {
-        let t_us = Instant::now().as_micros();
-        QUEUE.push(Record::Fault(Fault {
-            t_us,
-            source: FaultSource::Gps,
-            code,
-            count: 1,
-        }));
-    }
-    let mut receiver = GpsReceiver::new(GpsConfig::default());
-    gps::run(&mut port, &mut receiver, &QUEUE, &SHARED).await;
+    gps::run_link(&mut port, &QUEUE, &SHARED, &mut |step| {
+        defmt::info!("GPS set-up: {}", step);
+    })
+    .await;
 }
 
 #[embassy_executor::task]
