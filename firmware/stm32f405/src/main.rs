@@ -98,6 +98,9 @@ fn main() -> ! {
     }
     let mut board = Board::new(embassy_stm32::init(clocks::config(crystal)));
     startup::enable_flash_accelerator();
+    if crystal {
+        startup::enable_clock_security();
+    }
     let bor = boot::bor_fault(startup::bor_level());
     if let Some(code) = bor {
         defmt::warn!(

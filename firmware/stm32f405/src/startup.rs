@@ -216,6 +216,26 @@ unsafe fn DefaultHandler(irqn: i16) {
     defmt::error!("unexpected interrupt {}: masked", irqn);
 }
 
+/// Turns on the clock security system once the clocks run from the
+/// crystal (RM0090 6.2.7): if the crystal stops mid-ride, the hardware
+/// switches the system clock to the HSI and raises the NMI
+/// ([`NonMaskableInt`]), instead of the clocks stopping with it.
+pub fn enable_clock_security() {
+    RCC.cr().modify(|w| w.set_csson(true));
+}
+
+/// The crystal failed (the clock security system's NMI; nothing else
+/// raises it here). The CSS flag is cleared (else the NMI repeats) and the
+/// MCU resets: the boot then finds no crystal, runs the whole clock tree
+/// from the HSI and records system fault 9, so every timer, baud rate and
+/// sample time is right again instead of 16 MHz HSI under a 168 MHz set-up.
+#[exception]
+unsafe fn NonMaskableInt() {
+    RCC.cir().modify(|w| w.set_cssc(true));
+    defmt::error!("crystal failed (clock security system): reset to run from the HSI");
+    cortex_m::peripheral::SCB::sys_reset()
+}
+
 /// A panic (after panic-probe has printed it over defmt) or a fault ends
 /// here: reset, so the logger comes back and the next log records a
 /// software reset. With a probe attached, probe-rs halts on the fault
