@@ -4,7 +4,7 @@
 use std::path::Path;
 
 use assert_cmd::Command;
-use wobble_core::boot::ResetCause;
+use wobble_core::boot::{BorCheck, ResetCause};
 use wobble_core::selftest::{write_report, Measurements};
 
 fn run(path: &Path) -> (Option<i32>, String, String) {
@@ -34,6 +34,8 @@ fn a_report_is_printed_with_its_failures_named() {
         card_free_mib: 7_000,
         crystal: true,
         reset: Some(ResetCause::Watchdog),
+        bor: Some(BorCheck::Level3),
+        stack_bytes: Some((14_000, 86_000)),
     };
     let mut text = String::new();
     write_report(&m, &mut text).unwrap();
@@ -45,14 +47,16 @@ fn a_report_is_printed_with_its_failures_named() {
     assert_eq!(code, Some(1), "{stderr}");
     assert!(stderr.contains("SELFTEST.TXT: 2 checks failed"), "{stderr}");
     let lines: Vec<&str> = stdout.lines().collect();
-    assert_eq!(lines.len(), 8, "{stdout}");
+    assert_eq!(lines.len(), 10, "{stdout}");
     assert!(
         lines[0].starts_with("imu       pass  who_am_i=0x47"),
         "{stdout}"
     );
     assert!(lines[2].starts_with("wheel     FAIL  edges=0"), "{stdout}");
+    assert_eq!(lines[7], "bor       pass  level=3 (2.7 V)");
+    assert_eq!(lines[8], "stack     pass  used=14000 of 86000 bytes");
     assert_eq!(
-        lines[7],
+        lines[9],
         "failed: wheel, reset (see firmware/docs/board.md, bring-up)"
     );
     // The input is never touched.
