@@ -29,6 +29,15 @@ step "firmware for the STM32F405 board: release build, clippy, size budget"
 # `.cargo/config.toml` selects the MCU target and the size-optimised profile.
 (cd firmware/stm32f405 && cargo build --release)
 cargo clippy -p wobble-stm32f405 --target "$TARGET" -- -D warnings
+# One build, one image: a release build from anywhere but the crate's
+# directory would not get its size profile, and is refused by build.rs.
+root_build_err=$(mktemp)
+if cargo check -q --release -p wobble-stm32f405 --target "$TARGET" 2>"$root_build_err"; then
+    echo "a release build from the workspace root was not refused" >&2
+    exit 1
+fi
+grep -q "cd firmware/stm32f405 && cargo build --release" "$root_build_err"
+rm -f "$root_build_err"
 # Fails when flash > 192 KiB or static RAM > 64 KiB (firmware/docs/board.md).
 cargo run -q -p wobble-size-budget -- "${CARGO_TARGET_DIR:-target}/$TARGET/release/wobble-stm32f405"
 

@@ -175,3 +175,99 @@ fn margin_predicts_each_bicycle_within_5_percent() {
     eprintln!("{table}");
     assert_eq!(bad, 0, "{table}");
 }
+
+/// Coverage of the 95 % interval and the prediction's error over more
+/// campaigns (3 seeds on each of the four bicycles, kicks measured from
+/// each pass's steering without the card round trip, to keep it short).
+/// The straight line's bias on bicycles whose sigma bends (it
+/// under-predicts by 2 % on average) keeps the coverage below its stated
+/// rate: over 48 campaigns (seeds 100-111) 28 covered the truth and 45
+/// were within 5 % (worst -6.2 %), see `host-tools/docs/kick-testing.md`.
+/// This test guards those figures: at least half covered, none off by
+/// more than 7 %.
+#[test]
+fn interval_coverage_and_error_over_seeds() {
+    let variants = campaign::variants().unwrap();
+    let (mut covered, mut n, mut worst) = (0, 0, 0.0f64);
+    let mut table = String::new();
+    for v in &variants {
+        for seed in 100..103 {
+            let c = campaign::simulate(v, &Plan::default(), seed).unwrap();
+            let pts: Vec<KickPoint> = c
+                .passes
+                .iter()
+                .flat_map(|p| {
+                    let rows = wobble_hil::corpus::parse_rows(&p.fixture.csv).unwrap();
+                    let run = Run {
+                        t_s: rows.iter().map(|r| r.t_s).collect(),
+                        steer_deg: rows.iter().map(|r| f64::from(r.steer_deg)).collect(),
+                        speed_mps: rows.iter().map(|r| f64::from(r.speed_mps)).collect(),
+                        ..Run::default()
+                    };
+                    find_kicks(&run, WHEEL_CIRCUMFERENCE_M)
+                })
+                .map(|k| KickPoint {
+                    speed_mps: k.speed_mps,
+                    sigma_per_s: k.sigma_per_s,
+                    sigma_sd_per_s: k.sigma_sd_per_s,
+                    freq_hz: k.freq_hz,
+                })
+                .collect();
+            let m = predict(&pts);
+            let truth = c.wobble_speed_mps;
+            n += 1;
+            let inside = matches!(m.ci95_mps, [Some(lo), Some(hi)] if lo <= truth && truth <= hi);
+            covered += usize::from(inside);
+            let err = m
+                .wobble_speed_mps
+                .map_or(f64::INFINITY, |w| (w / truth - 1.0).abs());
+            worst = worst.max(err);
+            table.push_str(&format!(
+                "{} {seed}: true {truth:.3} predicted {:?} ci {:?}\n",
+                v.name, m.wobble_speed_mps, m.ci95_mps
+            ));
+        }
+    }
+    eprintln!(
+        "{table}covered {covered} of {n}; worst error {:.1} %",
+        100.0 * worst
+    );
+    assert!(2 * covered >= n, "{table}covered {covered} of {n}");
+    assert!(worst <= 0.07, "{table}worst {worst}");
+}
+
+/// `--model`: the test bicycle's file fitted (steering-head stiffness and
+/// damping) to the kicks of the test bicycle's and the damped head's
+/// campaigns gives their wobble speeds within 5 %, inside its interval.
+#[test]
+fn model_informed_estimate_finds_the_wobble_speed() {
+    let params = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../host-tools/bicycle-model/params/test-bicycle.toml");
+    let keys: Vec<String> = wobblog::cmd::margin_model::DEFAULT_PARAMS
+        .iter()
+        .map(|k| (*k).to_owned())
+        .collect();
+    for l in loaded()
+        .iter()
+        .filter(|l| ["test-bicycle", "head-damping"].contains(&l.campaign.variant.as_str()))
+    {
+        let kicks: Vec<(f64, f64, f64, f64)> = points(l)
+            .iter()
+            .map(|k| (k.speed_mps, k.freq_hz, k.sigma_per_s, k.sigma_sd_per_s))
+            .collect();
+        let m = wobblog::cmd::margin_model::estimate(&params, &keys, &kicks, 0).unwrap();
+        let truth = l.campaign.wobble_speed_mps;
+        let w = m.wobble_speed_mps.unwrap();
+        assert!(
+            (w / truth - 1.0).abs() <= 0.05,
+            "{} {truth}: {m:?}",
+            l.campaign.variant
+        );
+        let [lo, hi] = m.ci95_mps;
+        assert!(
+            lo.unwrap() <= truth && truth <= hi.unwrap(),
+            "{} {truth}: {m:?}",
+            l.campaign.variant
+        );
+    }
+}

@@ -1,8 +1,11 @@
 //! Writes the 64 MiB logs the memory and time figures in
 //! `docs/robustness.md` are measured on: a clean 7.6 h log, one block
 //! repeated through the file, a block of far-future times in front of the
-//! clean log, a log whose clock jumps a year forward every block, and a
-//! busy 7.3 h ride whose every column moves (the slowest to export).
+//! clean log, a log whose clock jumps a year forward every block, a
+//! busy 7.3 h ride whose every column moves (the slowest to export), the
+//! clean log with its blocks in reverse order (decoded in sequence order),
+//! back-to-back sync markers, and markers whose length fields pass (each
+//! one a candidate block whose CRC must be computed).
 //!
 //! ```text
 //! cargo run -p wobblog --release --example absurd_logs -- OUT_DIR
@@ -106,5 +109,9 @@ fn main() -> std::io::Result<()> {
     front.extend_from_slice(&clean[..LEN - 512]);
     write("front.wbl", &front)?;
     write("jumps.wbl", &log(1_000_000, YEAR_US, LEN))?;
+    let reversed: Vec<u8> = clean.chunks(512).rev().flatten().copied().collect();
+    write("reversed.wbl", &reversed)?;
+    write("markers.wbl", &b"WBLK".repeat(LEN / 4))?;
+    write("candidates.wbl", &b"WBLK\x01\x00\x10\x00".repeat(LEN / 8))?;
     write("busy.wbl", &busy(LEN))
 }

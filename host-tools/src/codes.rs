@@ -7,7 +7,7 @@ use wobble_core::app::sampler::{
     FAULT_IMU_BAD_SAMPLE, FAULT_IMU_NO_RESPONSE, FAULT_STEER_OVERRUN, FAULT_STEER_READ,
 };
 use wobble_core::boot::{
-    FAULT_BOR_FAILED, FAULT_BOR_PROGRAMMED, FAULT_HSE_FAILED, FAULT_RESET_BROWN_OUT,
+    FAULT_BOR_FAILED, FAULT_BOR_LOW, FAULT_BOR_PROGRAMMED, FAULT_HSE_FAILED, FAULT_RESET_BROWN_OUT,
     FAULT_RESET_LOW_POWER, FAULT_RESET_PIN, FAULT_RESET_POWER_ON, FAULT_RESET_SOFTWARE,
     FAULT_RESET_UNKNOWN, FAULT_RESET_WATCHDOG, FAULT_RESET_WINDOW_WATCHDOG,
 };
@@ -16,7 +16,7 @@ use wobble_core::config::{
     FAULT_UNREADABLE,
 };
 use wobble_core::drivers::gnss_bringup::{
-    FAULT_SETUP_SILENT, FAULT_SETUP_SLOW, FAULT_SETUP_UNCONFIRMED,
+    FAULT_RECEIVER_LOST, FAULT_SETUP_SILENT, FAULT_SETUP_SLOW, FAULT_SETUP_UNCONFIRMED,
 };
 use wobble_core::format::{DropoutReason, FaultSource};
 use wobble_core::gps::{
@@ -26,7 +26,7 @@ use wobble_core::gps::{
 use wobble_core::logger::{FAULT_CARD_ABSENT, FAULT_CARD_FULL, FAULT_CARD_WRITE};
 
 /// Every fault code the firmware records: (source, code, meaning).
-pub const FAULT_MEANINGS: [(FaultSource, u8, &str); 33] = [
+pub const FAULT_MEANINGS: [(FaultSource, u8, &str); 35] = [
     (
         FaultSource::Imu,
         FAULT_IMU_NO_RESPONSE,
@@ -76,6 +76,7 @@ pub const FAULT_MEANINGS: [(FaultSource, u8, &str); 33] = [
     (FaultSource::Gps, FAULT_SETUP_SILENT, "set-up: no valid NMEA at any baud rate (logging at 9600)"),
     (FaultSource::Gps, FAULT_SETUP_UNCONFIRMED, "set-up: no command set confirmed (logging at the receiver's own baud and rate)"),
     (FaultSource::Gps, FAULT_SETUP_SLOW, "set-up: configured, but fixes come slower than 15 Hz"),
+    (FaultSource::Gps, FAULT_RECEIVER_LOST, "receiver lost: no valid sentence for 3 s while logging; the set-up runs again"),
     (
         FaultSource::Card,
         FAULT_CARD_ABSENT,
@@ -157,12 +158,17 @@ pub const FAULT_MEANINGS: [(FaultSource, u8, &str); 33] = [
     (
         FaultSource::System,
         FAULT_BOR_PROGRAMMED,
-        "brown-out reset level was below 2.7 V and has been programmed to level 3",
+        "brown-out reset level was below 2.7 V and has been programmed to level 3 (firmware that programmed it at boot)",
     ),
     (
         FaultSource::System,
         FAULT_BOR_FAILED,
-        "programming the brown-out level failed",
+        "programming the brown-out level failed (firmware that programmed it at boot)",
+    ),
+    (
+        FaultSource::System,
+        FAULT_BOR_LOW,
+        "brown-out reset level below 2.7 V: the field self-test programs it",
     ),
 ];
 

@@ -2,6 +2,7 @@
 //! finite number the log can store, and the time column advances at the
 //! log's sample rate. Errors name the file, the line and the column.
 
+use std::io::{self, Read};
 use std::path::Path;
 
 use crate::CliError;
@@ -36,9 +37,12 @@ impl Cell<'_> {
 pub fn number_in(text: &str, range: (f64, f64), unit: &str) -> Result<f64, String> {
     let v: f64 = text
         .parse()
-        .map_err(|_| format!("is not a number: {text:?}"))?;
+        .map_err(|_| format!("is not a number: {}", echo(text)))?;
     if !v.is_finite() {
-        return Err(format!("is {text}: only finite numbers can be stored"));
+        return Err(format!(
+            "is {}: only finite numbers can be stored",
+            cut(text)
+        ));
     }
     let (lo, hi) = range;
     if !(lo..=hi).contains(&v) {
@@ -47,6 +51,84 @@ pub fn number_in(text: &str, range: (f64, f64), unit: &str) -> Result<f64, Strin
         ));
     }
     Ok(v)
+}
+
+/// Characters of a cell shown in a message; a longer cell is cut.
+const ECHO_CHARS: usize = 40;
+
+/// `text` quoted for a message, cut after [`ECHO_CHARS`] characters (with
+/// its length), its control characters escaped.
+#[must_use]
+pub fn echo(text: &str) -> String {
+    match text.char_indices().nth(ECHO_CHARS) {
+        None => format!("{text:?}"),
+        Some((end, _)) => format!("{:?}... ({} bytes)", &text[..end], text.len()),
+    }
+}
+
+/// Longest CSV line read, bytes: a line of samples is a few hundred; a
+/// longer one is not a CSV of samples and is refused before it fills memory.
+pub const LINE_MAX: usize = 1 << 20;
+
+/// A reader that fails once a line grows past [`LINE_MAX`] bytes.
+pub struct LineCap<R> {
+    inner: R,
+    /// Bytes since the last newline.
+    run: usize,
+    /// Newlines so far.
+    lines: u64,
+}
+
+impl<R: Read> LineCap<R> {
+    /// Caps the lines of `inner`.
+    pub fn new(inner: R) -> Self {
+        Self {
+            inner,
+            run: 0,
+            lines: 0,
+        }
+    }
+}
+
+impl<R: Read> Read for LineCap<R> {
+    fn read(&mut self, buf: &mut [u8]) -> io::Result<usize> {
+        let n = self.inner.read(buf)?;
+        let got = &buf[..n];
+        let (first, last) = (
+            got.iter().position(|&b| b == b'\n'),
+            got.iter().rposition(|&b| b == b'\n'),
+        );
+        let longest = match (first, last) {
+            (Some(f), Some(l)) => {
+                let before = self.run + f;
+                self.lines += got.iter().filter(|&&b| b == b'\n').count() as u64;
+                self.run = n - l - 1;
+                before
+            }
+            _ => {
+                self.run += n;
+                self.run
+            }
+        };
+        if longest.max(self.run) > LINE_MAX {
+            return Err(io::Error::new(
+                io::ErrorKind::InvalidData,
+                format!(
+                    "line {} is longer than {LINE_MAX} bytes: not a CSV of samples",
+                    self.lines + 1
+                ),
+            ));
+        }
+        Ok(n)
+    }
+}
+
+/// `text` as it is, cut like [`echo`] (for text that parsed as a number).
+fn cut(text: &str) -> String {
+    match text.char_indices().nth(ECHO_CHARS) {
+        None => crate::text::escape_controls(text).into_owned(),
+        Some((end, _)) => format!("{}... ({} bytes)", &text[..end], text.len()),
+    }
 }
 
 /// What one time step of the CSV was.
@@ -67,6 +149,11 @@ const MAX_STEP: f64 = 1.5;
 /// This many gaps in a row, each of about the same length, are a slower
 /// rate, not missing frames: a log's gaps are separated by frames.
 const SLOW_RATE_RUN: u32 = 3;
+/// Regular steps averaged to check the rate: one second at 100 Hz.
+const RATE_WINDOW: u32 = 100;
+/// Largest deviation of the average step from the frame period: 5 %
+/// (a rate of 95-105 Hz for 100 Hz; jitter of a few ms averages out).
+const RATE_TOLERANCE: f64 = 0.05;
 
 /// Follows the time column of a CSV that claims the log's sample rate.
 #[derive(Debug)]
@@ -76,6 +163,9 @@ pub struct TimeSteps {
     last: Option<(f64, u64)>,
     /// Consecutive gaps so far and the first one's length.
     gap_run: (u32, f64),
+    /// Regular steps since the rate was last checked, and the time and
+    /// line they started from.
+    regular: (u32, f64, u64),
 }
 
 impl TimeSteps {
@@ -86,6 +176,7 @@ impl TimeSteps {
             rate_hz: Some(rate_hz),
             last: None,
             gap_run: (0, 0.0),
+            regular: (0, 0.0, 0),
         }
     }
 
@@ -132,8 +223,9 @@ impl TimeSteps {
         }
         if dt <= MAX_STEP * period {
             self.gap_run = (0, 0.0);
-            return Ok(Step::Regular);
+            return self.regular_step(t_s, prev, prev_line, line, rate_hz);
         }
+        self.regular = (0, 0.0, 0);
         let (run, first) = self.gap_run;
         self.gap_run = if run > 0 && (dt - first).abs() < 0.25 * first {
             (run + 1, first)
@@ -151,10 +243,80 @@ impl TimeSteps {
     }
 }
 
+impl TimeSteps {
+    /// Counts a regular step; every [`RATE_WINDOW`] of them in a row, their
+    /// average must be the frame period: steps each within the tolerated
+    /// jitter can still add up to another rate (133 Hz passes 0.75 period
+    /// steps one by one).
+    fn regular_step(
+        &mut self,
+        t_s: f64,
+        prev: f64,
+        prev_line: u64,
+        line: u64,
+        rate_hz: f64,
+    ) -> Result<Step, String> {
+        let (n, from, from_line) = self.regular;
+        let (n, from, from_line) = if n == 0 {
+            (1, prev, prev_line)
+        } else {
+            (n + 1, from, from_line)
+        };
+        self.regular = (n, from, from_line);
+        if n < RATE_WINDOW {
+            return Ok(Step::Regular);
+        }
+        self.regular = (0, 0.0, 0);
+        let mean = (t_s - from) / f64::from(n);
+        let period = 1.0 / rate_hz;
+        if (mean - period).abs() > RATE_TOLERANCE * period {
+            return Err(format!(
+                "steps by {mean:.6} s on average from line {from_line} to line {line}, about \
+                 {:.0} Hz, but a log is sampled at {rate_hz} Hz (`encode --resample` resamples it)",
+                1.0 / mean
+            ));
+        }
+        Ok(Step::Regular)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use proptest::prelude::*;
+
+    #[test]
+    fn a_rate_each_step_of_which_passes_is_refused_by_its_average() {
+        for hz in [67.0, 80.0, 90.0, 110.0, 133.0] {
+            let times: Vec<f64> = (0..300).map(|i| f64::from(i) / hz).collect();
+            let (i, e) = steps(&times).unwrap_err();
+            assert_eq!(i, 100, "{hz} Hz");
+            assert!(
+                e.contains(&format!("{hz:.0} Hz")) && e.contains("line 2"),
+                "{e}"
+            );
+        }
+        for hz in [96.0, 100.0, 104.0] {
+            let times: Vec<f64> = (0..300).map(|i| f64::from(i) / hz).collect();
+            assert!(steps(&times).is_ok(), "{hz} Hz");
+        }
+    }
+
+    #[test]
+    fn a_long_line_is_refused_and_a_long_cell_is_cut_in_messages() {
+        let mut text = b"t_s,steer_deg\n0,1\n".to_vec();
+        text.extend(std::iter::repeat_n(b'7', LINE_MAX + 10));
+        let mut read = Vec::new();
+        let e = LineCap::new(&text[..]).read_to_end(&mut read).unwrap_err();
+        assert!(e.to_string().contains("line 3 is longer than"), "{e}");
+        let mut ok = Vec::new();
+        LineCap::new(&text[..LINE_MAX])
+            .read_to_end(&mut ok)
+            .unwrap();
+        let long = "x".repeat(10_000);
+        let e = number_in(&long, (0.0, 1.0), "").unwrap_err();
+        assert!(e.len() < 100 && e.contains("10000 bytes"), "{e}");
+    }
 
     fn steps(times: &[f64]) -> Result<Vec<Step>, (usize, String)> {
         let mut t = TimeSteps::new(100.0);

@@ -93,7 +93,7 @@ pub fn campaign_logs(dir: &Path) -> Result<Vec<LogEntry>, CliError> {
             if let Some(twin) = entries.iter().find(|e| e.partition() == entry.partition()) {
                 return Err(CliError::file(
                     &entry.path,
-                    format!("the same run number as {}", twin.path.display()),
+                    format!("the same run number as {}", crate::text::shown(&twin.path)),
                 ));
             }
             entries.push(entry);
@@ -325,7 +325,7 @@ pub fn write_dataset(
         runs.push(RunsRow {
             entry: entry.clone(),
             row: RunRow::of(&ride),
-            first_utc_us: ride.summary.utc_syncs.first().map(|p| p.1 * 1000),
+            first_utc_us: ride.summary.first_utc_us,
             firmware: ride.summary.firmware.clone(),
         });
     }

@@ -149,7 +149,7 @@ pub fn cause_name(cause: SkipCause) -> &'static str {
         SkipCause::BadHeader => "bad block header",
         SkipCause::Garbage => "garbage",
         SkipCause::TruncatedTail => "truncated tail",
-        SkipCause::Repeated => "repeated or stale blocks, decoded once",
+        SkipCause::Repeated => "copies of blocks decoded once",
     }
 }
 
@@ -163,5 +163,13 @@ pub fn out_of_range_text(what: OutOfRange) -> String {
         ),
         OutOfRange::GpsFields(n) => format!("{n} GPS values out of range dropped"),
         OutOfRange::UtcSync => "UTC sync outside 2000-2099 dropped".into(),
+        OutOfRange::FrameSpacing {
+            stated_hz,
+            spacing_us,
+        } => format!(
+            "the header states {stated_hz} Hz but frames come every {spacing_us} us \
+             (about {:.0} Hz): rates, distances and frequencies taken from the header are off",
+            1e6 / f64::from(spacing_us.max(1))
+        ),
     }
 }

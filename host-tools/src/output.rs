@@ -321,8 +321,8 @@ fn refuse_inputs(target: &Path, inputs: &[&Path]) -> Result<(), CliError> {
         if same_file::is_same_file(target, input).unwrap_or(false) {
             return Err(CliError::Usage(format!(
                 "{}: the output is the input {}; refusing to overwrite it",
-                target.display(),
-                input.display()
+                crate::text::shown(target),
+                crate::text::shown(input)
             )));
         }
     }

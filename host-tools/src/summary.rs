@@ -7,7 +7,7 @@ use wobble_core::format::{DecodeStats, Event, Record};
 
 use crate::losses::Losses;
 use crate::rows::{Row, RowAssembler};
-use crate::text::escape_controls;
+use crate::time::iso8601_unix_ms;
 
 /// One wobble alert, from its switching on to its switching off.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
@@ -75,8 +75,14 @@ pub struct Summary {
     pub gps_fixes: u64,
     /// Share of frames with a GPS position, percent.
     pub gps_coverage_pct: f64,
-    /// First UTC time seen, ISO 8601.
+    /// UTC of the first frame that has one (through the GPS sync pairs,
+    /// as `decode`'s `utc` column), ISO 8601.
     pub first_utc: Option<String>,
+    /// UTC of the last frame that has one, ISO 8601.
+    pub last_utc: Option<String>,
+    /// [`Self::first_utc`] in µs since 1970.
+    #[serde(skip)]
+    pub first_utc_us: Option<i64>,
     /// Wobble alerts.
     pub alerts: Vec<AlertSpan>,
     /// Rider markers, s.
@@ -133,7 +139,26 @@ pub struct SummaryBuilder {
     /// Frames of the current segment.
     segment_frames: u64,
     rows: RowAssembler,
-    rows_with_gps: u64,
+    row_stats: RowStats,
+}
+
+/// What the summary takes from the decoded rows.
+#[derive(Default)]
+struct RowStats {
+    with_gps: u64,
+    /// The `utc` of the first and last row that has one, µs since 1970.
+    first_utc_us: Option<i64>,
+    last_utc_us: Option<i64>,
+}
+
+impl RowStats {
+    fn take(&mut self, row: &Row) {
+        self.with_gps += u64::from(row.gps.is_some());
+        if let Some(us) = row.utc_us {
+            self.first_utc_us.get_or_insert(us);
+            self.last_utc_us = Some(us);
+        }
+    }
 }
 
 impl SummaryBuilder {
@@ -163,12 +188,7 @@ impl SummaryBuilder {
                 let first = self.span_us.map_or(f.t_us, |(first, _)| first);
                 self.span_us = Some((first, f.t_us));
             }
-            Record::Gps(fix) => {
-                s.gps_fixes += 1;
-                if s.first_utc.is_none() {
-                    s.first_utc = fix.utc.map(crate::time::iso8601);
-                }
-            }
+            Record::Gps(_) => s.gps_fixes += 1,
             Record::UtcSync(sync) => {
                 if let Ok(ms) = i64::try_from(sync.unix_ms) {
                     s.utc_syncs.push((t_s, ms));
@@ -194,19 +214,18 @@ impl SummaryBuilder {
                 *s.faults.entry(f.source.as_str()).or_default() += u64::from(f.count.max(1))
             }
             Record::LogInfo(info) => {
-                s.firmware = Some(escape_controls(info.firmware).into_owned());
+                // Kept as written; text output escapes it (JSON has its own escapes).
+                s.firmware = Some(info.firmware.to_string());
                 s.device_id = Some(info.device_id.iter().map(|b| format!("{b:02x}")).collect());
                 s.run = Some(info.run);
                 s.sample_rate_hz = Some(info.sample_rate_hz);
             }
             // `wobblog events` lists the kicks.
             Record::Channel(_) | Record::Kick(_) => {}
-            Record::Config(line) => s.config.push(escape_controls(line.text).into_owned()),
+            Record::Config(line) => s.config.push(line.text.to_string()),
         }
-        let with_gps = &mut self.rows_with_gps;
-        self.rows.push(record, &mut |row: &Row| {
-            *with_gps += u64::from(row.gps.is_some())
-        });
+        let stats = &mut self.row_stats;
+        self.rows.push(record, &mut |row: &Row| stats.take(row));
     }
 
     /// The frame rate the log has given so far (see
@@ -240,16 +259,19 @@ impl SummaryBuilder {
     /// The summary, given the decoder's totals.
     #[must_use]
     pub fn finish(mut self, stats: &DecodeStats) -> Summary {
-        let with_gps = &mut self.rows_with_gps;
-        self.rows
-            .finish(&mut |row: &Row| *with_gps += u64::from(row.gps.is_some()));
+        let row_stats = &mut self.row_stats;
+        self.rows.finish(&mut |row: &Row| row_stats.take(row));
         self.close_segment();
         let mut s = self.summary;
+        let utc_text = |us: Option<i64>| us.and_then(|us| iso8601_unix_ms(us.div_euclid(1000)));
+        s.first_utc = utc_text(self.row_stats.first_utc_us);
+        s.first_utc_us = self.row_stats.first_utc_us;
+        s.last_utc = utc_text(self.row_stats.last_utc_us);
         s.duration_s = self.closed_us as f64 / 1e6;
         s.gps_coverage_pct = if s.samples == 0 {
             0.0
         } else {
-            100.0 * self.rows_with_gps as f64 / s.samples as f64
+            100.0 * self.row_stats.with_gps as f64 / s.samples as f64
         };
         s.lost_blocks = stats.blocks_lost;
         s.frames_lost = stats.frames_lost;

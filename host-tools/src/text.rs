@@ -31,8 +31,8 @@ fn needs_escape(c: char) -> bool {
 /// A file name as messages show it: [`escape_controls`] of its text, so a
 /// name cannot forge lines or send a terminal commands.
 #[must_use]
-pub fn shown(path: &std::path::Path) -> String {
-    escape_controls(&path.to_string_lossy()).into_owned()
+pub fn shown(path: impl AsRef<std::path::Path>) -> String {
+    escape_controls(&path.as_ref().to_string_lossy()).into_owned()
 }
 
 #[cfg(test)]

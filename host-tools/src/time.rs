@@ -53,6 +53,19 @@ pub fn parse_iso8601(text: &str) -> Option<i64> {
     }
     let milli = format!("{frac:0<3}")[..3].parse::<u32>().ok()?;
     let days = UtcTime::days_from_date(i32::try_from(year).ok()?, month, day)?;
+    // A leap second only where one can be: 23:59:60 at the end of a month
+    // that can end with one (June or December, say), not on any day.
+    let ms_of_day = ((h * 60 + m) * 60 + s) * 1000 + milli;
+    let leap_ok = h == 23
+        && m == 59
+        && UtcTime {
+            days_since_2000: days,
+            ms_of_day,
+        }
+        .is_valid();
+    if s == 60 && !leap_ok {
+        return None;
+    }
     Some(
         UNIX_MS_AT_2000
             + i64::from(days) * MS_PER_DAY
@@ -134,6 +147,15 @@ pub fn utc_ms_at(pairs: &[SyncPair], t_s: f64) -> Option<i64> {
 const NO_UTC_FOR_WINDOW: &str =
     "the log has no UTC time (no GPS sync pair), so a UTC --from/--to cannot be placed";
 
+/// UTC at `t_s` since boot as ISO 8601, through the latest pair at or
+/// before it: what `decode`'s `utc` column gives a frame there (none before
+/// the first pair).
+#[must_use]
+pub fn utc_text_at(pairs: &[SyncPair], t_s: f64) -> Option<String> {
+    let earlier = pairs.partition_point(|p| p.0 <= t_s);
+    utc_ms_at(&pairs[..earlier], t_s).and_then(iso8601_unix_ms)
+}
+
 /// The `--from/--to` of a command.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct TimeWindow {
@@ -195,7 +217,7 @@ impl TimeWindow {
         if reversed {
             return Err(crate::CliError::Usage(format!(
                 "{}: the window {} ends before it starts, so it selects nothing",
-                log.display(),
+                crate::text::shown(log),
                 self.describe()
             )));
         }
@@ -257,7 +279,7 @@ impl TimeWindow {
             if a >= b {
                 return Err(crate::CliError::Usage(format!(
                     "{}: the window {} ends before it starts ({a:.3} to {b:.3} s since boot), so it selects nothing",
-                    log.display(),
+                    crate::text::shown(log),
                     self.describe()
                 )));
             }
@@ -309,6 +331,14 @@ mod tests {
         assert_eq!(parse_iso8601("2000-01-01T00:00:00Z"), Some(946_684_800_000));
         assert_eq!(parse_iso8601("2020-13-18T13:28:20Z"), None);
         assert_eq!(parse_iso8601("2020-03-18T25:28:20Z"), None);
+        assert_eq!(parse_iso8601("2026-02-30T10:00:00Z"), None);
+        assert_eq!(parse_iso8601("2026-02-14T23:59:60Z"), None);
+        assert_eq!(parse_iso8601("2016-12-31T12:00:60Z"), None);
+        assert_eq!(
+            parse_iso8601("2016-12-31T23:59:60Z"),
+            Some(1_483_228_800_000),
+            "the instant 2017 began, in Unix time"
+        );
         assert_eq!(parse_iso8601("yesterday"), None);
         assert_eq!("12.5".parse::<TimeBound>(), Ok(TimeBound::Boot(12.5)));
         assert!("inf".parse::<TimeBound>().is_err());

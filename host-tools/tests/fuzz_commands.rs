@@ -197,7 +197,7 @@ fn every_log_command(path: &Path, dir: &Path) {
     let _ = detect::replay_log(path, &wobble_core::config::Config::default());
     let mut track = gpx::Gpx::new(std::io::sink(), "fuzz");
     let walked = gpx::track(path, TimeWindow::default(), |step| {
-        if let gpx::Step::Point(fix) = step {
+        if let gpx::Step::Point(fix, _) = step {
             let (lat, lon) = (fix.lat_e7.unwrap_or(0), fix.lon_e7.unwrap_or(0));
             assert!(lat.unsigned_abs() <= 900_000_000 && lon.unsigned_abs() <= 1_800_000_000);
             assert!(fix.utc.is_none_or(UtcTime::is_valid));

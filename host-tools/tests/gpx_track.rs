@@ -116,7 +116,7 @@ fn the_track_is_walked_as_read_and_stops_at_the_first_failed_write() {
         let (mut points, mut breaks) = (0, 0);
         let walked = track(&log, Default::default(), |step| {
             match step {
-                Step::Point(_) => points += 1,
+                Step::Point(..) => points += 1,
                 Step::Break => breaks += 1,
             }
             if points == stop_after {

@@ -1,135 +1,264 @@
-//! `wobblog decode --format mcap`, read back with the `mcap` crate: a
-//! channel per sensor group with its JSON schema, the GPS as
-//! `foxglove.LocationFix`, the events on their own channel, the metadata.
+//! `wobblog decode --format mcap`, read back with the `mcap` crate as
+//! Foxglove reads it: zstd chunks, a CDR channel per sensor group with its
+//! ROS 2 message definition, the GPS as `foxglove.LocationFix`, the events as
+//! `foxglove.Log`, log times in UTC nanoseconds, the metadata.
 
 mod analysis_support;
 
 use std::collections::BTreeMap;
 
-use analysis_support::{gps_fix, wobblog, START_LAT_DEG};
+use analysis_support::{
+    gps_fix, wobblog, write_log, Extras, Ride, LON_DEG, START_LAT_DEG, UTC_AT_BOOT_MS,
+};
 
-fn json(data: &[u8]) -> serde_json::Value {
-    serde_json::from_slice(data).unwrap()
+/// One message as read back.
+struct Message {
+    log_time: u64,
+    publish_time: u64,
+    schema: String,
+    encoding: String,
+    data: Vec<u8>,
+}
+
+impl Message {
+    fn json(&self) -> serde_json::Value {
+        assert_eq!(self.encoding, "json");
+        serde_json::from_slice(&self.data).unwrap()
+    }
+
+    /// The float64 fields of a CDR message, after its encapsulation header.
+    fn cdr_f64(&self) -> Vec<f64> {
+        assert_eq!(self.encoding, "cdr");
+        assert_eq!(self.data[..4], [0, 1, 0, 0], "plain CDR, little-endian");
+        self.data[4..]
+            .chunks(8)
+            .map(|b| f64::from_le_bytes(b.try_into().unwrap()))
+            .collect()
+    }
+}
+
+/// Messages by topic, in file order; each topic's times must go forward.
+fn read_back(bytes: &[u8]) -> BTreeMap<String, Vec<Message>> {
+    let mut by_topic: BTreeMap<String, Vec<Message>> = BTreeMap::new();
+    for message in mcap::MessageStream::new(bytes).unwrap() {
+        let message = message.unwrap();
+        let schema = message.channel.schema.as_ref().unwrap();
+        let list = by_topic.entry(message.channel.topic.clone()).or_default();
+        if let Some(last) = list.last() {
+            assert!(
+                message.log_time >= last.log_time,
+                "{}",
+                message.channel.topic
+            );
+        }
+        list.push(Message {
+            log_time: message.log_time,
+            publish_time: message.publish_time,
+            schema: format!(
+                "{} {}: {}",
+                schema.encoding,
+                schema.name,
+                String::from_utf8_lossy(&schema.data)
+            ),
+            encoding: message.channel.message_encoding.clone(),
+            data: message.data.into_owned(),
+        });
+    }
+    by_topic
+}
+
+fn decode(log: &std::path::Path, out: &std::path::Path, extra: &[&str]) -> Vec<u8> {
+    let result = wobblog()
+        .arg("decode")
+        .arg(log)
+        .arg("-o")
+        .arg(out)
+        .args(extra)
+        .output()
+        .unwrap();
+    assert!(
+        result.status.success(),
+        "{}",
+        String::from_utf8_lossy(&result.stderr)
+    );
+    std::fs::read(out).unwrap()
+}
+
+/// UTC of `t_s` since boot in the synthetic logs, ns since 1970.
+fn utc_ns(t_s: f64) -> u64 {
+    (UTC_AT_BOOT_MS as u64) * 1_000_000 + (t_s * 1e9).round() as u64
 }
 
 #[test]
-fn mcap_has_every_frame_fix_and_event_on_its_channel() {
+fn mcap_is_compressed_in_utc_with_every_frame_fix_and_event_on_its_channel() {
     let dir = tempfile::tempdir().unwrap();
     let log = dir.path().join("RUN00003.WBL");
     let (ride, extras) = analysis_support::standard_log(&log);
-    let out = dir.path().join("run.mcap");
-    wobblog()
-        .arg("decode")
-        .arg(&log)
-        .arg("-o")
-        .arg(&out)
-        .assert()
-        .success();
-    let bytes = std::fs::read(&out).unwrap();
-
-    let mut by_topic: BTreeMap<String, Vec<serde_json::Value>> = BTreeMap::new();
-    let mut last_ns: BTreeMap<String, u64> = BTreeMap::new();
-    for message in mcap::MessageStream::new(&bytes).unwrap() {
-        let message = message.unwrap();
-        let topic = message.channel.topic.clone();
-        let schema = message.channel.schema.as_ref().unwrap();
-        assert_eq!(schema.encoding, "jsonschema");
-        assert_eq!(message.channel.message_encoding, "json");
-        if topic == "/gps" {
-            assert_eq!(schema.name, "foxglove.LocationFix");
-        }
-        // Times go forward on each channel.
-        let last = last_ns.entry(topic.clone()).or_insert(0);
-        assert!(message.log_time >= *last, "{topic}");
-        *last = message.log_time;
-        by_topic.entry(topic).or_default().push(json(&message.data));
-    }
-    let frames = ride.t_s.len();
-    assert_eq!(by_topic["/imu"].len(), frames);
-    assert_eq!(by_topic["/steering"].len(), frames);
-    assert_eq!(by_topic["/wheel"].len(), frames);
-    assert_eq!(by_topic["/wheel"][0]["speed_mps"], 5.0);
-    let fixes_with_position = (0..frames)
-        .filter_map(|i| gps_fix(&ride, i, &extras))
-        .filter(|f| f.lat_e7.is_some())
-        .count();
-    assert_eq!(by_topic["/gps"].len(), fixes_with_position);
-    let first_fix = &by_topic["/gps"][0];
-    assert_eq!(first_fix["latitude"], START_LAT_DEG);
-    assert_eq!(first_fix["timestamp"]["sec"], 1_584_525_601u64);
-    let kinds: Vec<&str> = by_topic["/events"]
-        .iter()
-        .map(|e| e["event"].as_str().unwrap())
-        .collect();
-    assert_eq!(kinds, ["marker", "alert_on", "alert_off", "marker"]);
+    let bytes = decode(&log, &dir.path().join("run.mcap"), &[]);
+    let by_topic = read_back(&bytes);
 
     let summary = mcap::Summary::read(&bytes).unwrap().unwrap();
+    assert!(!summary.chunk_indexes.is_empty());
+    for chunk in &summary.chunk_indexes {
+        assert_eq!(chunk.compression, "zstd");
+        assert!(chunk.compressed_size < chunk.uncompressed_size / 2);
+    }
     assert_eq!(summary.channels.len(), 5);
-    let index = &summary.metadata_indexes[0];
-    let meta = mcap::read::metadata(&bytes, index).unwrap();
+
+    let frames = ride.t_s.len();
+    let imu = &by_topic["/imu"];
+    assert_eq!(imu.len(), frames);
+    assert_eq!(by_topic["/steering"].len(), frames);
+    assert_eq!(by_topic["/wheel"].len(), frames);
+    assert!(imu[0]
+        .schema
+        .starts_with("ros2msg wobblog_msgs/msg/Imu: float64 ax_g\nfloat64 ay_g\nfloat64 az_g\n"));
+    // Every frame in UTC, to the nanosecond, with its time since boot as
+    // the publish time; the values are the frame's.
+    for (i, message) in imu.iter().enumerate() {
+        let t = ride.t_s[i];
+        assert_eq!(message.log_time, utc_ns(t), "frame {i}");
+        assert_eq!(message.publish_time, (t * 1e9).round() as u64);
+        let values = message.cdr_f64();
+        assert_eq!(values.len(), 6);
+        for axis in 0..3 {
+            assert!(
+                (values[axis] - ride.accel_g[i][axis]).abs() < 1e-3,
+                "frame {i}"
+            );
+            assert!(
+                (values[3 + axis] - ride.gyro_dps[i][axis]).abs() < 0.05,
+                "frame {i}"
+            );
+        }
+    }
+    assert_eq!(by_topic["/wheel"][0].cdr_f64(), [5.0]);
+    let steer = by_topic["/steering"][100].cdr_f64()[0];
+    assert!((steer - ride.steer_deg[100]).abs() < 0.01);
+
+    let fixes: Vec<_> = (0..frames)
+        .filter_map(|i| gps_fix(&ride, i, &extras))
+        .filter(|f| f.lat_e7.is_some())
+        .collect();
+    let gps = &by_topic["/gps"];
+    assert_eq!(gps.len(), fixes.len());
+    assert!(gps[0].schema.starts_with("jsonschema foxglove.LocationFix"));
+    for (message, fix) in gps.iter().zip(&fixes) {
+        let body = message.json();
+        // Latitude and longitude each their own value.
+        let lat = f64::from(fix.lat_e7.unwrap()) / 1e7;
+        let lon = f64::from(fix.lon_e7.unwrap()) / 1e7;
+        assert!((body["latitude"].as_f64().unwrap() - lat).abs() < 1e-9);
+        assert!((body["longitude"].as_f64().unwrap() - lon).abs() < 1e-9);
+        let t = fix.t_us as f64 / 1e6;
+        assert_eq!(message.log_time, utc_ns(t));
+        let stamp = body["timestamp"]["sec"].as_u64().unwrap() * 1_000_000_000
+            + body["timestamp"]["nsec"].as_u64().unwrap();
+        assert_eq!(stamp, message.log_time);
+    }
+    let first = gps[0].json();
+    assert!((first["latitude"].as_f64().unwrap() - START_LAT_DEG).abs() < 1e-6);
+    assert!((first["longitude"].as_f64().unwrap() - LON_DEG).abs() < 1e-9);
+
+    // The events in Foxglove's Log panel: alerts warn.
+    let events = &by_topic["/events"];
+    assert!(events[0].schema.starts_with("jsonschema foxglove.Log"));
+    let logged: Vec<(String, u64)> = events
+        .iter()
+        .map(|m| {
+            let body = m.json();
+            let stamp = body["timestamp"]["sec"].as_u64().unwrap() * 1_000_000_000
+                + body["timestamp"]["nsec"].as_u64().unwrap();
+            assert_eq!(stamp, m.log_time);
+            assert_eq!(body["file"], "RUN00003.WBL");
+            (
+                body["name"].as_str().unwrap().to_string(),
+                body["level"].as_u64().unwrap(),
+            )
+        })
+        .collect();
+    let expected = [
+        ("marker", 2),
+        ("alert_on", 3),
+        ("alert_off", 2),
+        ("marker", 2),
+    ];
+    let expected: Vec<(String, u64)> = expected.iter().map(|(n, l)| (n.to_string(), *l)).collect();
+    assert_eq!(logged, expected);
+    assert_eq!(events[0].log_time, utc_ns(5.0));
+    assert!(events[1].json()["message"]
+        .as_str()
+        .unwrap()
+        .starts_with("alert_on at 16."));
+
+    let meta = mcap::read::metadata(&bytes, &summary.metadata_indexes[0]).unwrap();
     assert_eq!(meta.name, "wobblog");
     assert_eq!(meta.metadata["run"], "3");
     assert_eq!(meta.metadata["first_utc"], "2020-03-18T10:00:01.000Z");
 }
 
-/// Messages by topic, and each topic's JSON Schema, of an MCAP file.
-fn read_back(
-    bytes: &[u8],
-) -> (
-    BTreeMap<String, Vec<serde_json::Value>>,
-    BTreeMap<String, serde_json::Value>,
-) {
-    let mut by_topic: BTreeMap<String, Vec<serde_json::Value>> = BTreeMap::new();
-    let mut schemas = BTreeMap::new();
-    for message in mcap::MessageStream::new(bytes).unwrap() {
-        let message = message.unwrap();
-        let topic = message.channel.topic.clone();
-        let schema = message.channel.schema.as_ref().unwrap();
-        schemas.insert(topic.clone(), json(&schema.data));
-        by_topic.entry(topic).or_default().push(json(&message.data));
+#[test]
+fn a_log_without_utc_keeps_the_loggers_clock() {
+    let dir = tempfile::tempdir().unwrap();
+    let log = dir.path().join("RUN00001.WBL");
+    let ride = Ride::new(5.0, 5.0, 0.0, 0.0, 0.0);
+    write_log(&log, &ride, &Extras::default());
+    let by_topic = read_back(&decode(&log, &dir.path().join("run.mcap"), &[]));
+    for (message, t) in by_topic["/imu"].iter().zip(&ride.t_s) {
+        assert_eq!(message.log_time, (t * 1e9).round() as u64);
+        assert_eq!(message.publish_time, message.log_time);
     }
-    (by_topic, schemas)
 }
 
 #[test]
-fn columns_choose_the_fields_and_channels() {
+fn columns_choose_the_fields_and_channels_and_say_where_the_rest_go() {
     let dir = tempfile::tempdir().unwrap();
     let log = dir.path().join("RUN00003.WBL");
     let (ride, _) = analysis_support::standard_log(&log);
-    let decode = |columns: &str, name: &str| {
-        let out = dir.path().join(name);
-        wobblog()
-            .arg("decode")
-            .arg(&log)
-            .args(["--columns", columns, "-o"])
-            .arg(&out)
-            .assert()
-            .success();
-        std::fs::read(&out).unwrap()
-    };
-    let keys =
-        |v: &serde_json::Value| -> Vec<String> { v.as_object().unwrap().keys().cloned().collect() };
-
-    let bytes = decode("t_s,steer_deg,gz_dps,gx_dps,gps_lat_deg", "some.mcap");
-    let (by_topic, schemas) = read_back(&bytes);
+    let out = dir.path().join("some.mcap");
+    let result = wobblog()
+        .arg("decode")
+        .arg(&log)
+        .args([
+            "--columns",
+            "t_s,steer_deg,gz_dps,gx_dps,gps_lat_deg,gps_fix,utc",
+            "-o",
+        ])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(result.status.success());
+    let stderr = String::from_utf8_lossy(&result.stderr);
+    assert!(
+        stderr.contains("--columns utc: in MCAP it is every message's log time"),
+        "{stderr}"
+    );
+    assert!(
+        stderr.contains("--columns t_s: in MCAP it is every message's publish time"),
+        "{stderr}"
+    );
+    assert!(
+        stderr.contains("warning: --columns gps_fix: MCAP has no field for it"),
+        "{stderr}"
+    );
+    let bytes = std::fs::read(&out).unwrap();
+    let by_topic = read_back(&bytes);
     let topics: Vec<&str> = by_topic.keys().map(String::as_str).collect();
     assert_eq!(topics, ["/events", "/gps", "/imu", "/steering"]);
-    // Only the chosen fields, in schema and message, in the order chosen
-    // (the messages are stored uncompressed).
-    assert_eq!(keys(&by_topic["/imu"][0]), ["gx_dps", "gz_dps"]);
-    let raw = |needle: &str| bytes.windows(needle.len()).any(|w| w == needle.as_bytes());
-    assert!(raw("{\"gz_dps\":") && !raw("{\"gx_dps\":"));
-    assert_eq!(
-        schemas["/imu"]["properties"]
-            .as_object()
-            .unwrap()
-            .keys()
-            .collect::<Vec<_>>(),
-        ["gx_dps", "gz_dps"]
+    // Only the chosen fields, in schema and message, in the order chosen.
+    let imu = &by_topic["/imu"];
+    assert!(
+        imu[0]
+            .schema
+            .ends_with(": float64 gz_dps\nfloat64 gx_dps\n"),
+        "{}",
+        imu[0].schema
     );
-    assert_eq!(keys(&by_topic["/steering"][0]), ["steer_deg"]);
-    assert_eq!(by_topic["/imu"].len(), ride.t_s.len());
-    assert_eq!(by_topic["/gps"][0]["latitude"], START_LAT_DEG);
+    assert_eq!(imu.len(), ride.t_s.len());
+    let values = imu[10].cdr_f64();
+    assert!((values[0] - ride.gyro_dps[10][2]).abs() < 0.05);
+    assert!((values[1] - ride.gyro_dps[10][0]).abs() < 0.05);
+    assert_eq!(by_topic["/steering"][0].cdr_f64().len(), 1);
     let summary = mcap::Summary::read(&bytes).unwrap().unwrap();
     assert_eq!(summary.channels.len(), 4);
     let meta = mcap::read::metadata(&bytes, &summary.metadata_indexes[0]).unwrap();
@@ -137,8 +266,12 @@ fn columns_choose_the_fields_and_channels() {
     assert!(!meta.metadata.contains_key("unit.ax_g"));
 
     // One field: its channel and the events, no map.
-    let (by_topic, _) = read_back(&decode("speed_mps", "speed.mcap"));
+    let by_topic = read_back(&decode(
+        &log,
+        &dir.path().join("speed.mcap"),
+        &["--columns", "speed_mps"],
+    ));
     let topics: Vec<&str> = by_topic.keys().map(String::as_str).collect();
     assert_eq!(topics, ["/events", "/wheel"]);
-    assert_eq!(by_topic["/wheel"][0]["speed_mps"], 5.0);
+    assert_eq!(by_topic["/wheel"][0].cdr_f64(), [5.0]);
 }

@@ -277,3 +277,48 @@ fn censored_episodes_are_compared_but_never_fitted() {
         .contains("0 episodes cannot determine 1 parameters"));
     assert!(!dir.path().join("fitted.toml").exists());
 }
+
+#[test]
+fn eig_no_slip_has_the_eight_states_of_the_constrained_bicycle() {
+    let out = model("eig", "test-bicycle.toml")
+        .args([
+            "--speeds",
+            "0:8:1",
+            "--format",
+            "csv",
+            "--contacts",
+            "no-slip",
+        ])
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert_eq!(text.lines().count(), 1 + 9 * 8, "8 eigenvalues at 9 speeds");
+    let at4: Vec<&str> = text.lines().filter(|l| l.starts_with("4,")).collect();
+    assert_eq!(
+        at4.iter().filter(|l| l.contains(",wobble,")).count(),
+        2,
+        "{text}"
+    );
+    assert_eq!(
+        at4.iter().filter(|l| l.contains(",weave,")).count(),
+        2,
+        "{text}"
+    );
+    // Said once: the camber relaxation lengths default.
+    let stderr = String::from_utf8(out.stderr).unwrap();
+    assert_eq!(
+        stderr.matches("camber_relaxation_length not given").count(),
+        2,
+        "{stderr}"
+    );
+    let both = model("eig", "benchmark.toml")
+        .args(["--whipple", "--contacts", "no-slip"])
+        .output()
+        .unwrap();
+    assert_eq!(
+        both.status.code(),
+        Some(2),
+        "--whipple and --contacts conflict"
+    );
+}

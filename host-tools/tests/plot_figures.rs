@@ -164,15 +164,36 @@ fn utc_axis_is_labelled_from_the_sync_pairs() {
         &["--utc", "--from", "2020-03-18T10:00:10Z", "--to", "15"],
     );
     let labels = texts(&svg);
+    assert!(labels.contains(&"UTC (hh:mm:ss)"), "{labels:?}");
+    assert!(labels.contains(&"10:00:12.0"), "{labels:?}");
     assert!(
-        labels.contains(&"UTC on 2020-03-18 (hh:mm:ss)"),
+        labels.contains(
+            &"RUN00003.WBL: 10.0 to 15.0 s (UTC 2020-03-18 10:00:10.000 to 10:00:15.000)"
+        ),
         "{labels:?}"
     );
-    assert!(labels.contains(&"10:00:12"), "{labels:?}");
-    assert!(
-        labels.contains(&"RUN00003.WBL: 10.0 to 15.0 s"),
-        "{labels:?}"
+    // A short window: ticks at round UTC times, labelled below the second,
+    // each once.
+    let svg = plot_svg(
+        &log,
+        &dir.path().join("short.svg"),
+        &["--utc", "--from", "10.03", "--to", "11.53"],
     );
+    let ticks: Vec<f64> = texts(&svg)
+        .into_iter()
+        .filter_map(|t| t.strip_prefix("10:00:"))
+        .filter(|t| t.len() == 5)
+        .map(|t| t.parse().unwrap())
+        .collect();
+    // The same ticks on each of the four panels.
+    assert!(ticks.len() >= 4 * 5, "{ticks:?}");
+    let distinct: std::collections::BTreeSet<i64> =
+        ticks.iter().map(|t| (t * 100.0).round() as i64).collect();
+    assert_eq!(distinct.len() * 4, ticks.len(), "{ticks:?}");
+    for t in &distinct {
+        assert_eq!(t % 5, 0, "a tick at a round UTC time: {t}");
+        assert!((1003..=1153).contains(t), "{t}");
+    }
     // Without GPS, --utc has nothing to go by.
     let bare = dir.path().join("BARE.WBL");
     analysis_support::write_log(

@@ -231,3 +231,28 @@ fn a_decoded_log_encodes_to_the_same_utc() {
     assert_eq!(column[100], "2020-03-18T10:00:01.000Z");
     assert_eq!(column[2999], "2020-03-18T10:00:29.990Z");
 }
+
+#[test]
+fn a_column_encode_does_not_know_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let csv = dir.path().join("ride.csv");
+    std::fs::write(&csv, "t_s,steer,speed_mps\n0.01,1.5,4.0\n").unwrap();
+    let log = dir.path().join("RUN00001.WBL");
+    let out = assert_cmd::Command::cargo_bin("wobblog")
+        .unwrap()
+        .args(["encode", "--csv"])
+        .arg(&csv)
+        .arg("-o")
+        .arg(&log)
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("ride.csv")
+            && stderr.contains("no column \"steer\"")
+            && stderr.contains("steer_deg"),
+        "{stderr}"
+    );
+    assert!(!log.exists());
+}

@@ -4,7 +4,7 @@
 use std::path::Path;
 
 use assert_cmd::Command;
-use wobble_core::boot::ResetCause;
+use wobble_core::boot::{BorCheck, ResetCause};
 use wobble_core::selftest::{write_report, Measurements};
 
 fn run(path: &Path) -> (Option<i32>, String, String) {
@@ -34,6 +34,8 @@ fn a_report_is_printed_with_its_failures_named() {
         card_free_mib: 7_000,
         crystal: true,
         reset: Some(ResetCause::Watchdog),
+        bor: Some(BorCheck::Level3),
+        stack_bytes: Some((14_000, 86_000)),
     };
     let mut text = String::new();
     write_report(&m, &mut text).unwrap();
@@ -41,16 +43,20 @@ fn a_report_is_printed_with_its_failures_named() {
     let path = dir.path().join("SELFTEST.TXT");
     std::fs::write(&path, &text).unwrap();
     let (code, stdout, stderr) = run(&path);
-    assert_eq!(code, Some(0), "{stderr}");
+    // A failed check fails the command.
+    assert_eq!(code, Some(1), "{stderr}");
+    assert!(stderr.contains("SELFTEST.TXT: 2 checks failed"), "{stderr}");
     let lines: Vec<&str> = stdout.lines().collect();
-    assert_eq!(lines.len(), 8, "{stdout}");
+    assert_eq!(lines.len(), 10, "{stdout}");
     assert!(
         lines[0].starts_with("imu       pass  who_am_i=0x47"),
         "{stdout}"
     );
     assert!(lines[2].starts_with("wheel     FAIL  edges=0"), "{stdout}");
+    assert_eq!(lines[7], "bor       pass  level=3 (2.7 V)");
+    assert_eq!(lines[8], "stack     pass  used=14000 of 86000 bytes");
     assert_eq!(
-        lines[7],
+        lines[9],
         "failed: wheel, reset (see firmware/docs/board.md, bring-up)"
     );
     // The input is never touched.
@@ -72,4 +78,33 @@ fn a_file_that_is_no_report_is_an_error_naming_it() {
     let (code, _, stderr) = run(&dir.path().join("missing.txt"));
     assert_eq!(code, Some(1));
     assert!(stderr.contains("missing.txt"), "{stderr}");
+}
+
+/// The `text` blocks of `firmware/docs/board.md` after `marker`.
+fn block_after(marker: &str) -> String {
+    let doc = include_str!("../../firmware/docs/board.md");
+    let from = doc.find(marker).expect("the marker is in board.md");
+    let rest = &doc[from..];
+    let start = rest.find("```text\n").unwrap() + "```text\n".len();
+    rest[start..start + rest[start..].find("```").unwrap()].to_string()
+}
+
+#[test]
+fn the_documented_report_reads_as_documented() {
+    let file = block_after("`SELFTEST.TXT` itself is plain text");
+    let printed = block_after("Read the report on a PC");
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("SELFTEST.TXT");
+    std::fs::write(&path, &file).unwrap();
+    let (code, stdout, stderr) = run(&path);
+    assert_eq!(code, Some(1), "{stderr}");
+    assert_eq!(stdout, printed);
+    let passing = file.replace("wheel FAIL edges=0", "wheel PASS edges=50");
+    std::fs::write(&path, passing).unwrap();
+    let (code, stdout, _) = run(&path);
+    assert_eq!(code, Some(0));
+    assert!(
+        stdout.ends_with("all checks passed: ready to ride\n"),
+        "{stdout}"
+    );
 }

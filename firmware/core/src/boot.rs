@@ -1,6 +1,7 @@
 //! What the board learns at boot and writes into the next log as system
 //! fault records (source 7): why the MCU reset, whether the crystal
-//! started, whether the brown-out reset had to be switched on.
+//! started, whether the brown-out reset is below 2.7 V; and what the
+//! self-test did about the brown-out level.
 //!
 //! The decoding works on the raw register words of the STM32F4 (RM0090:
 //! RCC_CSR, FLASH_OPTCR), so the board only reads and writes registers.
@@ -28,10 +29,15 @@ pub const FAULT_RESET_UNKNOWN: u8 = 8;
 /// from the internal RC oscillator (HSI, ±1 % at 25 °C).
 pub const FAULT_HSE_FAILED: u8 = 9;
 /// System fault 10: the brown-out reset level was below 2.7 V (factory:
-/// off) and has been programmed to level 3.
+/// off) and has been programmed to level 3. Recorded by firmware that
+/// programmed it at boot; the self-test does it now ([`BorCheck`]).
 pub const FAULT_BOR_PROGRAMMED: u8 = 10;
-/// System fault 11: programming the brown-out level failed.
+/// System fault 11: programming the brown-out level failed (firmware that
+/// programmed it at boot).
 pub const FAULT_BOR_FAILED: u8 = 11;
+/// System fault 12: the brown-out reset level is below 2.7 V; the field
+/// self-test programs it (the boot never writes the option bytes).
+pub const FAULT_BOR_LOW: u8 = 12;
 
 /// Why the MCU started, from the reset flags in RCC_CSR.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -173,9 +179,140 @@ pub const fn optcr_with_bor_level3(optcr: u32) -> u32 {
     optcr & !BOR_LEV_MASK & !OPTCR_CONTROL_MASK
 }
 
+/// Boots in a row that ended in a software reset (a panic or a fault)
+/// after which the logger stops opening a new log file per boot.
+pub const PANIC_LOOP_BOOTS: u32 = 3;
+/// A boot that has run this long ends the streak, µs.
+pub const PANIC_STREAK_CLEAR_US: u64 = 60_000_000;
+
+/// This boot's count of software resets in a row, from the count kept
+/// across the reset (`None` when the kept word is not valid: after a
+/// power-on RAM holds noise) and the reset cause.
+#[must_use]
+pub fn panic_streak(kept: Option<u32>, cause: ResetCause) -> u32 {
+    match cause {
+        ResetCause::Software => kept.unwrap_or(0).saturating_add(1),
+        _ => 0,
+    }
+}
+
+/// Whether a boot with `streak` is in a panic loop: it writes nothing (a
+/// panic at every boot would otherwise leave a new, nearly empty log file
+/// per boot) and shows the software-reset code until a power cycle.
+#[must_use]
+pub const fn in_panic_loop(streak: u32) -> bool {
+    streak >= PANIC_LOOP_BOOTS
+}
+
+/// The system fault to record at boot for the stored brown-out level.
+#[must_use]
+pub fn bor_fault(level: BorLevel) -> Option<u8> {
+    (level != BorLevel::Level3).then_some(FAULT_BOR_LOW)
+}
+
+/// FLASH_SR error flags (RM0090 3.9.4): OPERR (bit 1), WRPERR, PGAERR,
+/// PGPERR, PGSERR (bits 4-7). Each is cleared by writing 1.
+pub const FLASH_SR_ERRORS: u32 = (1 << 1) | (0b1111 << 4);
+
+/// What the self-test found or did about the brown-out level. OPTCR is
+/// loaded from the stored option bytes at reset, so a level read after a
+/// power cycle is what the option bytes hold.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum BorCheck {
+    /// Level 3 is stored.
+    Level3,
+    /// It was `was`; level 3 has been written, and is verified by the next
+    /// self-test after a power cycle.
+    Programmed {
+        /// The level before.
+        was: BorLevel,
+    },
+    /// The write did not complete: FLASH_SR's error flags at the end (0:
+    /// the flash stayed busy past the time-out).
+    Failed {
+        /// The level before.
+        was: BorLevel,
+        /// FLASH_SR & [`FLASH_SR_ERRORS`].
+        flash_sr: u32,
+    },
+}
+
+impl BorCheck {
+    /// How a write of level 3 over `was` ended: whether the flash went idle
+    /// in time, and FLASH_SR read then.
+    #[must_use]
+    pub const fn after_write(was: BorLevel, went_idle: bool, flash_sr: u32) -> Self {
+        let errors = flash_sr & FLASH_SR_ERRORS;
+        if went_idle && errors == 0 {
+            Self::Programmed { was }
+        } else {
+            Self::Failed {
+                was,
+                flash_sr: errors,
+            }
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_panic_at_every_boot_is_a_loop_after_three_and_anything_else_ends_it() {
+        let mut kept = None;
+        let mut loops = Vec::new();
+        for _ in 0..5 {
+            let n = panic_streak(kept, ResetCause::Software);
+            loops.push(in_panic_loop(n));
+            kept = Some(n);
+        }
+        assert_eq!(loops, [false, false, true, true, true]);
+        // A power-on, the reset button, the watchdog: a fresh start.
+        for cause in [ResetCause::PowerOn, ResetCause::Pin, ResetCause::Watchdog] {
+            assert_eq!(panic_streak(Some(7), cause), 0);
+        }
+        // Noise after a power-on is never taken for a count.
+        assert_eq!(panic_streak(None, ResetCause::Software), 1);
+        assert_eq!(panic_streak(Some(u32::MAX), ResetCause::Software), u32::MAX);
+    }
+
+    #[test]
+    fn the_boot_only_reports_a_low_brown_out_level() {
+        assert_eq!(bor_fault(BorLevel::Level3), None);
+        for low in [BorLevel::Level2, BorLevel::Level1, BorLevel::Off] {
+            assert_eq!(bor_fault(low), Some(FAULT_BOR_LOW));
+        }
+    }
+
+    #[test]
+    fn a_bor_write_is_judged_by_the_flash_error_flags() {
+        let was = BorLevel::Off;
+        assert_eq!(
+            BorCheck::after_write(was, true, 0),
+            BorCheck::Programmed { was }
+        );
+        // EOP (bit 0) and BSY (bit 16) are not errors.
+        assert_eq!(
+            BorCheck::after_write(was, true, 1 | 1 << 16),
+            BorCheck::Programmed { was }
+        );
+        // WRPERR: the option bytes are write-protected.
+        assert_eq!(
+            BorCheck::after_write(was, true, 1 << 4),
+            BorCheck::Failed {
+                was,
+                flash_sr: 1 << 4
+            }
+        );
+        assert_eq!(
+            BorCheck::after_write(was, false, 0),
+            BorCheck::Failed { was, flash_sr: 0 }
+        );
+        // RM0090 3.9.4: OPERR, WRPERR, PGAERR, PGPERR, PGSERR.
+        assert_eq!(FLASH_SR_ERRORS, 0b1111_0010);
+    }
 
     /// RCC_CSR as read after each kind of reset (RM0090 7.3.21 and 5.3:
     /// every reset pulls NRST, a POR also sets BORRSTF).

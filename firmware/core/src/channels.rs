@@ -7,22 +7,29 @@
 //! | [`SharedStatus`] | GPS task, writer | sampler (status bits, LED) |
 //!
 //! Queue sizing: at 100 frames/s plus a 20 Hz GPS (fix, and now and then a
-//! UTC pair, an alert or a fault) the producers make at most about 125
-//! records per second. The SD specification lets a card stall a write for up
-//! to 500 ms, during which the writer drains nothing: 0.5 s × 125 /s = 63
-//! records. [`QUEUE_LEN`] = 128 holds 1.0 s of records, twice the allowed
-//! stall, so only a card that breaks the specification costs data, and that
-//! loss is counted and logged. 128 records of at most 56 bytes: 7 KiB of RAM.
+//! UTC pair, an alert or a fault) the producers make at most about
+//! [`MAX_RECORDS_PER_S`] = 125 records per second. The SD specification lets
+//! a card stall a write for up to 500 ms, but the writer's card operations
+//! are bounded at `drivers::sd_spi::CARD_OPERATION_BUDGET_US` = 1.5 s (a
+//! slow card's erase or file-system update), during which it drains
+//! nothing: 1.5 s × 125 /s = 188 records. [`QUEUE_LEN`] = 200 holds 1.6 s,
+//! so only an operation that the budget cuts off costs data, and that loss
+//! is counted and logged. 200 records of at most 56 bytes: 11 KiB of RAM.
 
 use core::sync::atomic::{AtomicU32, Ordering};
 
 use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
 use embassy_sync::channel::Channel;
 
+use crate::drivers::sd_spi::CARD_OPERATION_BUDGET_US;
 use crate::format::{Dropout, DropoutReason, Record};
 
+/// Most records the producers make per second (see the module docs).
+pub const MAX_RECORDS_PER_S: u64 = 125;
 /// Capacity of the sampler -> writer queue, in records (see the module docs).
-pub const QUEUE_LEN: usize = 128;
+pub const QUEUE_LEN: usize = 200;
+// Holds the longest card operation at the highest record rate.
+const _: () = assert!(QUEUE_LEN as u64 * 1_000_000 >= MAX_RECORDS_PER_S * CARD_OPERATION_BUDGET_US);
 
 /// The bounded queue from the producers to the SD writer.
 ///
@@ -320,6 +327,30 @@ mod tests {
             );
             prop_assert!(delivered_others.windows(2).all(|w| w[0] < w[1]));
         }
+    }
+
+    /// The longest card operation the writer's budget allows, at the
+    /// highest record rate (100 frames and 25 other records a second):
+    /// nothing is dropped.
+    #[test]
+    fn a_card_operation_at_its_budget_loses_no_record() {
+        let q = RecordQueue::new();
+        let mut pushed = 0u64;
+        let ticks = CARD_OPERATION_BUDGET_US / 10_000;
+        for k in 0..ticks {
+            q.push(frame(k * 10_000));
+            pushed += 1;
+            if k % 4 == 0 {
+                q.push(Record::Marker(Marker {
+                    t_us: k * 10_000,
+                    id: k as u16,
+                }));
+                pushed += 1;
+            }
+        }
+        assert!(pushed >= MAX_RECORDS_PER_S * CARD_OPERATION_BUDGET_US / 1_000_000);
+        assert_eq!(q.len() as u64, pushed);
+        assert_eq!((q.frames_dropped_pending(), q.others_dropped()), (0, 0));
     }
 
     /// The writer stops once `is_empty` says everything queued is on its

@@ -572,6 +572,9 @@ pub const KEY_COUNT: usize = KEYS.len();
 /// not among [`KEYS`]: the log header never records it.
 pub const SELFTEST_KEY: &str = "selftest";
 
+/// The UTF-8 byte order mark.
+const UTF8_BOM: &[u8] = b"\xEF\xBB\xBF";
+
 /// Keys of older firmware that are skipped with [`FAULT_OBSOLETE_KEY`].
 const OBSOLETE_KEYS: [&str; 1] = ["detector.wheel_circumference_m"];
 
@@ -585,16 +588,19 @@ impl Config {
         let mut selftest = false;
         // Per section, the last line that set one of its keys (for reports).
         let mut touched: [Option<u16>; SECTIONS.len()] = [None; SECTIONS.len()];
+        // A UTF-8 byte order mark (Windows editors write one) is not part
+        // of the first key.
+        let text = text.strip_prefix(UTF8_BOM).unwrap_or(text);
         for (index, raw) in text.split(|&b| b == b'\n').enumerate() {
             let line_no = u16::try_from(index + 1).unwrap_or(u16::MAX);
-            let Ok(line) = core::str::from_utf8(raw) else {
+            // The comment is cut off as bytes first: whatever its encoding
+            // (a Latin-1 `°` from an old editor), it cannot spoil the key.
+            let before_comment = raw.split(|&b| b == b'#').next().unwrap_or_default();
+            let Ok(line) = core::str::from_utf8(before_comment) else {
                 faults.push(line_no, FAULT_UNREADABLE);
                 continue;
             };
-            let line = line
-                .split_once('#')
-                .map_or(line, |(before, _)| before)
-                .trim();
+            let line = line.trim();
             if line.is_empty() {
                 continue;
             }
@@ -683,8 +689,9 @@ pub enum Source {
 }
 
 /// Reads [`FILE_NAME`] from the first volume of the card into `buf` and
-/// parses it. A file longer than `buf` is cut after its last whole line
-/// and the rest reported as [`FAULT_UNREADABLE`] (line 0).
+/// parses it. A file longer than `buf`, or one whose reading failed part
+/// way, is cut after its last whole line read and the rest reported as
+/// [`FAULT_UNREADABLE`] (line 0).
 pub fn load<D: BlockDevice, T: TimeSource>(
     volumes: &VolumeManager<D, T>,
     buf: &mut [u8],
@@ -723,17 +730,23 @@ pub fn load<D: BlockDevice, T: TimeSource>(
 }
 
 /// Reads `file` into `buf`; returns the length read and whether that was
-/// the whole file. A read error ends the file there.
+/// the whole file. A read error is not the end of the file: what follows
+/// it is missing, and the caller reports it.
 fn read_into<D: BlockDevice, T: TimeSource>(
     volumes: &VolumeManager<D, T>,
     file: embedded_sdmmc::RawFile,
     buf: &mut [u8],
 ) -> (usize, bool) {
+    // A block per call: a read that fails returns nothing of what it had
+    // read, so this keeps everything before the failing block.
+    const BLOCK: usize = embedded_sdmmc::Block::LEN;
     let mut len = 0;
     while let Some(rest) = buf.get_mut(len..).filter(|r| !r.is_empty()) {
-        match volumes.read(file, rest) {
+        let chunk = rest.len().min(BLOCK);
+        match volumes.read(file, rest.get_mut(..chunk).unwrap_or_default()) {
             Ok(n) if n > 0 => len += n,
-            _ => return (len, true),
+            Ok(_) => break,
+            Err(_) => return (len, false),
         }
     }
     (len, volumes.file_eof(file).unwrap_or(true))
@@ -851,6 +864,30 @@ mod tests {
         assert_eq!(c.detector.amp_on_deg, 0.6);
         assert!(!c.alert.enabled);
         assert_eq!(c.wheel.holes, WheelConfig::DEFAULT.holes);
+    }
+
+    #[test]
+    fn a_byte_order_mark_does_not_spoil_the_first_key() {
+        // What Windows Notepad saves as "UTF-8 with BOM".
+        let loaded = Config::parse(b"\xEF\xBB\xBFwheel.circumference_m=2.05\r\nwheel.holes=36\r\n");
+        assert!(loaded.faults.is_empty(), "{:?}", loaded.faults);
+        assert_eq!(loaded.config.wheel.circumference_m, 2.05);
+        assert_eq!(loaded.config.wheel.holes, 36);
+    }
+
+    #[test]
+    fn a_comment_in_any_encoding_keeps_its_line_key() {
+        // Latin-1 / Windows-1252 `°` (0xB0) and `é` (0xE9): not UTF-8.
+        let text = b"steering.center_counts=2100  # \xB0 left, r\xE9gl\xE9\n\
+            wheel.holes=36 # UTF-8 is fine too: \xC2\xB0\n\
+            # whole-line comment \xE9\n";
+        let loaded = Config::parse(text);
+        assert!(loaded.faults.is_empty(), "{:?}", loaded.faults);
+        assert_eq!(loaded.config.wheel.holes, 36);
+        assert_eq!(loaded.config.steering.center_counts, 2100.0);
+        // A key or value that is not UTF-8 is still unreadable.
+        let loaded = Config::parse(b"wheel.holes=3\xB06\n");
+        assert_eq!(loaded.faults.count(FAULT_UNREADABLE), 1);
     }
 
     #[test]

@@ -7,6 +7,7 @@
 #![cfg_attr(not(any(test, feature = "std")), no_std)]
 #![warn(missing_docs)]
 
+pub mod adc_ring;
 pub mod app;
 pub mod boot;
 pub mod channels;

@@ -20,7 +20,7 @@ use core::fmt::{self, Write};
 
 use embedded_sdmmc::{Block, BlockDevice, BlockIdx};
 
-use crate::boot::ResetCause;
+use crate::boot::{BorCheck, ResetCause};
 use crate::drivers::icm42688::reg::WHO_AM_I_VALUE;
 
 /// How long the rider turns the bar and spins the wheel, µs.
@@ -68,7 +68,15 @@ pub struct Measurements {
     pub crystal: bool,
     /// Why the MCU last reset.
     pub reset: Option<ResetCause>,
+    /// The brown-out level, and what the self-test did about it.
+    pub bor: Option<BorCheck>,
+    /// Deepest stack use since power-on, and the stack's size, bytes.
+    pub stack_bytes: Option<(u32, u32)>,
 }
+
+/// At most this share of the stack, in percent, may have been used: the
+/// ride's interrupts (sampler, GPS) nest on top of what the self-test saw.
+const MAX_STACK_USE_PERCENT: u32 = 50;
 
 /// One check's result.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -99,10 +107,14 @@ pub enum Check {
     Clock,
     /// The last reset was a normal one.
     Reset,
+    /// The brown-out reset at 2.7 V is stored in the option bytes.
+    Bor,
+    /// The stack's high-water mark leaves room.
+    Stack,
 }
 
 /// Every check, in order.
-pub const CHECKS: [Check; 7] = [
+pub const CHECKS: [Check; 9] = [
     Check::Imu,
     Check::Steering,
     Check::Wheel,
@@ -110,6 +122,8 @@ pub const CHECKS: [Check; 7] = [
     Check::Card,
     Check::Clock,
     Check::Reset,
+    Check::Bor,
+    Check::Stack,
 ];
 
 impl Check {
@@ -124,6 +138,8 @@ impl Check {
             Self::Card => "card",
             Self::Clock => "clock",
             Self::Reset => "reset",
+            Self::Bor => "bor",
+            Self::Stack => "stack",
         }
     }
 
@@ -150,6 +166,12 @@ impl Check {
             }
             Self::Clock => m.crystal,
             Self::Reset => m.reset.is_some_and(|r| !r.is_abnormal()),
+            // Programmed is not yet verified: only the next power cycle
+            // loads the stored bytes.
+            Self::Bor => m.bor == Some(BorCheck::Level3),
+            Self::Stack => m
+                .stack_bytes
+                .is_some_and(|(used, size)| used * 100 <= size * MAX_STACK_USE_PERCENT),
         };
         if pass {
             Verdict::Pass
@@ -197,6 +219,21 @@ impl Check {
             Self::Reset => match m.reset {
                 None => out.write_str("unknown"),
                 Some(r) => write!(out, "cause={r:?}"),
+            },
+            Self::Bor => match m.bor {
+                None => out.write_str("not checked"),
+                Some(BorCheck::Level3) => out.write_str("level=3 (2.7 V)"),
+                Some(BorCheck::Programmed { was }) => write!(
+                    out,
+                    "was={was:?} programmed level 3 (power-cycle, then run the self-test again)"
+                ),
+                Some(BorCheck::Failed { was, flash_sr }) => {
+                    write!(out, "was={was:?} not programmed flash_sr=0x{flash_sr:02x}")
+                }
+            },
+            Self::Stack => match m.stack_bytes {
+                None => out.write_str("not measured"),
+                Some((used, size)) => write!(out, "used={used} of {size} bytes"),
             },
         }
     }
@@ -324,6 +361,7 @@ pub fn fat32_free_mib<D: BlockDevice>(card: &D) -> Option<u32> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::boot::BorLevel;
 
     fn good() -> Measurements {
         Measurements {
@@ -337,6 +375,8 @@ mod tests {
             card_free_mib: 30_000,
             crystal: true,
             reset: Some(ResetCause::PowerOn),
+            bor: Some(BorCheck::Level3),
+            stack_bytes: Some((14_000, 86_000)),
         }
     }
 
@@ -350,7 +390,7 @@ mod tests {
     #[test]
     fn each_fault_fails_its_own_check_and_gives_its_code() {
         type Spoil = fn(&mut Measurements);
-        let cases: [(Check, Spoil); 12] = [
+        let cases: [(Check, Spoil); 17] = [
             (Check::Imu, |m| m.imu_id = Some(0x00)),
             (Check::Imu, |m| m.accel_g = Some(0.5)),
             (Check::Imu, |m| m.accel_g = None),
@@ -363,6 +403,18 @@ mod tests {
             (Check::Card, |m| m.card_free_mib = 10),
             (Check::Clock, |m| m.crystal = false),
             (Check::Reset, |m| m.reset = Some(ResetCause::Watchdog)),
+            (Check::Bor, |m| m.bor = None),
+            (Check::Bor, |m| {
+                m.bor = Some(BorCheck::Programmed { was: BorLevel::Off });
+            }),
+            (Check::Bor, |m| {
+                m.bor = Some(BorCheck::Failed {
+                    was: BorLevel::Off,
+                    flash_sr: 1 << 4,
+                });
+            }),
+            (Check::Stack, |m| m.stack_bytes = Some((43_001, 86_000))),
+            (Check::Stack, |m| m.stack_bytes = None),
         ];
         for (check, spoil) in cases {
             let mut m = good();

@@ -60,15 +60,19 @@ pub enum Verdict {
     Stalled(usize),
 }
 
-/// The feed rule for `N` heartbeat counters (see the module docs).
+/// The feed rule for `N` heartbeat counters (see the module docs). Until
+/// [`Liveness::arm`] (the watchdog started) nothing is due: before it the
+/// tasks that beat may not run yet (card reads at boot, the self-test), and
+/// no feed or stall means anything.
 #[derive(Clone, Debug)]
 pub struct Liveness<const N: usize> {
     last_beats: [u32; N],
+    /// When the current round began; `None` until armed.
     last_check_us: Option<u64>,
 }
 
 impl<const N: usize> Liveness<N> {
-    /// Nothing checked yet: the first check only records the counters.
+    /// Not armed: every check is [`Verdict::NotDue`].
     #[must_use]
     pub const fn new() -> Self {
         Self {
@@ -77,12 +81,17 @@ impl<const N: usize> Liveness<N> {
         }
     }
 
+    /// The watchdog was started at `now_us` with the counters at `beats`:
+    /// the first round begins.
+    pub fn arm(&mut self, now_us: u64, beats: [u32; N]) {
+        self.last_check_us = Some(now_us);
+        self.last_beats = beats;
+    }
+
     /// Checks the heartbeat counters `beats` at `now_us`.
     pub fn check(&mut self, now_us: u64, beats: [u32; N]) -> Verdict {
         let Some(last_us) = self.last_check_us else {
-            self.last_check_us = Some(now_us);
-            self.last_beats = beats;
-            return Verdict::Alive;
+            return Verdict::NotDue;
         };
         if now_us.saturating_sub(last_us) < ROUND_US {
             return Verdict::NotDue;
@@ -118,11 +127,24 @@ mod tests {
     #[test]
     fn fed_only_when_every_heartbeat_moved_once_a_round() {
         let mut l = Liveness::<2>::new();
-        assert_eq!(l.check(0, [0, 0]), Verdict::Alive);
+        l.arm(0, [0, 0]);
         assert_eq!(l.check(500_000, [50, 5]), Verdict::NotDue);
         assert_eq!(l.check(1_000_000, [100, 10]), Verdict::Alive);
         assert_eq!(l.check(2_000_000, [200, 10]), Verdict::Stalled(1));
         assert_eq!(l.check(3_000_000, [200, 20]), Verdict::Stalled(0));
         assert_eq!(l.check(4_000_000, [300, 30]), Verdict::Alive);
+    }
+
+    #[test]
+    fn nothing_is_due_before_the_watchdog_is_armed() {
+        // Boot card reads and the self-test: the sampler does not beat.
+        let mut l = Liveness::<2>::new();
+        for k in 0..10 {
+            assert_eq!(l.check(k * ROUND_US, [0, 0]), Verdict::NotDue);
+        }
+        // Armed late: the first round starts then, with the counters then.
+        l.arm(10 * ROUND_US, [7, 3]);
+        assert_eq!(l.check(10 * ROUND_US + 1, [7, 3]), Verdict::NotDue);
+        assert_eq!(l.check(11 * ROUND_US, [8, 4]), Verdict::Alive);
     }
 }

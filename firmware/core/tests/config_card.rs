@@ -1,5 +1,6 @@
 //! `CONFIG.TXT` read from a FAT card: a file with a bad line, no file, no
-//! file system, and a file longer than the buffer.
+//! file system, a file longer than the buffer, and a file whose second
+//! block cannot be read.
 
 use std::io::Write;
 
@@ -80,4 +81,36 @@ fn a_file_longer_than_the_buffer_keeps_its_whole_lines() {
     );
     assert_eq!(loaded.faults.count(FAULT_UNREADABLE), 1);
     assert_eq!(loaded.faults.first().len(), 1);
+}
+
+#[test]
+fn a_read_error_part_way_is_not_the_end_of_the_file() {
+    // Block 1 of the file ends inside `wheel.circumference_m=2.135`, at
+    // `2.1`; block 2 cannot be read. Taken as the end of the file, the cut
+    // value would pass as a 2.1 m wheel, silently.
+    let head = b"wheel.holes=36\n# padding\n";
+    let key = b"wheel.circumference_m=2.1";
+    let mut text = head.to_vec();
+    // A comment line of padding up to the key.
+    text.resize(512 - key.len() - 1, b'#');
+    text.push(b'\n');
+    text.extend_from_slice(key);
+    assert_eq!(text.len(), 512);
+    text.extend_from_slice(b"35\nwheel.timeout_us=900000\n");
+    let card = card(&[(FILE_NAME, &text)]);
+    let image = card.image();
+    let second = image
+        .windows(9)
+        .position(|w| w == b"35\nwheel.")
+        .expect("the file's second block");
+    assert_eq!(second % 512, 0);
+    card.set_unreadable(Some((second / 512) as u32));
+    let (loaded, source) = load_from(card, 4096);
+    assert_eq!(source, Source::File);
+    assert_eq!(loaded.config.wheel.holes, 36);
+    assert_eq!(
+        loaded.config.wheel.circumference_m,
+        Config::default().wheel.circumference_m
+    );
+    assert_eq!(loaded.faults.count(FAULT_UNREADABLE), 1);
 }

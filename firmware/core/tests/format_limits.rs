@@ -175,3 +175,64 @@ fn a_newer_minor_version_decodes() {
     let (_, stats) = decode(&file);
     assert_eq!((stats.blocks, stats.bytes_skipped), (2, 0));
 }
+
+fn spacing_reports(rate_hz: u16, step_us: u64) -> Vec<OutOfRange> {
+    let mut records = vec![Record::LogInfo(LogInfo {
+        t_us: 0,
+        firmware: "x",
+        device_id: [0; 12],
+        sample_rate_hz: rate_hz,
+        run: 1,
+    })];
+    records.extend((0..400).map(|i| frame(i * step_us)));
+    let file = encode(&records);
+    decode(&file)
+        .0
+        .iter()
+        .filter_map(|e| match e {
+            Event::OutOfRange { what, .. } => Some(*what),
+            _ => None,
+        })
+        .collect()
+}
+
+#[test]
+fn a_stated_rate_the_frames_contradict_is_flagged_once() {
+    // 10 ms frames under a header saying 50 Hz, and 20 ms frames under 100 Hz.
+    assert_eq!(
+        spacing_reports(50, 10_000),
+        [OutOfRange::FrameSpacing {
+            stated_hz: 50,
+            spacing_us: 10_000
+        }]
+    );
+    assert_eq!(
+        spacing_reports(100, 20_000),
+        [OutOfRange::FrameSpacing {
+            stated_hz: 100,
+            spacing_us: 20_000
+        }]
+    );
+    // Frames that keep to the stated rate, within 5 %, are not flagged.
+    assert_eq!(spacing_reports(100, 10_000), []);
+    assert_eq!(spacing_reports(100, 10_400), []);
+    assert_eq!(spacing_reports(200, 5_000), []);
+}
+
+#[test]
+fn back_to_back_markers_cost_no_crc_each_and_hide_nothing_after_them() {
+    let records: Vec<Record<'_>> = (0..100).map(|i| frame(i * 10_000)).collect();
+    let log = encode(&records);
+    let mut file = b"WBLK".repeat(1 << 16);
+    file.extend_from_slice(&log);
+    let (events, stats) = decode(&file);
+    assert_eq!(stats.frames, 100);
+    assert_eq!(stats.bytes_skipped, 1 << 18);
+    assert_eq!(
+        events
+            .iter()
+            .filter(|e| matches!(e, Event::Skipped { .. }))
+            .count(),
+        1
+    );
+}

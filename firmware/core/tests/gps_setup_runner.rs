@@ -10,148 +10,30 @@
 
 mod gnss_support;
 
-use std::future::Future;
-use std::pin::pin;
-use std::sync::Mutex;
-use std::task::{Context, Poll, Waker};
-
-use embassy_time::{Duration, Instant, MockDriver, Timer};
+use embassy_time::{Duration, Instant};
+use gnss_support::link::{drive, link_to, SimLink};
 use gnss_support::{Family, Receiver};
 use wobble_core::app::gps::IDLE_POLL_MS;
-use wobble_core::app::gps_setup::{run, GpsLink};
-use wobble_core::app::ports::GpsPort;
+use wobble_core::app::gps_setup::run;
 use wobble_core::drivers::gnss_bringup::{
     CommandSet, Outcome, Step, FAULT_SETUP_SILENT, FAULT_SETUP_UNCONFIRMED, SETTLE_US,
 };
 use wobble_core::drivers::gnss_setup::TARGET_BAUD;
 use wobble_core::watchdog::ROUND_US;
 
-/// The mock time driver is one global clock: one test at a time.
-static CLOCK: Mutex<()> = Mutex::new(());
-
-/// Bytes on the line are generated a window at a time and released at the
-/// line's pace.
-const WINDOW_US: u64 = 1_000_000;
-
-/// A UART wired to a simulated receiver.
-struct SimLink {
-    rx: Receiver,
-    baud: u32,
-    /// The bytes of the current window, when it started, and how many of
-    /// them have been handed out.
-    window: Vec<u8>,
-    window_start: Instant,
-    taken: usize,
-    /// Every baud switch and every command sent, with the baud it went at.
-    switches: Vec<u32>,
-    sent: Vec<(u32, Vec<u8>)>,
-    /// The longest time between two reads started (the heartbeat).
-    last_read: Option<Instant>,
-    max_read_gap: Duration,
-}
-
-impl SimLink {
-    fn new(rx: Receiver) -> Self {
-        Self {
-            rx,
-            baud: 9_600,
-            window: Vec::new(),
-            window_start: Instant::now(),
-            taken: 0,
-            switches: Vec::new(),
-            sent: Vec::new(),
-            last_read: None,
-            max_read_gap: Duration::from_ticks(0),
-        }
-    }
-
-    fn start_window(&mut self) {
-        self.window = self.rx.transmit(self.baud, WINDOW_US);
-        self.window_start = Instant::now();
-        self.taken = 0;
-    }
-
-    /// Bytes of the window that have arrived by now and not been read.
-    fn arrived(&mut self) -> usize {
-        let elapsed = Instant::now().duration_since(self.window_start).as_micros();
-        if elapsed >= WINDOW_US && self.taken == self.window.len() {
-            self.start_window();
-            return 0;
-        }
-        let due = (self.window.len() as u64 * elapsed.min(WINDOW_US) / WINDOW_US) as usize;
-        due - self.taken
-    }
-}
-
-impl GpsPort for SimLink {
-    async fn read(&mut self, buf: &mut [u8]) -> usize {
-        let now = Instant::now();
-        if let Some(last) = self.last_read {
-            self.max_read_gap = self.max_read_gap.max(now.duration_since(last));
-        }
-        self.last_read = Some(now);
-        loop {
-            let n = self.arrived().min(buf.len());
-            if n > 0 {
-                buf[..n].copy_from_slice(&self.window[self.taken..self.taken + n]);
-                self.taken += n;
-                return n;
-            }
-            // A real UART wakes on its idle-line interrupt; 5 ms is finer
-            // than any listening window.
-            Timer::after_millis(5).await;
-        }
-    }
-}
-
-impl GpsLink for SimLink {
-    fn set_baud(&mut self, baud: u32) {
-        self.switches.push(baud);
-        self.baud = baud;
-        // What was on the line at the old baud is lost.
-        self.start_window();
-    }
-
-    async fn send(&mut self, bytes: &[u8]) {
-        // 10 bits a byte on the wire.
-        let us = bytes.len() as u64 * 10 * 1_000_000 / u64::from(self.baud);
-        Timer::after_micros(us).await;
-        self.rx.receive(self.baud, bytes);
-        self.sent.push((self.baud, bytes.to_vec()));
-    }
-}
-
-/// Runs the bring-up on `link` to its end in virtual time (1 ms steps);
-/// returns the outcome, the steps logged and the time taken.
+/// Runs the bring-up on `link` to its end in virtual time; returns the
+/// outcome, the steps logged and the time taken. The link is left at the
+/// outcome's baud.
 fn bring_up(link: &mut SimLink) -> (Outcome, Vec<Step>, Duration) {
     let mut steps = Vec::new();
     let start = Instant::now();
     let outcome = {
         let mut log = |step: &Step| steps.push(*step);
-        let mut future = pin!(run(link, &mut log));
-        let mut cx = Context::from_waker(Waker::noop());
-        let driver = MockDriver::get();
-        loop {
-            if let Poll::Ready(outcome) = future.as_mut().poll(&mut cx) {
-                break outcome;
-            }
-            assert!(
-                Instant::now().duration_since(start) < Duration::from_secs(120),
-                "bring-up did not end"
-            );
-            driver.advance(Duration::from_millis(1));
-        }
+        drive(run(link, &mut log), Duration::from_secs(120), &mut || {})
     };
+    assert_eq!(link.baud, outcome.baud, "link and outcome disagree");
+    assert_eq!(link.switches.last(), Some(&outcome.baud));
     (outcome, steps, Instant::now().duration_since(start))
-}
-
-/// A fresh clock and a link to `rx`.
-fn link_to(rx: Receiver) -> (std::sync::MutexGuard<'static, ()>, SimLink) {
-    let guard = CLOCK
-        .lock()
-        .unwrap_or_else(|poisoned| poisoned.into_inner());
-    MockDriver::get().reset();
-    (guard, SimLink::new(rx))
 }
 
 /// The baud each Listen or Send step asked for, in order.
@@ -177,8 +59,12 @@ fn a_mediatek_at_9600_is_brought_to_115200_at_20_hz_on_the_link() {
         (link.rx.baud, link.rx.rate_hz, link.rx.lean),
         (TARGET_BAUD, 20, true)
     );
-    // The UART is switched before every step, to the step's baud.
-    assert_eq!(link.switches, asked_bauds(&steps));
+    // The UART is switched before every step, to the step's baud, and
+    // at the end to the outcome's.
+    assert_eq!(
+        link.switches,
+        [asked_bauds(&steps), vec![outcome.baud]].concat()
+    );
     assert_eq!(steps.last(), Some(&Step::Done(outcome)));
     // Each set went out whole, in order, at the baud its step named.
     let mut expected = Vec::new();
@@ -206,7 +92,10 @@ fn a_ublox_m10_at_38400_is_configured_with_valset_on_the_link() {
     assert_eq!(outcome.found_baud, Some(38_400));
     assert_eq!(outcome.configured, Some(CommandSet::Valset));
     assert_eq!((outcome.baud, outcome.rate_hz), (TARGET_BAUD, 20));
-    assert_eq!(link.switches, asked_bauds(&steps));
+    assert_eq!(
+        link.switches,
+        [asked_bauds(&steps), vec![TARGET_BAUD]].concat()
+    );
     // The legacy set went first and changed nothing: VALSET did it.
     let sets: Vec<_> = steps
         .iter()
@@ -230,13 +119,18 @@ fn a_deaf_receiver_is_left_at_its_baud_after_a_bounded_bring_up() {
 }
 
 #[test]
-fn a_silent_line_ends_at_9600_with_reads_all_along() {
+fn a_silent_line_ends_with_the_link_at_9600_with_reads_all_along() {
     let mut rx = Receiver::new(Family::Mtk, 9_600);
     rx.silent = true;
     let (_clock, mut link) = link_to(rx);
     let (outcome, steps, took) = bring_up(&mut link);
     assert_eq!((outcome.found_baud, outcome.baud), (None, 9_600));
     assert_eq!(outcome.fault(), Some(FAULT_SETUP_SILENT));
+    // The last probe listened at 115 200; the UART is back at 9600.
+    assert_eq!(
+        &link.switches[link.switches.len() - 2..],
+        [TARGET_BAUD, 9_600]
+    );
     // Listening plus settling per probe, nothing more.
     let listening: u64 = steps
         .iter()

@@ -2,7 +2,7 @@
 //! runs it at the data clock with chip select held for each operation, and
 //! after any error identifies it again before the next access: a card that
 //! was missing, then inserted, then pulled; and one whose blocks keep
-//! failing their CRC, which then runs at half the clock.
+//! failing their CRC, read or written, which then runs at half the clock.
 
 mod sd_support;
 
@@ -216,6 +216,42 @@ fn a_written_block_reaches_the_card_whole() {
     let mut chip_select = PinMock::new(&cs(&[&IDENTIFY_CS[..], &OPERATION_CS].concat()));
     let card = card(&spi, &chip_select);
     card.write(&[block], BlockIdx(42)).expect("written");
+    spi.done();
+    chip_select.done();
+}
+
+/// A card that keeps rejecting written blocks' CRC (data response token
+/// 0x0B, which embedded-sdmmc 0.10 reports as a write error) runs at half
+/// the clock too: the signal is as bad going out as coming in.
+#[test]
+fn repeated_write_crc_rejections_halve_the_data_clock() {
+    let block = Block::new();
+    let crc_rejected = 0x0B;
+    let rejected_write = || {
+        [
+            command(24, 42, R1_READY),
+            byte(0xFE, NOTHING),
+            written(&block.contents),
+            written(&crc16(&block.contents).to_be_bytes()),
+            byte(0xFF, crc_rejected),
+        ]
+        .concat()
+    };
+    let identify = || identification([sdhc_identification(), csd_read()].concat());
+    let mut expectations = Vec::new();
+    let mut pins = Vec::new();
+    for _ in 0..CRC_ERRORS_BEFORE_SLOWING {
+        expectations.extend([identify(), operation(rejected_write())].concat());
+        pins.extend([&IDENTIFY_CS[..], &OPERATION_CS].concat());
+    }
+    let mut spi = Mock::new(&expectations);
+    let mut chip_select = PinMock::new(&cs(&pins));
+    let card = card(&spi, &chip_select);
+    for _ in 0..CRC_ERRORS_BEFORE_SLOWING {
+        let write = card.write(std::slice::from_ref(&block), BlockIdx(42));
+        assert!(matches!(write, Err(SdCardError::WriteError)), "{write:?}");
+    }
+    assert_eq!(card.data_clock_hz(), DATA_CLOCK_HZ / 2);
     spi.done();
     chip_select.done();
 }

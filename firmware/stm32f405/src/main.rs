@@ -27,14 +27,13 @@ use embedded_hal_bus::spi::ExclusiveDevice;
 use embedded_sdmmc::VolumeManager;
 use static_cell::StaticCell;
 use wobble_core::app::sampler::{Sampler, SamplerPorts};
-use wobble_core::app::{gps, gps_setup, sampler, writer};
+use wobble_core::app::{gps, sampler, writer};
 use wobble_core::boot;
 use wobble_core::channels::{RecordQueue, SharedStatus};
 use wobble_core::config::{self, Config, Loaded, KEY_COUNT, MAX_TEXT_LEN};
 use wobble_core::drivers::icm42688::{self, Icm42688};
-use wobble_core::format::{Fault, FaultSource, Record};
+use wobble_core::format::Record;
 use wobble_core::frame_assembly::FrameConfig;
-use wobble_core::gps::{GpsConfig, GpsReceiver};
 use wobble_core::imu::Imu;
 use wobble_core::logger::{CardLogger, FixedTime, HeaderSpec, LoggerConfig};
 use wobble_core::steering::Steering;
@@ -45,7 +44,7 @@ use wobble_stm32f405::adapters::card::SdCard;
 use wobble_stm32f405::adapters::gps::GpsAdapter;
 use wobble_stm32f405::adapters::imu::ImuAdapter;
 use wobble_stm32f405::adapters::rider::{AlertPins, MarkerButton, StatusLight};
-use wobble_stm32f405::adapters::steering::{SteeringAdapter, DMA_SAMPLES};
+use wobble_stm32f405::adapters::steering::SteeringAdapter;
 use wobble_stm32f405::adapters::wheel::WheelAdapter;
 use wobble_stm32f405::pins::{Board, Irqs};
 
@@ -61,8 +60,6 @@ static EXECUTOR_THREAD: StaticCell<Executor> = StaticCell::new();
 /// The configuration in force as text, and its lines for the log header.
 static CONFIG_TEXT: StaticCell<heapless::String<MAX_TEXT_LEN>> = StaticCell::new();
 static CONFIG_LINES: StaticCell<heapless::Vec<&'static str, KEY_COUNT>> = StaticCell::new();
-static ADC_RING: StaticCell<[u16; DMA_SAMPLES]> = StaticCell::new();
-static GPS_RING: StaticCell<[u8; adapters::gps::RING_BYTES]> = StaticCell::new();
 
 const FIRMWARE: &str = concat!(env!("CARGO_PKG_NAME"), " ", env!("CARGO_PKG_VERSION"));
 /// 100 Hz, from the sampler's period.
@@ -87,10 +84,12 @@ unsafe fn UART5() {
 
 #[entry]
 fn main() -> ! {
+    startup::guard_stack();
     // RTT needs no clock: this line appears even if the clocks never come up.
     defmt::info!("{} starting", FIRMWARE);
     let reset = startup::take_reset_cause();
     defmt::info!("reset cause: {}", reset);
+    let streak = startup::take_panic_streak(reset);
     let crystal = startup::start_hse();
     if !crystal {
         defmt::error!(
@@ -100,9 +99,15 @@ fn main() -> ! {
     }
     let mut board = Board::new(embassy_stm32::init(clocks::config(crystal)));
     startup::enable_flash_accelerator();
-    let bor = startup::ensure_bor_level3();
+    if crystal {
+        startup::enable_clock_security();
+    }
+    let bor = boot::bor_fault(startup::bor_level());
     if let Some(code) = bor {
-        defmt::warn!("brown-out reset level 3: system fault {}", code);
+        defmt::warn!(
+            "brown-out reset below 2.7 V (system fault {}): run the self-test to program it",
+            code
+        );
     }
     let boot_faults = [
         Some(reset.fault_code()),
@@ -125,6 +130,18 @@ fn main() -> ! {
         startup::blink_code(&mut led, code);
     }
 
+    if boot::in_panic_loop(streak) {
+        // Nothing is written: no new log file per boot. The code repeats
+        // until a power cycle (the watchdog is not started).
+        defmt::error!(
+            "{} software resets in a row: not logging until power-off",
+            streak
+        );
+        let mut led = Output::new(board.rider.alert_led.reborrow(), Level::Low, Speed::Low);
+        loop {
+            startup::blink_code(&mut led, boot::FAULT_RESET_SOFTWARE);
+        }
+    }
     let button = marker_held(&mut board);
     let (card, loaded) = card_and_config(board.card);
     let config = loaded.config;
@@ -141,7 +158,7 @@ fn main() -> ! {
             imu: ports.imu,
             steering: ports.steering,
             wheel: ports.wheel,
-            gps: GpsAdapter::new(board.gps, GPS_RING.init([0; adapters::gps::RING_BYTES])),
+            gps: GpsAdapter::new(board.gps),
             card,
             buzzer: ports.alert.buzzer,
             alert_led: ports.alert.led,
@@ -166,7 +183,7 @@ fn main() -> ! {
 
     let _wheel_timer = adapters::wheel::start(board.wheel);
     let (sampler, ports) = sampler_parts(board.imu, board.steering, board.rider, &config);
-    let gps_port = GpsAdapter::new(board.gps, GPS_RING.init([0; adapters::gps::RING_BYTES]));
+    let gps_port = GpsAdapter::new(board.gps);
 
     interrupt::UART4.set_priority(Priority::P6);
     let high = EXECUTOR_HIGH.start(interrupt::UART4);
@@ -286,7 +303,7 @@ fn steering_adc(
 ) -> RingBufferedAdc<'static, ADC1> {
     Adc::new(adc).into_ring_buffered(
         dma,
-        ADC_RING.init([0; DMA_SAMPLES]),
+        adapters::steering::ring(),
         Irqs,
         [(wiper.degrade_adc(), SampleTime::CYCLES480)].into_iter(),
         CONTINUOUS,
@@ -312,19 +329,10 @@ async fn sampler_task(mut sampler: Sampler, mut ports: Ports) {
 
 #[embassy_executor::task]
 async fn gps_task(mut port: GpsAdapter) {
-    let outcome = gps_setup::run(&mut port, &mut |step| defmt::info!("GPS set-up: {}", step)).await;
-    defmt::info!("GPS: {}", outcome);
-    if let Some(code) = outcome.fault() {
-        let t_us = Instant::now().as_micros();
-        QUEUE.push(Record::Fault(Fault {
-            t_us,
-            source: FaultSource::Gps,
-            code,
-            count: 1,
-        }));
-    }
-    let mut receiver = GpsReceiver::new(GpsConfig::default());
-    gps::run(&mut port, &mut receiver, &QUEUE, &SHARED).await;
+    gps::run_link(&mut port, &QUEUE, &SHARED, &mut |step| {
+        defmt::info!("GPS set-up: {}", step);
+    })
+    .await;
 }
 
 #[embassy_executor::task]

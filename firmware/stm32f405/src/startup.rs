@@ -1,15 +1,19 @@
 //! Register work before and right after `embassy_stm32::init`: the reset
 //! cause, a bounded wait for the crystal, the flash accelerator, the
-//! brown-out level, and a visible failure code. The decisions (what the
+//! brown-out level (read at boot, programmed by the self-test), the stack
+//! guard and high-water mark, and a visible failure code. The decisions (what the
 //! flags mean, which option word to program, which fault to record) are the
 //! core's `boot` module.
 
+use core::mem::MaybeUninit;
+use core::ptr::addr_of_mut;
 use cortex_m_rt::{exception, ExceptionFrame};
 use embassy_stm32::gpio::Output;
 use embassy_stm32::pac::{self, FLASH, RCC};
 use embassy_time::{block_for, Duration};
+
 use wobble_core::boot::{
-    optcr_with_bor_level3, BorLevel, ResetCause, FAULT_BOR_FAILED, FAULT_BOR_PROGRAMMED,
+    optcr_with_bor_level3, panic_streak, BorCheck, BorLevel, ResetCause, FLASH_SR_ERRORS,
 };
 
 use crate::clocks::HSE_STARTUP_TIMEOUT_MS;
@@ -72,34 +76,50 @@ const OPT_KEYS: [u32; 2] = [0x0819_2A3B, 0x4C5D_6E7F];
 /// polls (each one a register read, a few cycles at 168 MHz).
 const OPT_BUSY_POLLS: u32 = 100_000_000;
 
-/// Programs the brown-out reset to level 3 (2.7 V) once, if the option
-/// bytes hold anything else (the factory setting is off). Returns the
-/// system fault to record, if something was done. The other option bytes,
-/// read protection included, are written back as read.
-pub fn ensure_bor_level3() -> Option<u8> {
+/// The brown-out level the option bytes hold (FLASH_OPTCR is loaded from
+/// them at reset). The boot only reads it: writing the option bytes
+/// rewrites the whole user option sector, read protection included, and a
+/// power cut during the write at an unknown supply could leave the chip
+/// protected; the self-test, which a person asks for at the bench,
+/// programs it ([`program_bor_level3`]).
+pub fn bor_level() -> BorLevel {
+    BorLevel::from_optcr(FLASH.optcr().read().0)
+}
+
+/// Programs the brown-out reset to level 3 (2.7 V) if the option bytes
+/// hold anything else (the factory setting is off), with the other option
+/// bytes, read protection included, written back as read. Stale FLASH_SR
+/// error flags are cleared first and the ones the write raised are
+/// reported and cleared; the stored value is verified by the next
+/// self-test, after a power cycle loads it.
+pub fn program_bor_level3() -> BorCheck {
     let optcr = FLASH.optcr().read().0;
-    if BorLevel::from_optcr(optcr) == BorLevel::Level3 {
-        return None;
+    let was = BorLevel::from_optcr(optcr);
+    if was == BorLevel::Level3 {
+        return BorCheck::Level3;
     }
+    let clear_errors = || {
+        FLASH
+            .sr()
+            .write_value(pac::flash::regs::Sr(FLASH_SR_ERRORS))
+    };
+    clear_errors();
     for key in OPT_KEYS {
         FLASH.optkeyr().write_value(key);
     }
     let idle = || (0..OPT_BUSY_POLLS).any(|_| !FLASH.sr().read().bsy());
-    let mut ok = idle();
-    if ok {
+    let mut went_idle = idle();
+    if went_idle {
         FLASH
             .optcr()
             .write_value(pac::flash::regs::Optcr(optcr_with_bor_level3(optcr)));
         FLASH.optcr().modify(|w| w.set_optstrt(true));
-        ok = idle();
+        went_idle = idle();
     }
+    let sr = FLASH.sr().read().0;
+    clear_errors();
     FLASH.optcr().modify(|w| w.set_optlock(true));
-    let now = BorLevel::from_optcr(FLASH.optcr().read().0);
-    Some(if ok && now == BorLevel::Level3 {
-        FAULT_BOR_PROGRAMMED
-    } else {
-        FAULT_BOR_FAILED
-    })
+    BorCheck::after_write(was, went_idle, sr)
 }
 
 /// Blinks `code` on `led` (200 ms on, 200 ms off, then a 1 s pause), so a
@@ -112,6 +132,141 @@ pub fn blink_code(led: &mut Output<'_>, code: u8) {
         block_for(Duration::from_millis(200));
     }
     block_for(Duration::from_secs(1));
+}
+
+extern "C" {
+    /// Top of the stack (cortex-m-rt's linker script: the end of RAM).
+    static _stack_start: u32;
+    /// Bottom of the stack: the end of the statics (`.bss`, `.uninit`).
+    static _stack_end: u32;
+}
+
+/// Bytes at the bottom of the stack no access is allowed to (an MPU
+/// region's size must be a power of two, its base aligned to it).
+const GUARD_BYTES: u32 = 256;
+/// MPU_RASR: execute never (bit 28), AP = 0b000 (no access, bits 26:24),
+/// SIZE = log2(bytes) - 1 (bits 5:1), ENABLE (bit 0).
+const GUARD_RASR: u32 = (1 << 28) | ((GUARD_BYTES.trailing_zeros() - 1) << 1) | 1;
+/// MPU_CTRL: the default memory map everywhere else (PRIVDEFENA), on.
+const MPU_CTRL_PRIVDEFENA_ENABLE: u32 = (1 << 2) | 1;
+
+/// The lowest stack address in use, and the top, as numbers.
+fn stack_bounds() -> (u32, u32) {
+    let end = &raw const _stack_end as u32;
+    let start = &raw const _stack_start as u32;
+    (end, start)
+}
+
+/// The guard's base: the first [`GUARD_BYTES`]-aligned address above the
+/// statics.
+fn guard_base() -> u32 {
+    let (end, _) = stack_bounds();
+    end.next_multiple_of(GUARD_BYTES)
+}
+
+/// Puts a no-access MPU region at the bottom of the stack: a stack that
+/// grows into it faults (and resets, see [`HardFault`]; if the fault's own
+/// stacking faults too, the core locks up and the watchdog resets it)
+/// instead of silently overwriting the statics below it (the RTT buffer,
+/// then the queues). The region is below the deepest use ever measured by
+/// far (board.md).
+pub fn guard_stack() {
+    // SAFETY: region 0 is the only MPU region this firmware sets; the rest
+    // of the memory map stays the default one (PRIVDEFENA).
+    unsafe {
+        let mpu = &*cortex_m::peripheral::MPU::PTR;
+        mpu.rnr.write(0);
+        mpu.rbar.write(guard_base());
+        mpu.rasr.write(GUARD_RASR);
+        mpu.ctrl.write(MPU_CTRL_PRIVDEFENA_ENABLE);
+    }
+    cortex_m::asm::dsb();
+    cortex_m::asm::isb();
+}
+
+/// The deepest the stack has been since reset, and its size above the
+/// guard, bytes: cortex-m-rt paints the stack at reset (`paint-stack`), and
+/// use scrubs the paint off. Scans up from the guard to the first word
+/// that is not paint.
+pub fn stack_use() -> (u32, u32) {
+    let (_, start) = stack_bounds();
+    let bottom = guard_base() + GUARD_BYTES;
+    let mut p = bottom;
+    while p < start {
+        // SAFETY: `bottom..start` is the stack's RAM above the guard,
+        // word-aligned; reading it races only with the stack's own writes
+        // below the current frame, which are not paint anyway.
+        let word = unsafe { core::ptr::read_volatile(p as *const u32) };
+        if word != cortex_m_rt::STACK_PAINT_VALUE {
+            break;
+        }
+        p += 4;
+    }
+    (start - p, start - bottom)
+}
+
+/// An interrupt without a handler of its own (enabled by mistake in a
+/// driver, or by a bit flip): masked in the NVIC and logged, and the ride
+/// goes on. cortex-m-rt's default handler would spin in it for ever, with
+/// the watchdog's reset as the only way out.
+#[exception]
+unsafe fn DefaultHandler(irqn: i16) {
+    if let Ok(n) = usize::try_from(irqn) {
+        // SAFETY: writing ICER only disables the interrupt that fired.
+        unsafe {
+            let nvic = &*cortex_m::peripheral::NVIC::PTR;
+            nvic.icer[n / 32].write(1 << (n % 32));
+        }
+    }
+    defmt::error!("unexpected interrupt {}: masked", irqn);
+}
+
+/// The software-reset streak kept across resets: a magic word and the
+/// count, in `.uninit` (not zeroed at reset; noise after a power-on, which
+/// the magic word tells apart).
+#[link_section = ".uninit.PANIC_STREAK"]
+static mut PANIC_STREAK: MaybeUninit<[u32; 2]> = MaybeUninit::uninit();
+const STREAK_MAGIC: u32 = 0x5742_4C21;
+
+fn keep_streak(n: u32) {
+    // SAFETY: written only in thread mode (boot, then the watchdog task),
+    // never borrowed.
+    unsafe { addr_of_mut!(PANIC_STREAK).write_volatile(MaybeUninit::new([STREAK_MAGIC, n])) }
+}
+
+/// This boot's software-reset streak (`wobble_core::boot::panic_streak`),
+/// kept for the next boot.
+pub fn take_panic_streak(cause: ResetCause) -> u32 {
+    // SAFETY: as in `keep_streak`; any bit pattern is a valid `[u32; 2]`.
+    let [magic, count] = unsafe { addr_of_mut!(PANIC_STREAK).read_volatile().assume_init() };
+    let n = panic_streak((magic == STREAK_MAGIC).then_some(count), cause);
+    keep_streak(n);
+    n
+}
+
+/// The logger ran long enough: the next panic starts a new streak.
+pub fn clear_panic_streak() {
+    keep_streak(0);
+}
+
+/// Turns on the clock security system once the clocks run from the
+/// crystal (RM0090 6.2.7): if the crystal stops mid-ride, the hardware
+/// switches the system clock to the HSI and raises the NMI
+/// ([`NonMaskableInt`]), instead of the clocks stopping with it.
+pub fn enable_clock_security() {
+    RCC.cr().modify(|w| w.set_csson(true));
+}
+
+/// The crystal failed (the clock security system's NMI; nothing else
+/// raises it here). The CSS flag is cleared (else the NMI repeats) and the
+/// MCU resets: the boot then finds no crystal, runs the whole clock tree
+/// from the HSI and records system fault 9, so every timer, baud rate and
+/// sample time is right again instead of 16 MHz HSI under a 168 MHz set-up.
+#[exception]
+unsafe fn NonMaskableInt() {
+    RCC.cir().modify(|w| w.set_cssc(true));
+    defmt::error!("crystal failed (clock security system): reset to run from the HSI");
+    cortex_m::peripheral::SCB::sys_reset()
 }
 
 /// A panic (after panic-probe has printed it over defmt) or a fault ends

@@ -11,16 +11,20 @@
 use core::cell::RefCell;
 use core::sync::atomic::{AtomicU32, Ordering};
 
+use embassy_stm32::pac;
 use embassy_stm32::peripherals::IWDG;
 use embassy_stm32::wdg::IndependentWatchdog;
 use embassy_stm32::Peri;
 use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
 use embassy_sync::blocking_mutex::Mutex;
 use embassy_time::{Instant, Timer};
+use wobble_core::boot::PANIC_STREAK_CLEAR_US;
 use wobble_core::watchdog::{Liveness, Verdict, TIMEOUT_REQUEST_US};
 
 /// How often the task behind the writer asks.
 const ASK_MS: u64 = 250;
+/// Asks between two stack reports: a minute.
+const STACK_REPORT_ASKS: u32 = 240;
 
 /// A task's heartbeat counter.
 pub struct Heartbeat(AtomicU32);
@@ -75,19 +79,40 @@ pub fn prove_alive() {
     });
 }
 
+/// Stops the watchdog's counter while a debugger halts the core
+/// (DBGMCU_APB1_FZ.DBG_IWDG_STOP, RM0090 38.16.4): a breakpoint would
+/// otherwise reset the MCU under the probe after 3-8 s. No effect
+/// without a debugger.
+pub fn freeze_when_halted() {
+    pac::DBGMCU.apb1fzr().modify(|w| w.set_iwdg(true));
+}
+
 /// Starts the watchdog and asks for feeds behind the writer.
 pub async fn feed(iwdg: Peri<'static, IWDG>) -> ! {
+    freeze_when_halted();
     let mut dog = IndependentWatchdog::new(iwdg, TIMEOUT_REQUEST_US as u32);
     dog.unleash();
     DOG.lock(|d| {
         let mut d = d.borrow_mut();
         d.iwdg = Some(dog);
-        // Rounds count from here: the card reads at boot checked before
-        // the tasks that beat had started.
-        d.liveness = Liveness::new();
+        // Rounds count from here: before, the card reads at boot (and the
+        // self-test, which never starts the watchdog) ask with nothing due.
+        let beats = [SAMPLER.count(), GPS.count()];
+        d.liveness.arm(Instant::now().as_micros(), beats);
     });
+    let mut asks = 0u32;
     loop {
         prove_alive();
+        // The stack's high-water mark in the log once a minute (a scan of
+        // the painted stack, well under a millisecond).
+        if asks.is_multiple_of(STACK_REPORT_ASKS) {
+            let (used, size) = crate::startup::stack_use();
+            defmt::info!("stack: {} of {} bytes used at most", used, size);
+        }
+        asks = asks.wrapping_add(1);
+        if u64::from(asks) * ASK_MS * 1000 == PANIC_STREAK_CLEAR_US {
+            crate::startup::clear_panic_streak();
+        }
         Timer::after_millis(ASK_MS).await;
     }
 }

@@ -10,20 +10,17 @@ use defmt_rtt as _;
 #[embedded_test::tests]
 mod tests {
     use embassy_time::{Duration, Instant};
-    use static_cell::StaticCell;
     use wobble_core::app::gps_setup::GpsLink;
     use wobble_core::app::ports::GpsPort;
     use wobble_core::drivers::gnss_bringup::SentenceCounter;
-    use wobble_stm32f405::adapters::gps::{GpsAdapter, RING_BYTES};
-
-    static RING: StaticCell<[u8; RING_BYTES]> = StaticCell::new();
+    use wobble_stm32f405::adapters::gps::GpsAdapter;
 
     const RMC: &[u8] = b"$GPRMC,123519,A,4807.038,N,01131.000,E,022.4,084.4,230394,003.1,W*6A\r\n";
     const GGA: &[u8] = b"$GPGGA,123519,4807.038,N,01131.000,E,1,08,0.9,545.4,M,46.9,M,,*47\r\n";
 
     fn port() -> GpsAdapter {
         let (board, _) = wobble_on_target::board();
-        GpsAdapter::new(board.gps, RING.init([0; RING_BYTES]))
+        GpsAdapter::new(board.gps)
     }
 
     /// Sends `epochs` epochs at `hz`, reading back as it goes.

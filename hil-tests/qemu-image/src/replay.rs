@@ -180,7 +180,8 @@ impl ReplayedAdc {
 }
 
 impl SteeringPort for ReplayedAdc {
-    async fn read(&mut self) -> Result<SteeringSample, SensorError> {
+    // Each frame replays its own fixture row, however late it is read.
+    async fn read(&mut self, _late_us: u64) -> Result<SteeringSample, SensorError> {
         let ride = self.ride.borrow();
         let row = ride.row.as_ref().ok_or(SensorError::Stale)?;
         if within(self.scenario.steer_open_ms, Instant::now().as_millis()) {

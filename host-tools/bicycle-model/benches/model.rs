@@ -7,7 +7,7 @@ use std::path::Path;
 use criterion::{criterion_group, criterion_main, Criterion};
 use wobble_model::fit::{fit, Observation, Weights};
 use wobble_model::sweep::mode_at;
-use wobble_model::{Mode, Model, ParamSet, Sweep};
+use wobble_model::{critical_speeds, Mode, Model, ParamSet, Sweep};
 
 fn test_bicycle() -> ParamSet {
     ParamSet::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("params/test-bicycle.toml")).unwrap()
@@ -18,6 +18,21 @@ fn sweep_1000(c: &mut Criterion) {
     let speeds: Vec<f64> = (0..1000).map(|i| f64::from(i) * 0.01).collect();
     c.bench_function("wobble model, 1000-speed sweep", |b| {
         b.iter(|| Sweep::run(&model, black_box(&speeds), |_| {}).unwrap());
+    });
+    c.bench_function("wobble model, 1000-speed sweep with critical speeds", |b| {
+        b.iter(|| {
+            let sweep = Sweep::run(&model, black_box(&speeds), |_| {}).unwrap();
+            critical_speeds(&model, &sweep)
+        });
+    });
+    // The floor: the eigenvalues alone at the same 1000 speeds.
+    let (a0, a1) = model.pencil().unwrap();
+    c.bench_function("wobble model, 1000 eigenvalue calls", |b| {
+        b.iter(|| {
+            for &u in black_box(&speeds) {
+                black_box(wobble_model::eig::eigenvalues(&(&a0 + &a1 * u)));
+            }
+        });
     });
 }
 

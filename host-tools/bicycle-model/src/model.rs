@@ -3,6 +3,7 @@
 
 use nalgebra::DMatrix;
 
+use crate::no_slip::{self, NoSlipModel};
 use crate::params::{ModelKind, ParamError, ParamSet};
 use crate::whipple::{self, Benchmark, WhippleMatrices};
 use crate::wobble::{WobbleModel, WobbleParams};
@@ -31,6 +32,9 @@ pub enum Model {
     Whipple(WhippleMatrices),
     /// The extended wobble model (14 states).
     Wobble(Box<WobbleModel>),
+    /// Its non-holonomic counterpart: no lateral slip at the contacts,
+    /// torso and twist free (8 states).
+    NoSlip(Box<NoSlipModel>),
 }
 
 impl Model {
@@ -54,12 +58,24 @@ impl Model {
         })
     }
 
+    /// The non-holonomic counterpart of the bicycle: its own model for a
+    /// Whipple set (which has no slip already), else the wobble model's bodies
+    /// and springs with both contacts rolling without lateral slip.
+    pub fn no_slip_of(set: &ParamSet) -> Result<Self, ParamError> {
+        Ok(match set.model {
+            ModelKind::Whipple => Self::Whipple(Benchmark::from_set(set)?.matrices()),
+            ModelKind::Wobble => {
+                Self::NoSlip(Box::new(NoSlipModel::of(&WobbleModel::from_set(set)?)))
+            }
+        })
+    }
+
     /// The Whipple matrices, if this is the Whipple model.
     #[must_use]
     pub fn whipple_matrices(&self) -> Option<&WhippleMatrices> {
         match self {
             Self::Whipple(m) => Some(m),
-            Self::Wobble(_) => None,
+            Self::Wobble(_) | Self::NoSlip(_) => None,
         }
     }
 
@@ -69,6 +85,23 @@ impl Model {
         match self {
             Self::Whipple(m) => m.state_matrix(speed_mps),
             Self::Wobble(m) => m.state_matrix(speed_mps),
+            Self::NoSlip(m) => m.state_matrix(speed_mps),
+        }
+    }
+
+    /// The pencil `(A0, A1)` with `A(u) = A0 + u A1`, if the state matrix is
+    /// affine in the speed (the wobble model: every speed dependence there is
+    /// `u G`, `u / sigma` or `u` times a slip): one multiply-add per entry
+    /// per speed instead of assembling the equations.
+    #[must_use]
+    pub fn pencil(&self) -> Option<(DMatrix<f64>, DMatrix<f64>)> {
+        match self {
+            Self::Whipple(_) | Self::NoSlip(_) => None,
+            Self::Wobble(m) => {
+                let a0 = m.state_matrix(0.0);
+                let a1 = m.state_matrix(1.0) - &a0;
+                Some((a0, a1))
+            }
         }
     }
 
@@ -78,6 +111,7 @@ impl Model {
         match self {
             Self::Whipple(_) => whipple::STATES.to_vec(),
             Self::Wobble(m) => m.state_names(),
+            Self::NoSlip(_) => no_slip::STATES.to_vec(),
         }
     }
 

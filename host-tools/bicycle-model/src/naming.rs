@@ -18,7 +18,8 @@
 //!   rider's lean oscillation carries much steer, but it is not the wobble;
 //! - roll or steer the largest, oscillating somewhere, with at least
 //!   [`WEAVE_MIN_ROLL_PER_STEER`] roll per steer and below 2 Hz on average: the
-//!   lowest-frequency one is the `weave`;
+//!   one with the largest roll share (of roll and steer) is the `weave` (a
+//!   castering pair made complex by the tyre lags steers);
 //! - steer the largest, oscillating at 2 Hz or more on average: the lowest such
 //!   is the `wobble`;
 //! - real throughout with roll the largest: the slowest (smallest mean
@@ -256,7 +257,12 @@ pub(crate) fn name(
     );
     // The lean is neither weave nor wobble.
     let not_lean = |g: &Group| lean.is_none_or(|l| !std::ptr::eq(g, &groups[l]));
-    let weave = pick(&groups, |g| g.weave_like() && not_lean(g), |g| -g.freq);
+    // The weave rolls; a castering pair made complex by the tyre lags steers.
+    let weave = pick(
+        &groups,
+        |g| g.weave_like() && not_lean(g),
+        |g| g.share(StateRole::Roll) / (g.share(StateRole::Roll) + g.share(StateRole::Steer)),
+    );
     let wobble = pick(&groups, |g| g.wobble_like() && not_lean(g), |g| -g.freq);
     let capsize = pick(
         &groups,

@@ -92,12 +92,11 @@ impl Sweep {
         speeds_mps: &[f64],
         progress: impl FnMut(usize),
     ) -> Result<Self, SweepError> {
-        Self::run_matrices(
-            |u| model.state_matrix(u),
-            &model.state_roles(),
-            speeds_mps,
-            progress,
-        )
+        let roles = model.state_roles();
+        match model.pencil() {
+            Some((a0, a1)) => Self::run_matrices(|u| &a0 + &a1 * u, &roles, speeds_mps, progress),
+            None => Self::run_matrices(|u| model.state_matrix(u), &roles, speeds_mps, progress),
+        }
     }
 
     /// [`Self::run`] on any state matrix function with states of `roles`

@@ -225,3 +225,79 @@ fn wobble_keeps_its_name_whatever_the_hip_stiffness() {
         }
     }
 }
+
+/// The state matrix is affine in the speed: the pencil the sweep evaluates
+/// equals the assembled equations.
+#[test]
+fn state_matrix_is_the_affine_pencil() {
+    let model = Model::from_set(&set("test-bicycle.toml")).unwrap();
+    let (a0, a1) = model.pencil().expect("the wobble model is affine in u");
+    for u in [0.3, 2.0, 7.5, 14.0, 40.0] {
+        let a = model.state_matrix(u);
+        let scale = a.amax();
+        assert!((&a0 + &a1 * u - &a).amax() < 1e-12 * scale, "at {u} m/s");
+    }
+    assert!(Model::from_set(&set("benchmark.toml"))
+        .unwrap()
+        .pencil()
+        .is_none());
+}
+
+/// The non-holonomic counterpart: with the steering head made rigid its
+/// eigenvalues are those of the independent constrained description that
+/// keeps roll, torso and steer (the one checked against BicycleParameters'
+/// rider-lean model), with the same hip spring-damper.
+#[test]
+fn no_slip_counterpart_with_a_rigid_head_is_the_rider_lean_bicycle() {
+    let mut set = set("test-bicycle.toml");
+    set.set_value("steer_head.stiffness", 1e9, "rigid").unwrap();
+    let model = Model::no_slip_of(&set).unwrap();
+    assert_eq!(model.state_names().len(), 8);
+    let wobble = WobbleModel::from_set(&set).unwrap();
+    let [m, c1, k0g, k2] = multibody::constrained(
+        &wobble.lin,
+        &[multibody::PHI, multibody::PHI_R, multibody::DELTA],
+    );
+    let p = &wobble.params;
+    for u in [1.0, 4.0, 8.0] {
+        let mut k = &k0g + &k2 * (u * u);
+        let mut c = &c1 * u;
+        k[(1, 1)] += p.hip_stiffness;
+        c[(1, 1)] += p.hip_damping;
+        c[(2, 2)] += p.steer_damping;
+        let mi = m.clone().try_inverse().unwrap();
+        let mut a = nalgebra::DMatrix::zeros(6, 6);
+        a.view_mut((0, 3), (3, 3)).fill_with_identity();
+        a.view_mut((3, 0), (3, 3)).copy_from(&(-&mi * k));
+        a.view_mut((3, 3), (3, 3)).copy_from(&(-&mi * c));
+        let got = wobble_model::eig::eigenvalues(&model.state_matrix(u)).unwrap();
+        for want in wobble_model::eig::eigenvalues(&a).unwrap() {
+            let d = got
+                .iter()
+                .map(|g| (g - want).norm())
+                .fold(f64::INFINITY, f64::min);
+            assert!(d < 1e-4 * want.norm().max(1.0), "{want} at {u} m/s: {d}");
+        }
+    }
+}
+
+/// Writes the test bicycle's pencil `A0`, `A1` (14 rows each) to the file
+/// `PENCIL_OUT` names, for `scripts/lapack_batch_reference.py` (run by hand).
+#[test]
+#[ignore = "writes a file for the LAPACK comparison"]
+fn write_pencil() {
+    let out = std::env::var("PENCIL_OUT").expect("PENCIL_OUT names the file to write");
+    let (a0, a1) = Model::from_set(&set("test-bicycle.toml"))
+        .unwrap()
+        .pencil()
+        .unwrap();
+    let mut text = String::new();
+    for m in [a0, a1] {
+        for r in m.row_iter() {
+            let cells: Vec<String> = r.iter().map(|v| format!("{v:e}")).collect();
+            text.push_str(&cells.join(","));
+            text.push('\n');
+        }
+    }
+    std::fs::write(out, text).unwrap();
+}

@@ -38,7 +38,7 @@ use std::ops::Range;
 use serde::Serialize;
 
 use super::censor::{Cut, Edge};
-use super::filter::{wobble_band, Biquad, Pass};
+use super::filter::{wobble_band, wobble_band_causal, Biquad, Pass};
 use super::run::Run;
 use super::search::EpisodeSearch;
 use super::sinefit::{fit_mode, SineFit};
@@ -74,6 +74,19 @@ const MIN_DECAY_FIT_S: f64 = 0.15;
 /// Largest unexplained share (RMS) of the signal for a mode fit to count:
 /// a struck oscillation fitted as growth leaves most of it.
 const MAX_RESIDUAL_REL: f64 = 0.5;
+/// A growth must show in the causally filtered signal: its RMS over
+/// [`CAUSAL_WINDOW_S`] before the climb's last [`CAUSAL_TRIM_S`] at least
+/// this share of the zero-phase band's there.
+const CAUSAL_SHARE: f64 = 0.5;
+/// See [`CAUSAL_SHARE`], s.
+const CAUSAL_WINDOW_S: f64 = 0.3;
+/// The causal check of a growth leaves out this much of the climb's end, s.
+const CAUSAL_TRIM_S: f64 = 0.15;
+/// A decay fit the largest swing cannot start (a push there) starts this
+/// much later in turn...
+const PUSH_STEP_S: f64 = 0.05;
+/// ... up to this long after it, s.
+const PUSH_MAX_S: f64 = 0.5;
 /// A growth fit starts this long before the wobble rises, s.
 const TONE_LOOKBACK_S: f64 = 4.0;
 /// A steady tone is looked for within this of the wobble's frequency, Hz.
@@ -210,6 +223,8 @@ pub(super) struct Span<'a> {
     frames: Frames<'a>,
     t_s: &'a [f64],
     band: Vec<f64>,
+    /// The same band filtered causally: a growth must show in it too.
+    causal: Vec<f64>,
     pub energy: Vec<f64>,
     fs_hz: f64,
     place: Place,
@@ -218,6 +233,7 @@ pub(super) struct Span<'a> {
 impl<'a> Span<'a> {
     pub fn new(frames: Frames<'a>, fs_hz: f64, place: Place) -> Self {
         let band = wobble_band(frames.steer_deg, fs_hz);
+        let causal = wobble_band_causal(frames.steer_deg, fs_hz);
         let mut energy: Vec<f64> = band.iter().map(|v| 2.0 * v * v).collect();
         Biquad::butterworth(Pass::Low, ENERGY_SMOOTHING_HZ, fs_hz).filtfilt(&mut energy);
         let energy = energy.into_iter().map(|e| e.max(0.0).sqrt()).collect();
@@ -225,6 +241,7 @@ impl<'a> Span<'a> {
             t_s: frames.t_s,
             frames,
             band,
+            causal,
             energy,
             fs_hz,
             place,
@@ -302,6 +319,7 @@ impl<'a> Span<'a> {
         }
 
         let band = &self.band[window.clone()];
+        let causal = &self.causal[window.clone()];
         // The mode fitted over `range` if it grows (or decays) as asked and
         // explains the signal there.
         let fit = |range: Range<usize>, growing: bool| {
@@ -343,7 +361,25 @@ impl<'a> Span<'a> {
                 tone,
             )?;
             let ok = (mode.sigma_per_s > 0.0) == growing && mode.residual_rel <= MAX_RESIDUAL_REL;
-            ok.then_some((fitted, mode))
+            // A growth must also be there in the causally filtered signal:
+            // the zero-phase band answers a push on the bar before the push
+            // itself, with an oscillation growing towards it that is no
+            // wobble. A real growth is as large in either filter (the same
+            // magnitude response); the push's answer before the push is
+            // only in the zero-phase one. Compared over
+            // [`CAUSAL_WINDOW_S`] ending [`CAUSAL_TRIM_S`] before the top
+            // of the climb (the push itself may fill the last moments).
+            let causal_ok = !growing || {
+                let end = fitted.end.saturating_sub(self.samples(CAUSAL_TRIM_S));
+                let start = end.saturating_sub(self.samples(CAUSAL_WINDOW_S));
+                let rms = |x: &[f64]| {
+                    let n = x.len().max(1) as f64;
+                    (x.iter().map(|v| v * v).sum::<f64>() / n).sqrt()
+                };
+                end > start.max(fitted.start)
+                    && rms(&causal[start..end]) >= CAUSAL_SHARE * rms(&band[start..end])
+            };
+            (ok && causal_ok).then_some((fitted, mode))
         };
         // Quiet before it within the stretch, or it reaches the cut.
         let starts_at_cut = region.start == 0;
@@ -352,7 +388,15 @@ impl<'a> Span<'a> {
                 Some((r, mode)) => (Stability::Unstable, r, mode),
                 None if starts_at_cut => return None,
                 None => {
-                    let (r, mode) = fit(decay_range(&clean, band, local.clone(), floor)?, false)?;
+                    // A push before the ring-down leaves the fall from the
+                    // largest swing unexplained: the fit starts later, past
+                    // the push, until it explains the ring.
+                    let fall = decay_range(&clean, band, local.clone(), floor)?;
+                    let step = self.samples(PUSH_STEP_S).max(1);
+                    let (r, mode) = (0..=self.samples(PUSH_MAX_S) / step)
+                        .map(|k| fall.start + k * step..fall.end)
+                        .take_while(|r| r.end > r.start + 2)
+                        .find_map(|r| fit(r, false))?;
                     (Stability::Stable, r, mode)
                 }
             };

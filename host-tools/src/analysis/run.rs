@@ -161,7 +161,7 @@ pub fn read_rows(
 #[must_use]
 pub fn log_name(path: &Path) -> String {
     path.file_name().map_or_else(
-        || path.display().to_string(),
+        || crate::text::shown(path),
         |n| n.to_string_lossy().into_owned(),
     )
 }

@@ -32,7 +32,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
     if !faults.is_empty() {
         eprintln!(
             "wobblog: {}: warning: {} configuration lines this version does not accept as they are",
-            args.log.display(),
+            crate::text::shown(&args.log),
             faults.first().len()
         );
     }
@@ -56,7 +56,7 @@ impl Header {
     #[must_use]
     pub fn config_text(&self, log: &Path) -> String {
         let name = log.file_name().map_or_else(
-            || log.display().to_string(),
+            || crate::text::shown(log),
             |n| n.to_string_lossy().into_owned(),
         );
         let mut text = format!(

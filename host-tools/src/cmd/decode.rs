@@ -14,8 +14,25 @@ use crate::time::{utc_ms_at, SyncPair, TimeWindow, WindowArgs};
 use crate::CliError;
 use wobble_core::format::{Event, GpsFix, Record};
 
+/// The columns of a decoded row with their units, for `--help` and the
+/// man page (`columns::COLUMNS` in this order; a test holds them together).
+pub const COLUMNS_HELP: &str = "\
+Columns (units in the names):
+  t_s            time since boot, s
+  ax_g ay_g az_g acceleration, g (1 g = 9.80665 m/s2)
+  gx_dps gy_dps gz_dps
+                 angular rate, deg/s
+  steer_deg      steering angle, deg
+  speed_mps      wheel speed, m/s
+  gps_lat_deg    GPS latitude, deg (empty or null without a fix)
+  gps_lon_deg    GPS longitude, deg
+  gps_speed_mps  GPS ground speed, m/s
+  gps_fix        none, 2d or 3d
+  utc            UTC, ISO 8601 (through the GPS sync pairs; empty before the first)";
+
 /// Arguments of `wobblog decode`.
 #[derive(clap::Args)]
+#[command(after_help = COLUMNS_HELP)]
 pub struct Args {
     /// The card log (`RUNnnnnn.WBL`).
     pub log: PathBuf,
@@ -80,6 +97,9 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         window: args.window.window(),
     };
     export.window.check_order(&args.log)?;
+    if export.format == Format::Mcap && args.columns.is_some() {
+        say_mcap_homes(&export.columns);
+    }
     let binary = matches!(export.format, Format::Parquet | Format::Mcap);
     if binary && args.output.is_none() && std::io::stdout().is_terminal() {
         return Err(CliError::Usage(format!(
@@ -105,9 +125,27 @@ pub fn run(args: &Args) -> Result<(), CliError> {
     };
     out.commit()?;
     for line in crate::cmd::logs::warnings(&losses) {
-        eprintln!("wobblog: {}: warning: {line}", args.log.display());
+        eprintln!(
+            "wobblog: {}: warning: {line}",
+            crate::text::shown(&args.log)
+        );
     }
     Ok(())
+}
+
+/// Says where each chosen column that is not a sensor field goes in MCAP,
+/// and which have no home there.
+fn say_mcap_homes(columns: &[Column]) {
+    for column in columns {
+        match crate::export::mcap::home_of(column.name) {
+            Some("its sensor channel") => {}
+            Some(home) => eprintln!("wobblog: --columns {}: in MCAP it is {home}", column.name),
+            None => eprintln!(
+                "wobblog: warning: --columns {}: MCAP has no field for it; left out",
+                column.name
+            ),
+        }
+    }
 }
 
 /// Decodes `log` into `out`; returns what could not be recovered.
@@ -131,11 +169,21 @@ pub fn decode_to(
     let mut meta = LogMetadata::default();
     // Fixes and events have messages of their own only in MCAP.
     let mut events = (export.format == Format::Mcap).then(EventConverter::new);
+    if events.is_some() {
+        // MCAP log times are UTC from the first row on, placed through the
+        // first sync pair: find it before writing.
+        if let Some((t_us, unix_ms)) = first_sync_pair(log)? {
+            sink.sync_pair(t_us, unix_ms);
+        }
+    }
+    let log_name = log
+        .file_name()
+        .map_or_else(String::new, |n| n.to_string_lossy().into_owned());
     read_log(log, |event| {
         losses.observe(&event);
         meta.observe(&event);
         if let Some(e) = events.as_mut().and_then(|c| c.convert(&event)) {
-            sink.event(&e);
+            sink.event(&e, &log_name);
         }
         if let Event::Record(record) = event {
             match (&events, &record) {
@@ -144,6 +192,7 @@ pub fn decode_to(
                     if let Ok(ms) = i64::try_from(pair.unix_ms) {
                         sink.sync = vec![(pair.t_us as f64 / 1e6, ms)];
                     }
+                    sink.sync_pair(pair.t_us, pair.unix_ms);
                 }
                 _ => {}
             }
@@ -210,10 +259,24 @@ impl<W: Write + Send> WindowedSink<W> {
         self.keep(inside, |w| w.gps(fix));
     }
 
-    fn event(&mut self, event: &LogEvent) {
+    fn event(&mut self, event: &LogEvent, log_name: &str) {
         let inside = self
             .window
             .contains(event.t_s, utc_ms_at(&self.sync, event.t_s));
-        self.keep(inside, |w| w.event(event));
+        self.keep(inside, |w| w.event(event, log_name));
     }
+
+    fn sync_pair(&mut self, t_us: u64, unix_ms: u64) {
+        self.keep(true, |w| w.sync(t_us, unix_ms));
+    }
+}
+
+/// The log's first GPS sync pair (µs since boot, ms since 1970), reading
+/// only up to it.
+fn first_sync_pair(log: &Path) -> Result<Option<(u64, u64)>, CliError> {
+    let found = crate::reader::read_log_try(log, |event| match event {
+        Event::Record(Record::UtcSync(pair)) => Err((pair.t_us, pair.unix_ms)),
+        _ => Ok(()),
+    })?;
+    Ok(found.err())
 }

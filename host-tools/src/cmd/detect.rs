@@ -94,9 +94,21 @@ pub struct Replay {
     pub span_s: Option<(f64, f64)>,
     /// Whether the CSV has a `speed_mps` column.
     pub has_speed: bool,
-    /// Lines at which a time gap restarted the detector.
+    /// Lines (or frames) at which a time gap restarted the detector: the
+    /// first [`GAP_NOTES_MAX`] of them.
     pub restarts: Vec<u64>,
+    /// Time gaps that restarted the detector, all of them.
+    pub restart_count: u64,
 }
+
+/// Times a log can hold, s (microseconds since boot in a u64, with room).
+const T_S_RANGE: (f64, f64) = (0.0, 1.8e13);
+/// Steering angles a log stores, deg (an i16 of 0.01 deg).
+const STEER_DEG_RANGE: (f64, f64) = (-327.68, 327.67);
+/// Speeds a log stores, m/s (a u16 of mm/s).
+const SPEED_MPS_RANGE: (f64, f64) = (0.0, 65.535);
+/// Time gaps noted one by one on stderr; the rest are counted.
+const GAP_NOTES_MAX: usize = 20;
 
 /// Replays CSV text from `input` through a fresh detector as `config` sets it
 /// up (its detector settings on its wheel). `path` only names the input in
@@ -145,7 +157,7 @@ pub fn replay(path: &Path, input: impl Read, config: &Config) -> Result<Replay, 
         if record.iter().all(str::is_empty) {
             continue;
         }
-        let number = |col: usize, name: &str| -> Result<Option<f64>, CliError> {
+        let number = |col: usize, name: &str, range, unit| -> Result<Option<f64>, CliError> {
             let cell = Cell {
                 line,
                 column: col + 1,
@@ -153,16 +165,18 @@ pub fn replay(path: &Path, input: impl Read, config: &Config) -> Result<Replay, 
             };
             match record.get(col) {
                 None | Some("") => Ok(None),
-                Some(text) => number_in(text, (f64::MIN, f64::MAX), "")
+                Some(text) => number_in(text, range, unit)
                     .map(Some)
                     .map_err(|e| cell.error(path, e)),
             }
         };
-        let t_s = number(t_col, "t_s")?.ok_or_else(|| at_line(line, "`t_s` is empty".into()))?;
-        let steer = number(steer_col, "steer_deg")?
+        // The ranges a log stores (as `encode` checks them).
+        let t_s = number(t_col, "t_s", T_S_RANGE, " s")?
+            .ok_or_else(|| at_line(line, "`t_s` is empty".into()))?;
+        let steer = number(steer_col, "steer_deg", STEER_DEG_RANGE, " deg")?
             .ok_or_else(|| at_line(line, "`steer_deg` is empty".into()))?;
         let speed = match speed_col {
-            Some(c) => number(c, "speed_mps")?,
+            Some(c) => number(c, "speed_mps", SPEED_MPS_RANGE, " m/s")?,
             None => None,
         };
         let step = steps.step(t_s, line).map_err(|e| {
@@ -201,7 +215,10 @@ impl Replay {
                 });
             }
             det.reset();
-            self.restarts.push(place);
+            if self.restarts.len() < GAP_NOTES_MAX {
+                self.restarts.push(place);
+            }
+            self.restart_count += 1;
         }
         self.samples += 1;
         self.span_s = Some((self.span_s.map_or(t_s, |s| s.0), t_s));
@@ -432,8 +449,8 @@ pub fn table(r: &Replay) -> String {
             crate::words::plural(r.kicks.len(), "kick")
         );
     }
-    if !r.restarts.is_empty() {
-        let _ = write!(s, ", {} restarts at time gaps", r.restarts.len());
+    if r.restart_count > 0 {
+        let _ = write!(s, ", {} restarts at time gaps", r.restart_count);
     }
     s.push('\n');
     s
@@ -447,7 +464,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
             if header.config.is_empty() {
                 eprintln!(
                     "wobblog: {}: note: no configuration in the header; the defaults are used",
-                    log.display()
+                    crate::text::shown(log)
                 );
             }
             let config = log_config(&header.config, &args.set)?;
@@ -456,14 +473,19 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         (None, Some(csv)) => {
             let config = log_config(&[], &args.set)?;
             let file = std::fs::File::open(csv).map_err(|e| CliError::file(csv, e))?;
-            (replay(csv, io::BufReader::new(file), &config)?, csv, "line")
+            let input = crate::csv_input::LineCap::new(io::BufReader::new(file));
+            (replay(csv, input, &config)?, csv, "line")
         }
         (None, None) => return Err(CliError::Usage("give a LOG or --csv IN".into())),
     };
-    for at in &r.restarts {
+    let shown = crate::text::shown(input);
+    for at in r.restarts.iter().take(GAP_NOTES_MAX) {
+        eprintln!("wobblog: {shown}: {place} {at}: time gap; detector restarted");
+    }
+    if r.restart_count > GAP_NOTES_MAX as u64 {
         eprintln!(
-            "wobblog: {}: {place} {at}: time gap; detector restarted",
-            input.display()
+            "wobblog: {shown}: {} more time gaps; the detector restarted at each",
+            r.restart_count - GAP_NOTES_MAX as u64
         );
     }
     let text = if args.json {
@@ -568,11 +590,36 @@ mod tests {
         }
         text.push_str("20.00,0\n");
         let r = run_text(&text).unwrap();
-        assert_eq!(r.restarts, vec![602]);
+        assert_eq!((r.restarts.clone(), r.restart_count), (vec![602], 1));
         assert!(matches!(r.changes[0].event, AlertEvent::On { .. }));
         assert_eq!(
             r.changes.last().map(|c| (c.t_s, c.event)),
             Some((5.99, AlertEvent::Off))
         );
+    }
+
+    #[test]
+    fn values_a_log_cannot_hold_are_refused_with_line_and_column() {
+        for (row, column) in [
+            ("0.01,1e300,4", "column 2: `steer_deg` is 1000"),
+            ("0.01,1,-1", "column 3: `speed_mps` is -1,"),
+            ("-0.01,1,4", "column 1: `t_s` is -0.01,"),
+        ] {
+            let text = format!("t_s,steer_deg,speed_mps\n0,0,4\n{row}\n");
+            let e = message(run_text(&text).unwrap_err());
+            assert!(e.contains("line 3") && e.contains(column), "{e}");
+        }
+    }
+
+    #[test]
+    fn time_gaps_are_all_counted_but_only_the_first_kept() {
+        let mut text = String::from("t_s,steer_deg\n");
+        for i in 0..200 {
+            text.push_str(&format!("{},0\n{},0\n", f64::from(i), f64::from(i) + 0.01));
+        }
+        let r = run_text(&text).unwrap();
+        assert_eq!(r.restart_count, 199);
+        assert_eq!(r.restarts.len(), GAP_NOTES_MAX);
+        assert!(table(&r).contains("199 restarts"));
     }
 }

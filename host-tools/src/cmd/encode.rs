@@ -49,6 +49,7 @@ const GPS_REPEAT_US: u64 = 500_000;
 pub fn run(args: &Args) -> Result<(), CliError> {
     let mut output = Output::create(&args.output, &[&args.csv])?;
     let input = File::open(&args.csv).map_err(|e| CliError::file(&args.csv, e))?;
+    let input = crate::csv_input::LineCap::new(input);
     encode(input, &args.csv, &mut output, &args.output, args.resample)?;
     output.commit()
 }
@@ -72,6 +73,22 @@ impl Columns {
             column: self.1.unwrap_or(0) + 1,
             name: UTC_COLUMN,
         }
+    }
+}
+
+/// Refuses a header naming a column the log has no place for: a misspelt
+/// one (`steer` for `steer_deg`) would otherwise be silently zero.
+fn refuse_unknown_columns(header: &csv::StringRecord, in_name: &Path) -> Result<(), CliError> {
+    let known = |name: &str| CSV_COLUMNS.contains(&name) || name == UTC_COLUMN;
+    match header.iter().map(str::trim).find(|name| !known(name)) {
+        Some(name) => Err(CliError::file(
+            in_name,
+            format!(
+                "no column {name:?} in a log; the columns are {},{UTC_COLUMN} (missing ones are zero)",
+                CSV_COLUMNS.join(",")
+            ),
+        )),
+        None => Ok(()),
     }
 }
 
@@ -130,6 +147,7 @@ pub fn encode(
         .headers()
         .map_err(|e| CliError::file(in_name, e))?
         .clone();
+    refuse_unknown_columns(&header, in_name)?;
     let columns = Columns::new(&header);
     if columns.0[0].is_none() {
         return Err(CliError::file(
@@ -275,12 +293,20 @@ fn parse_row(
             .and_then(|c| Some((c, record.get(c)?)))
             .filter(|(_, f)| !f.is_empty())
     };
-    // A missing column or empty cell is zero (or no GPS); a value that is
-    // given must be one the log can store.
+    // A missing column is zero (or no GPS); an empty cell of a column that
+    // is there is refused (it would be stored as a zero nobody measured); a
+    // value that is given must be one the log can store.
     let number = |i: usize, range: (f64, f64), unit: &str| -> Result<f64, CliError> {
-        field(i).map_or(Ok(0.0), |(c, text)| {
-            number_in(text, range, unit).map_err(|e| cell(i, c).error(path, e))
-        })
+        match (columns.0[i], field(i)) {
+            (None, _) => Ok(0.0),
+            (Some(c), None) => Err(cell(i, c).error(
+                path,
+                "is empty: give a value, or leave the column out (then it is zero)",
+            )),
+            (Some(c), Some((_, text))) => {
+                number_in(text, range, unit).map_err(|e| cell(i, c).error(path, e))
+            }
+        }
     };
     let counts = |scale: f32| {
         let k = f64::from(scale);
@@ -320,7 +346,15 @@ fn parse_row(
                 match field(12) {
                     Some((_, "3d")) => FixMode::Fix3d,
                     Some((_, "2d")) => FixMode::Fix2d,
-                    Some((_, "none")) => FixMode::None,
+                    // A position without a fix is not one: `decode` writes
+                    // none, and the log would keep it but no reader show it.
+                    Some((c, "none")) => {
+                        return Err(cell(12, c).error(
+                            path,
+                            "is none but a position is given: a position needs 2d or 3d \
+                             (leave gps_lat_deg and gps_lon_deg empty without a fix)",
+                        ))
+                    }
                     Some((c, other)) => {
                         return Err(cell(12, c)
                             .error(path, format!("must be 2d, 3d or none, not {other:?}")))
@@ -424,5 +458,44 @@ mod tests {
         let header = csv::StringRecord::from(vec!["t_s", "steer_deg", "utc"]);
         let cell = Columns::new(&header).utc_cell(7);
         assert_eq!((cell.line, cell.column, cell.name), (7, 3, "utc"));
+    }
+
+    fn encoded(text: &str) -> Result<(), String> {
+        encode(
+            text.as_bytes(),
+            Path::new("in.csv"),
+            std::io::sink(),
+            Path::new("out"),
+            false,
+        )
+        .map_err(|e| e.to_string())
+    }
+
+    #[test]
+    fn an_empty_cell_is_refused_but_a_missing_column_is_zero() {
+        let e = encoded("t_s,steer_deg,speed_mps\n0,1,4\n0.01,,4\n").unwrap_err();
+        assert!(e.contains("line 3, column 2: `steer_deg` is empty"), "{e}");
+        encoded("t_s,steer_deg\n0,1\n0.01,2\n").unwrap();
+    }
+
+    #[test]
+    fn a_position_without_a_fix_is_refused() {
+        let head = "t_s,steer_deg,gps_lat_deg,gps_lon_deg,gps_fix\n";
+        let e = encoded(&format!("{head}0,1,52.1,6.9,none\n")).unwrap_err();
+        assert!(
+            e.contains("column 5: `gps_fix` is none but a position"),
+            "{e}"
+        );
+        encoded(&format!("{head}0,1,52.1,6.9,3d\n0.01,1,,,\n")).unwrap();
+    }
+
+    #[test]
+    fn a_day_the_month_lacks_and_a_leap_second_off_its_day_are_refused() {
+        let head = "t_s,steer_deg,utc\n";
+        for utc in ["2026-02-30T10:00:00.000Z", "2026-02-14T23:59:60.000Z"] {
+            let e = encoded(&format!("{head}0,1,{utc}\n")).unwrap_err();
+            assert!(e.contains("is not a UTC time"), "{e}");
+        }
+        encoded(&format!("{head}0,1,2016-12-31T23:59:60.000Z\n")).unwrap();
     }
 }

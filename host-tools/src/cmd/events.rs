@@ -7,23 +7,24 @@ use std::path::{Path, PathBuf};
 use crate::events::{EventConverter, LogEvent, TimeOrder};
 use crate::output::Output;
 use crate::reader::read_log_try;
+use crate::time::{utc_text_at, SyncPair};
 use crate::CliError;
+use wobble_core::format::{Event, Record};
 
 /// Arguments of `wobblog events`.
 #[derive(clap::Args)]
 pub struct Args {
     /// The card log (`RUNnnnnn.WBL`).
     pub log: PathBuf,
-    /// One JSON object per line (`{"t_s": .., "event": "alert_on", ..}`)
-    /// instead of a table.
-    #[arg(long)]
-    pub json: bool,
+    /// `--json` (or `--format jsonl`) for JSON instead of text.
+    #[command(flatten)]
+    pub output: crate::cmd::logs::JsonArgs,
 }
 
 /// Runs `wobblog events`.
 pub fn run(args: &Args) -> Result<(), CliError> {
     let mut out = Output::stdout();
-    match list(&args.log, args.json, &mut out)? {
+    match list(&args.log, args.output.is_json()?, &mut out)? {
         Ok(()) => out.commit(),
         Err(e) => Err(out.error(e)),
     }
@@ -40,27 +41,57 @@ pub fn list(path: &Path, json: bool, out: impl Write) -> Result<std::io::Result<
         json,
         count: 0,
     };
-    let walked = walk(path, |e| listing.event(&e))?;
+    let walked = walk(path, |e, utc| listing.event(&e, utc))?;
     Ok(walked.and_then(|()| listing.finish()))
 }
 
 /// Hands the events of the log at `path` to `visit` in time order, holding
-/// only the few that may still move ([`TimeOrder`]). An error from `visit`
-/// ends the walk and is the inner result.
+/// only the few that may still move ([`TimeOrder`]), each with its UTC
+/// through the sync pairs read so far, as `decode`'s `utc` column places a
+/// frame. An error from `visit` ends the walk and is the
+/// inner result.
 ///
 /// # Errors
 /// The log cannot be read.
 pub fn walk<E>(
     path: &Path,
-    mut visit: impl FnMut(LogEvent) -> Result<(), E>,
+    mut visit: impl FnMut(LogEvent, Option<String>) -> Result<(), E>,
 ) -> Result<Result<(), E>, CliError> {
     let mut converter = EventConverter::new();
     let mut order = TimeOrder::new();
-    let walked = read_log_try(path, |event| match converter.convert(&event) {
-        Some(e) => order.push(e, &mut visit),
-        None => Ok(()),
+    // Every pair: an event held back may come before the latest one.
+    let mut pairs: Vec<SyncPair> = Vec::new();
+    let walked = read_log_try(path, |event| {
+        if let Event::Record(Record::UtcSync(pair)) = &event {
+            if let Ok(ms) = i64::try_from(pair.unix_ms) {
+                pairs.push((pair.t_us as f64 / 1e6, ms));
+            }
+        }
+        match converter.convert(&event) {
+            Some(e) => order.push(e, &mut |e: LogEvent| {
+                let utc = utc_text_at(&pairs, e.t_s);
+                visit(e, utc)
+            }),
+            None => Ok(()),
+        }
     })?;
-    Ok(walked.and_then(|()| order.finish(&mut visit)))
+    Ok(walked.and_then(|()| {
+        order.finish(&mut |e: LogEvent| {
+            let utc = utc_text_at(&pairs, e.t_s);
+            visit(e, utc)
+        })
+    }))
+}
+
+/// One event of the JSON lines: its time since boot, UTC, kind and fields.
+#[derive(serde::Serialize)]
+struct JsonEvent<'a> {
+    t_s: f64,
+    /// ISO 8601, when the log has UTC there.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    utc: Option<String>,
+    #[serde(flatten)]
+    kind: &'a crate::events::EventKind,
 }
 
 /// The events as a table or as JSON lines.
@@ -71,18 +102,28 @@ struct Listing<W: Write> {
 }
 
 impl<W: Write> Listing<W> {
-    fn event(&mut self, e: &LogEvent) -> std::io::Result<()> {
+    fn event(&mut self, e: &LogEvent, utc: Option<String>) -> std::io::Result<()> {
         self.count += 1;
         if self.json {
-            serde_json::to_writer(&mut self.out, e)?;
+            let line = JsonEvent {
+                t_s: e.t_s,
+                utc,
+                kind: &e.kind,
+            };
+            serde_json::to_writer(&mut self.out, &line)?;
             return self.out.write_all(b"\n");
         }
         if self.count == 1 {
-            writeln!(self.out, "{:>10}  {:<11}  details", "t_s", "event")?;
+            writeln!(
+                self.out,
+                "{:>10}  {:<24}  {:<11}  details",
+                "t_s", "utc", "event"
+            )?;
         }
         let line = format!(
-            "{:>10.3}  {:<11}  {}",
+            "{:>10.3}  {:<24}  {:<11}  {}",
             e.t_s,
+            utc.as_deref().unwrap_or("-"),
             e.kind.name(),
             e.kind.describe()
         );

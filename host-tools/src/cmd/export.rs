@@ -61,7 +61,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
     bar.finish_and_clear();
     eprintln!(
         "wobblog: {}: {} written",
-        args.output.display(),
+        crate::text::shown(&args.output),
         crate::words::plural(entries.len() - skipped, "run")
     );
     if skipped > 0 {

@@ -10,7 +10,7 @@ use wobble_core::format::{Event as LogEvent, GpsFix, Record};
 use crate::output::Output;
 use crate::reader::read_log_try;
 use crate::rows::GpsColumns;
-use crate::time::{TimeWindow, WindowArgs};
+use crate::time::{utc_ms_at, SyncPair, TimeWindow, WindowArgs};
 use crate::CliError;
 
 /// Arguments of `wobblog gpx`.
@@ -34,14 +34,14 @@ const SEGMENT_GAP_US: u64 = 5_000_000;
 /// Runs `wobblog gpx`.
 pub fn run(args: &Args) -> Result<(), CliError> {
     let mut out = Output::create_or_stdout(args.output.as_deref(), &[&args.log])?;
-    let name = args
-        .log
-        .file_stem()
-        .map_or_else(String::new, |s| s.to_string_lossy().into_owned());
+    // Control characters are not XML: a name holding them is escaped.
+    let name = args.log.file_stem().map_or_else(String::new, |s| {
+        crate::text::escape_controls(&s.to_string_lossy()).into_owned()
+    });
     let mut points = 0usize;
     let mut gpx = Gpx::new(&mut out, &name);
     let walked = track(&args.log, args.window.window(), |step| {
-        points += usize::from(matches!(step, Step::Point(_)));
+        points += usize::from(matches!(step, Step::Point(..)));
         gpx.step(step)
     })?;
     walked
@@ -50,7 +50,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
     if points == 0 {
         eprintln!(
             "wobblog: {}: warning: no GPS fix with a position; the track is empty",
-            args.log.display()
+            crate::text::shown(&args.log)
         );
     }
     out.commit()
@@ -59,8 +59,10 @@ pub fn run(args: &Args) -> Result<(), CliError> {
 /// What the track does next.
 #[derive(Debug)]
 pub enum Step<'a> {
-    /// A fix with a position, in the current segment.
-    Point(&'a GpsFix),
+    /// A fix with a position, in the current segment, and its UTC (ms
+    /// since 1970): the fix's own, else through the log's sync pairs as
+    /// `decode`'s `utc` column gives it.
+    Point(&'a GpsFix, Option<i64>),
     /// The current segment ends: a gap in the fixes or in the file.
     Break,
 }
@@ -80,7 +82,14 @@ pub fn track<E>(
     // The time of the open segment's last point.
     let mut last_us: Option<u64> = None;
     let (mut points, mut span_s, mut has_utc) = (0u64, None::<(f64, f64)>, false);
+    // The latest sync pair, for fixes without a UTC of their own.
+    let mut sync: Vec<SyncPair> = Vec::new();
     let walked = read_log_try(log, |event| {
+        if let LogEvent::Record(Record::UtcSync(pair)) = &event {
+            if let Ok(ms) = i64::try_from(pair.unix_ms) {
+                sync = vec![(pair.t_us as f64 / 1e6, ms)];
+            }
+        }
         let LogEvent::Record(Record::Gps(fix)) = event else {
             // A block lost from the file may have held fixes.
             if matches!(event, LogEvent::Gap(_)) && last_us.take().is_some() {
@@ -88,8 +97,11 @@ pub fn track<E>(
             }
             return Ok(());
         };
-        let utc_ms = fix.utc.and_then(|u| i64::try_from(u.unix_ms()).ok());
         let t_s = fix.t_us as f64 / 1e6;
+        let utc_ms = fix
+            .utc
+            .and_then(|u| i64::try_from(u.unix_ms()).ok())
+            .or_else(|| utc_ms_at(&sync, t_s));
         let positioned = GpsColumns::from_fix(&fix).is_some();
         if positioned {
             has_utc |= utc_ms.is_some();
@@ -106,7 +118,7 @@ pub fn track<E>(
         }
         last_us = Some(fix.t_us);
         points += 1;
-        visit(Step::Point(&fix))
+        visit(Step::Point(&fix, utc_ms))
     })?;
     if walked.is_ok() && points == 0 && !window.is_all() {
         return Err(window.selects_nothing(log, "GPS fixes with a position", span_s, has_utc));
@@ -159,13 +171,13 @@ impl<'n, W: Write> Gpx<'n, W> {
     pub fn step(&mut self, step: Step<'_>) -> std::io::Result<()> {
         self.start()?;
         match step {
-            Step::Point(fix) => {
+            Step::Point(fix, utc_ms) => {
                 if !self.in_segment {
                     self.w
                         .write_event(Event::Start(BytesStart::new("trkseg")))?;
                     self.in_segment = true;
                 }
-                write_point(&mut self.w, fix)
+                write_point(&mut self.w, fix, utc_ms)
             }
             Step::Break => self.end_segment(),
         }
@@ -191,7 +203,11 @@ impl<'n, W: Write> Gpx<'n, W> {
     }
 }
 
-fn write_point<W: Write>(w: &mut Writer<W>, fix: &GpsFix) -> std::io::Result<()> {
+fn write_point<W: Write>(
+    w: &mut Writer<W>,
+    fix: &GpsFix,
+    utc_ms: Option<i64>,
+) -> std::io::Result<()> {
     let Some(pos) = GpsColumns::from_fix(fix) else {
         return Ok(());
     };
@@ -206,8 +222,12 @@ fn write_point<W: Write>(w: &mut Writer<W>, fix: &GpsFix) -> std::io::Result<()>
                 w.create_element("ele")
                     .write_text_content(BytesText::new(&ele))?;
             }
-            if let Some(utc) = fix.utc {
-                let time = crate::time::iso8601(utc);
+            // The fix's own time keeps a leap second (23:59:60).
+            let time = fix
+                .utc
+                .map(crate::time::iso8601)
+                .or_else(|| utc_ms.and_then(crate::time::iso8601_unix_ms));
+            if let Some(time) = time {
                 w.create_element("time")
                     .write_text_content(BytesText::new(&time))?;
             }

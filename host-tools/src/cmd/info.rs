@@ -5,6 +5,7 @@ use std::path::PathBuf;
 use crate::cmd::logs::print_stdout;
 use crate::reader::read_log;
 use crate::summary::{Summary, SummaryBuilder};
+use crate::text::escape_controls;
 use crate::CliError;
 
 /// Arguments of `wobblog info`.
@@ -12,15 +13,15 @@ use crate::CliError;
 pub struct Args {
     /// The card log (`RUNnnnnn.WBL`).
     pub log: PathBuf,
-    /// Print one JSON object instead of text.
-    #[arg(long)]
-    pub json: bool,
+    /// `--json` (or `--format jsonl`) for JSON instead of text.
+    #[command(flatten)]
+    pub output: crate::cmd::logs::JsonArgs,
 }
 
 /// Runs `wobblog info`.
 pub fn run(args: &Args) -> Result<(), CliError> {
     let summary = summarise(&args.log)?;
-    let text = if args.json {
+    let text = if args.output.is_json()? {
         let json =
             serde_json::to_string_pretty(&summary).map_err(|e| CliError::file(&args.log, e))?;
         json + "\n"
@@ -40,8 +41,11 @@ pub fn summarise(path: &std::path::Path) -> Result<Summary, CliError> {
 fn render(path: &std::path::Path, s: &Summary) -> String {
     use std::fmt::Write;
     let mut o = String::new();
-    let opt = |v: &Option<String>| v.clone().unwrap_or_else(|| "unknown".into());
-    let _ = writeln!(o, "log:          {}", path.display());
+    let opt = |v: &Option<String>| {
+        v.as_deref()
+            .map_or_else(|| "unknown".into(), |t| escape_controls(t).into_owned())
+    };
+    let _ = writeln!(o, "log:          {}", crate::text::shown(path));
     let _ = writeln!(
         o,
         "firmware:     {}  device {}  run {}",
@@ -90,16 +94,20 @@ fn render(path: &std::path::Path, s: &Summary) -> String {
     if s.repeated_blocks + s.out_of_range > 0 {
         let _ = writeln!(
             o,
-            "invalid:      {} repeated or stale blocks decoded once, {} impossible values dropped or replaced",
+            "invalid:      {} copies of blocks skipped (decoded once), {} impossible values dropped, replaced or flagged",
             s.repeated_blocks, s.out_of_range
         );
     }
     let _ = writeln!(
         o,
-        "gps:          {} fixes, {:.1} % of samples with a position, first UTC {}",
-        s.gps_fixes,
-        s.gps_coverage_pct,
-        opt(&s.first_utc)
+        "gps:          {} fixes, {:.1} % of samples with a position",
+        s.gps_fixes, s.gps_coverage_pct,
+    );
+    let _ = writeln!(
+        o,
+        "utc:          {} to {} (frames, through the GPS sync pairs)",
+        opt(&s.first_utc),
+        opt(&s.last_utc)
     );
     let _ = writeln!(o, "alerts:       {}", s.alerts.len());
     for a in &s.alerts {
@@ -123,7 +131,7 @@ fn render(path: &std::path::Path, s: &Summary) -> String {
     );
     let _ = writeln!(o, "config:       {} lines", s.config.len());
     for line in &s.config {
-        let _ = writeln!(o, "  {line}");
+        let _ = writeln!(o, "  {}", escape_controls(line));
     }
     let losses = s.losses.describe();
     if !losses.is_empty() {

@@ -6,7 +6,7 @@
 //! fix it emits is printed as one JSON object per line; counted faults are
 //! summarised on stderr.
 
-use std::io::{self, Write};
+use std::io::{self, Read, Write};
 use std::path::PathBuf;
 
 use serde::Serialize;
@@ -19,6 +19,9 @@ use crate::CliError;
 
 /// Bytes handed to the receiver at once, like a UART DMA half-buffer.
 const CHUNK: usize = 64;
+/// Bytes read from the capture at a time: a capture of any length (or a
+/// device that never ends) is replayed in this much memory.
+const READ_LEN: usize = 1 << 16;
 
 /// Arguments of `wobblog nmea`.
 #[derive(clap::Args)]
@@ -73,21 +76,25 @@ impl From<&GpsFix> for FixJson {
 
 /// Runs `wobblog nmea`.
 pub fn run(args: &Args) -> Result<(), CliError> {
-    let capture = std::fs::read(&args.input).map_err(|e| CliError::file(&args.input, e))?;
+    let capture = std::fs::File::open(&args.input).map_err(|e| CliError::file(&args.input, e))?;
     let config = GpsConfig {
         baud: args.baud,
         ..GpsConfig::default()
     };
     let mut out = Output::stdout();
-    let replayed = replay(&capture, config, &mut |fix| write_fix(&mut out, fix));
-    let stats = replayed.map_err(|e| out.error(e))?;
+    let replayed = replay(capture, config, &mut |fix| write_fix(&mut out, fix));
+    let stats = match replayed {
+        Ok(stats) => stats,
+        Err(ReplayError::Read(e)) => return Err(CliError::file(&args.input, e)),
+        Err(ReplayError::Write(e)) => return Err(out.error(e)),
+    };
     out.commit()?;
     for (code, &count) in (1u8..).zip(&stats.faults) {
         if count > 0 {
             let what = gps::fault_name(code).unwrap_or("other faults");
             eprintln!(
                 "wobblog: {}: warning: {what}: {count}",
-                args.input.display()
+                crate::text::shown(&args.input)
             );
         }
     }
@@ -99,37 +106,88 @@ fn write_fix(out: &mut impl Write, fix: &GpsFix) -> io::Result<()> {
     out.write_all(b"\n")
 }
 
+/// Why a replay stopped early.
+#[derive(Debug)]
+pub enum ReplayError {
+    /// The capture could not be read.
+    Read(io::Error),
+    /// A fix could not be passed on (`on_fix` failed).
+    Write(io::Error),
+}
+
 /// Feeds `capture` (its `#` lines skipped) through the GPS path on a synthetic
-/// clock and hands every fix to `on_fix`, stopping at its first error;
-/// returns the path's counters.
+/// clock, reading it as it goes, and hands every fix to `on_fix`, stopping
+/// at its first error; returns the path's counters.
+///
+/// # Errors
+/// The capture cannot be read, or `on_fix` failed.
 pub fn replay(
-    capture: &[u8],
+    mut capture: impl Read,
     config: GpsConfig,
     on_fix: &mut impl FnMut(&GpsFix) -> io::Result<()>,
-) -> io::Result<GpsStats> {
+) -> Result<GpsStats, ReplayError> {
     let char_ns = 10_000_000_000 / u64::from(config.baud.max(1));
     let mut rx = GpsReceiver::new(config);
     let mut result = Ok(());
     let mut index = 0u64;
-    let lines = capture
-        .split_inclusive(|&b| b == b'\n')
-        .filter(|l| !l.starts_with(b"#"));
-    for line in lines {
-        for chunk in line.chunks(CHUNK) {
-            index += chunk.len() as u64;
-            // The chunk's last byte arrived at the end of its character time.
-            rx.feed(chunk, index * char_ns / 1000, &mut |e| {
-                forward(e, on_fix, &mut result);
-            });
+    let mut buf = vec![0u8; READ_LEN];
+    // Whether the next byte starts a line, and whether the line being read
+    // is a comment.
+    let (mut line_start, mut comment) = (true, false);
+    // A chunk being gathered: each line goes out in chunks of CHUNK bytes
+    // from its start, however the reads split it.
+    let mut pending: Vec<u8> = Vec::with_capacity(CHUNK);
+    let mut feed = |chunk: &[u8], rx: &mut GpsReceiver, result: &mut io::Result<()>| {
+        index += chunk.len() as u64;
+        // The chunk's last byte arrived at the end of its character time.
+        rx.feed(chunk, index * char_ns / 1000, &mut |e| {
+            forward(e, on_fix, result);
+        });
+    };
+    loop {
+        let n = match capture.read(&mut buf) {
+            Ok(0) => break,
+            Ok(n) => n,
+            Err(e) if e.kind() == io::ErrorKind::Interrupted => continue,
+            Err(e) => return Err(ReplayError::Read(e)),
+        };
+        let mut rest = &buf[..n];
+        while let Some(&first) = rest.first() {
+            if line_start {
+                comment = first == b'#';
+            }
+            let end = rest
+                .iter()
+                .position(|&b| b == b'\n')
+                .map_or(rest.len(), |i| i + 1);
+            let (line, tail) = rest.split_at(end);
+            line_start = line.ends_with(b"\n");
+            rest = tail;
+            if comment {
+                continue;
+            }
+            let mut piece = line;
+            while !piece.is_empty() {
+                let take = (CHUNK - pending.len()).min(piece.len());
+                pending.extend_from_slice(&piece[..take]);
+                piece = &piece[take..];
+                if pending.len() == CHUNK || (piece.is_empty() && line_start) {
+                    feed(&pending, &mut rx, &mut result);
+                    pending.clear();
+                }
+            }
+            if let Err(e) = result {
+                return Err(ReplayError::Write(e));
+            }
         }
-        if result.is_err() {
-            return result.map(|()| rx.stats());
-        }
+    }
+    if !pending.is_empty() {
+        feed(&pending, &mut rx, &mut result);
     }
     rx.finish(index * char_ns / 1000, &mut |e| {
         forward(e, on_fix, &mut result)
     });
-    result.map(|()| rx.stats())
+    result.map_err(ReplayError::Write).map(|()| rx.stats())
 }
 
 fn forward(
@@ -139,5 +197,53 @@ fn forward(
 ) {
     if let (GpsEvent::Fix(fix), Ok(())) = (event, &result) {
         *result = on_fix(&fix);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A reader handing out `step` bytes at a time.
+    struct Trickle<'a>(&'a [u8], usize);
+
+    impl Read for Trickle<'_> {
+        fn read(&mut self, buf: &mut [u8]) -> io::Result<usize> {
+            let n = self.1.min(buf.len()).min(self.0.len());
+            buf[..n].copy_from_slice(&self.0[..n]);
+            self.0 = &self.0[n..];
+            Ok(n)
+        }
+    }
+
+    fn fixes(capture: impl Read) -> (Vec<GpsFix>, GpsStats) {
+        let mut out = Vec::new();
+        let stats = replay(capture, GpsConfig::default(), &mut |f| {
+            out.push(*f);
+            Ok(())
+        })
+        .unwrap();
+        (out, stats)
+    }
+
+    #[test]
+    fn a_capture_read_in_any_pieces_gives_the_same_fixes_and_skips_comments() {
+        let mut text = String::from("# a comment line $GPRMC,not,a,sentence\r\n");
+        for s in 0..30 {
+            let body = format!(
+                "GPRMC,1328{s:02}.00,A,4134.49821229,N,09345.03351845,W,3.252,92.308,180320,11.5985,E,D"
+            );
+            let sum = body.bytes().fold(0u8, |a, b| a ^ b);
+            text.push_str(&format!("${body}*{sum:02X}\r\n"));
+            if s % 7 == 0 {
+                text.push_str("#$GPRMC,comment\r\n");
+            }
+        }
+        let (whole, stats) = fixes(text.as_bytes());
+        assert!(whole.len() >= 29, "{}", whole.len());
+        assert_eq!(stats.faults.iter().sum::<u32>(), 0, "{stats:?}");
+        for step in [1, 7, 64, 1000] {
+            assert_eq!(fixes(Trickle(text.as_bytes(), step)).0, whole, "{step}");
+        }
     }
 }

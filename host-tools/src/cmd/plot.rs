@@ -91,7 +91,7 @@ fn warn_narrowed(log: &std::path::Path, summary: &Summary, (from, to): (f64, f64
     eprintln!(
         "wobblog: {}: warning: time jumps leave most of the run's time span empty; plotting its longest stretch, \
          {from:.2} to {to:.2} s ({frames} of {} frames); --from/--to plot another",
-        log.display(),
+        crate::text::shown(log),
         summary.samples
     );
 }

@@ -1,5 +1,6 @@
 //! `wobblog selftest`: the logger's field self-test report (`SELFTEST.TXT`
-//! on the card), one check per line, failures first in the summary.
+//! on the card), one check per line, failures first in the summary; the
+//! exit code is 1 when a check failed.
 
 use std::path::PathBuf;
 
@@ -46,5 +47,14 @@ pub fn run(args: &Args) -> Result<(), CliError> {
             failed.join(", ")
         )
     });
-    print_stdout(&out)
+    print_stdout(&out)?;
+    // A failed check is a failure of the command, so scripts can tell.
+    if failed.is_empty() {
+        Ok(())
+    } else {
+        Err(CliError::file(
+            &args.report,
+            format!("{} failed", crate::words::plural(failed.len(), "check")),
+        ))
+    }
 }

@@ -27,6 +27,9 @@ pub struct Args {
     /// Output format.
     #[arg(long, value_enum, default_value_t = SummaryFormat::Table)]
     pub format: SummaryFormat,
+    /// The same as `--format jsonl`, as on `info`, `events` and `wobble`.
+    #[arg(long, conflicts_with = "format")]
+    pub json: bool,
 }
 
 /// One run's row.
@@ -54,6 +57,8 @@ pub struct RunRow {
     pub frames_lost: u64,
     /// Blocks missing from the file.
     pub lost_blocks: u64,
+    /// UTC of the first frame that has one, as `info` gives it.
+    pub first_utc: Option<String>,
 }
 
 impl RunRow {
@@ -76,6 +81,7 @@ impl RunRow {
             wobble_speed_mps: wobble_speed_mps(episodes),
             frames_lost: s.frames_dropped + s.frames_lost,
             lost_blocks: s.lost_blocks,
+            first_utc: s.first_utc.clone(),
         }
     }
 }
@@ -110,7 +116,12 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         rows.push(RunRow::of(&ride));
         Ok(())
     });
-    let printed = print_stdout(&render(&rows, args.format));
+    let format = if args.json {
+        SummaryFormat::Jsonl
+    } else {
+        args.format
+    };
+    let printed = print_stdout(&render(&rows, format));
     result.and(printed)
 }
 
@@ -118,7 +129,7 @@ fn opt(v: Option<f64>) -> String {
     v.map_or(String::new(), |v| format!("{v:.2}"))
 }
 
-fn cells(r: &RunRow) -> [String; 10] {
+fn cells(r: &RunRow) -> [String; 11] {
     [
         r.log.clone(),
         format!("{:.2}", r.duration_s),
@@ -130,10 +141,11 @@ fn cells(r: &RunRow) -> [String; 10] {
         opt(r.wobble_speed_mps),
         r.frames_lost.to_string(),
         r.lost_blocks.to_string(),
+        r.first_utc.clone().unwrap_or_default(),
     ]
 }
 
-const HEADER: [&str; 10] = [
+const HEADER: [&str; 11] = [
     "log",
     "duration_s",
     "distance_m",
@@ -144,6 +156,7 @@ const HEADER: [&str; 10] = [
     "wobble_speed_mps",
     "frames_lost",
     "lost_blocks",
+    "first_utc",
 ];
 
 /// The rows in `format`.
@@ -166,7 +179,7 @@ pub fn render(rows: &[RunRow], format: SummaryFormat) -> String {
             }
         }
         SummaryFormat::Table => {
-            let table: Vec<[String; 10]> = std::iter::once(HEADER.map(String::from))
+            let table: Vec<[String; 11]> = std::iter::once(HEADER.map(String::from))
                 .chain(rows.iter().map(cells))
                 .collect();
             let widths: Vec<usize> = (0..HEADER.len())

@@ -10,7 +10,7 @@ use crate::cmd::logs::{for_each_log, print_stdout, warn_losses};
 use crate::output::Output;
 use crate::plot::modes::ModePlot;
 use crate::plot::{render, ImageKind};
-use crate::time::WindowArgs;
+use crate::time::{utc_text_at, WindowArgs};
 use crate::CliError;
 
 /// Arguments of `wobblog wobble`.
@@ -19,9 +19,9 @@ pub struct Args {
     /// Card logs (`RUNnnnnn.WBL`).
     #[arg(required = true)]
     pub logs: Vec<PathBuf>,
-    /// Print one JSON object per run (one per line) instead of a table.
-    #[arg(long)]
-    pub json: bool,
+    /// `--json` (or `--format jsonl`) for JSON instead of text.
+    #[command(flatten)]
+    pub output: crate::cmd::logs::JsonArgs,
     /// Also draw every episode as a point of sigma against 2 pi f into this
     /// `.png` or `.svg` file.
     #[arg(long, value_name = "OUT")]
@@ -39,12 +39,25 @@ pub struct RunEpisodes {
     /// Lowest speed at onset of an unstable episode, m/s.
     pub wobble_speed_mps: Option<f64>,
     /// Every episode, in time order.
-    pub episodes: Vec<Episode>,
+    pub episodes: Vec<EpisodeUtc>,
+}
+
+/// An episode and the UTC of its onset.
+#[derive(Serialize)]
+pub struct EpisodeUtc {
+    /// The episode.
+    #[serde(flatten)]
+    pub episode: Episode,
+    /// UTC at onset, ISO 8601, through the log's sync pairs (as `decode`'s
+    /// `utc` column); absent before the first pair.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub onset_utc: Option<String>,
 }
 
 /// Runs `wobblog wobble`. A log that cannot be read is reported and
 /// skipped; the others are still analysed, and the exit code says one failed.
 pub fn run(args: &Args) -> Result<(), CliError> {
+    let json = args.output.is_json()?;
     if let Some(plot) = &args.plot {
         ImageKind::of(plot)?;
     }
@@ -63,17 +76,24 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         let mut episodes = ride.episodes.clone();
         episodes
             .retain(|e| from.is_none_or(|a| e.onset_s >= a) && to.is_none_or(|b| e.onset_s <= b));
+        let pairs = &ride.summary.utc_syncs;
         reports.push(RunEpisodes {
             log: log.display().to_string(),
             wobble_speed_mps: wobble_speed_mps(&episodes),
-            episodes,
+            episodes: episodes
+                .into_iter()
+                .map(|episode| EpisodeUtc {
+                    onset_utc: utc_text_at(pairs, episode.onset_s),
+                    episode,
+                })
+                .collect(),
         });
         names.push(ride.name());
         Ok(())
     });
     let mut text = String::new();
     for report in &reports {
-        if args.json {
+        if json {
             let line = serde_json::to_string(report)
                 .map_err(|e| CliError::file(Path::new(&report.log), e))?;
             text.push_str(&line);
@@ -89,7 +109,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         let runs = names
             .into_iter()
             .zip(reports)
-            .map(|(name, r)| (name, r.episodes))
+            .map(|(name, r)| (name, r.episodes.into_iter().map(|e| e.episode).collect()))
             .collect();
         render(&ModePlot::new(runs), out)?;
     }
@@ -107,24 +127,29 @@ fn render_text(r: &RunEpisodes) -> String {
     let _ = writeln!(
         o,
         "{}: {}, wobble speed {speed}",
-        r.log,
+        crate::text::escape_controls(&r.log),
         crate::words::plural(r.episodes.len(), "episode")
     );
     // The same names as the JSON fields.
     if !r.episodes.is_empty() {
         let _ = writeln!(
             o,
-            "  onset_s    end_s  freq_hz  sigma_per_s  peak_amp_deg  speed_at_onset_mps  stability  censored"
+            "  onset_s  onset_utc                   end_s  freq_hz  sigma_per_s  peak_amp_deg  speed_at_onset_mps  stability  censored"
         );
     }
-    for e in &r.episodes {
+    for EpisodeUtc {
+        episode: e,
+        onset_utc,
+    } in &r.episodes
+    {
         let stability = match e.stability {
             Stability::Stable => "stable",
             Stability::Unstable => "unstable",
         };
         let line = format!(
-            "  {:7.2}  {:7.2}  {:7.2}  {:11.2}  {:12.2}  {:18.2}  {stability:<9}  {}",
+            "  {:7.2}  {:<24}  {:7.2}  {:7.2}  {:11.2}  {:12.2}  {:18.2}  {stability:<9}  {}",
             e.onset_s,
+            onset_utc.as_deref().unwrap_or("-"),
             e.end_s,
             e.freq_hz,
             e.sigma_per_s,

@@ -14,7 +14,6 @@ use std::path::Path;
 use columns::Column;
 use lines::LineWriter;
 pub use metadata::LogMetadata;
-pub(crate) use text::json_object;
 use text::LineFormat;
 
 use crate::events::LogEvent;
@@ -49,8 +48,8 @@ pub enum Format {
     Jsonl,
     /// Apache Parquet (binary; typed columns, GPS columns nullable).
     Parquet,
-    /// MCAP for Foxglove (binary; a JSON channel per sensor group, GPS as
-    /// foxglove.LocationFix, events on their own channel).
+    /// MCAP for Foxglove (binary, zstd; a CDR channel per sensor group, GPS
+    /// as foxglove.LocationFix, events as foxglove.Log; log times in UTC).
     Mcap,
 }
 
@@ -121,7 +120,7 @@ impl Format {
                     .collect();
                 format!(
                     "{}: no output format has this extension; the known ones are {} (or give --format)",
-                    path.display(),
+                    crate::text::shown(path),
                     known.join(" ")
                 )
             })
@@ -150,7 +149,7 @@ impl Format {
                 return Err(CliError::Usage(format!(
                     "--format {} contradicts the output file {} (a {} name)",
                     g.name(),
-                    output.map_or(String::new(), |p| p.display().to_string()),
+                    output.map_or(String::new(), crate::text::shown),
                     n.format.name()
                 )))
             }
@@ -268,12 +267,21 @@ impl<W: Write + Send> RowWriter<W> {
         }
     }
 
-    /// Writes an event (MCAP only).
-    pub fn event(&mut self, event: &LogEvent) -> std::io::Result<()> {
+    /// Writes an event of the log named `log_name` (MCAP only).
+    pub fn event(&mut self, event: &LogEvent, log_name: &str) -> std::io::Result<()> {
         match self.sink {
-            Sink::Mcap(..) => self.mcap()?.event(event).map_err(mcap_io_error),
+            Sink::Mcap(..) => self.mcap()?.event(event, log_name).map_err(mcap_io_error),
             _ => Ok(()),
         }
+    }
+
+    /// Takes a GPS sync pair: MCAP log times are UTC from it on (the
+    /// table formats carry UTC in their `utc` column).
+    pub fn sync(&mut self, t_us: u64, unix_ms: u64) -> std::io::Result<()> {
+        if let Sink::Mcap(..) = self.sink {
+            self.mcap()?.sync(t_us, unix_ms);
+        }
+        Ok(())
     }
 
     fn mcap(&mut self) -> std::io::Result<&mut mcap::McapWriter<W>> {

@@ -52,7 +52,7 @@ impl ImageKind {
             Some("svg") => Ok(Self::Svg),
             _ => Err(CliError::Usage(format!(
                 "{}: plot files must end in .png or .svg",
-                path.display()
+                crate::text::shown(path)
             ))),
         }
     }

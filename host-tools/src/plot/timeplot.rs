@@ -47,8 +47,9 @@ pub struct TimePlot {
     /// Forward jumps of the frame times, s: no data, and no time passed
     /// that the logger saw.
     jumps_s: Vec<(f64, f64)>,
-    /// Sync pairs, when the time axis is labelled in UTC.
-    utc: Option<Vec<SyncPair>>,
+    /// Sync pairs and the UTC midnight (ms since 1970) before the
+    /// window's start, when the time axis is in UTC.
+    utc: Option<(Vec<SyncPair>, i64)>,
 }
 
 /// Figure width, px.
@@ -218,9 +219,48 @@ impl TimePlot {
         self.series.iter().all(Vec::is_empty)
     }
 
-    /// Labels the time axis in UTC through the log's sync `pairs`.
+    /// Puts the time axis in UTC through the log's sync `pairs`: ticks at
+    /// round UTC times (the axis is UTC seconds of the day), labelled to
+    /// the tenth or hundredth of a second on short windows, and the UTC
+    /// span in the title. Without a pair, nothing changes.
     pub fn label_utc(&mut self, pairs: Vec<SyncPair>) {
-        self.utc = Some(pairs);
+        const DAY_MS: i64 = 86_400_000;
+        let Some(start_ms) = utc_ms_at(&pairs, self.window_s.start) else {
+            return;
+        };
+        self.utc = Some((pairs, start_ms.div_euclid(DAY_MS) * DAY_MS));
+        let (from, to) = (self.x(self.window_s.start), self.x(self.window_s.end));
+        let day = iso8601_unix_ms(start_ms).map_or(String::new(), |iso| iso[..10].to_string());
+        self.title = format!(
+            "{} (UTC {day} {} to {})",
+            self.title,
+            clock_text(from, 3),
+            clock_text(to, 3)
+        );
+    }
+
+    /// Where `t_s` since boot sits on the time axis: itself, or its UTC
+    /// in seconds since the midnight before the window (exact, not rounded
+    /// to the millisecond).
+    fn x(&self, t_s: f64) -> f64 {
+        let Some((pairs, midnight_ms)) = &self.utc else {
+            return t_s;
+        };
+        let at = pairs.partition_point(|p| p.0 <= t_s).saturating_sub(1);
+        pairs.get(at).map_or(t_s, |&(pair_s, pair_ms)| {
+            (pair_ms - midnight_ms) as f64 / 1000.0 + (t_s - pair_s)
+        })
+    }
+
+    /// Decimals of the UTC tick labels: tenths or hundredths of a second
+    /// where the ticks are that close.
+    fn utc_decimals(&self) -> usize {
+        let span = self.x(self.window_s.end) - self.x(self.window_s.start);
+        match span {
+            s if s <= 1.5 => 2,
+            s if s <= 15.0 => 1,
+            _ => 0,
+        }
     }
 
     /// Stretches lost from the file drawn, s.
@@ -232,23 +272,16 @@ impl TimePlot {
     /// The time axis's label.
     fn x_desc(&self) -> String {
         match &self.utc {
-            Some(pairs) => {
-                let day = utc_ms_at(pairs, self.window_s.start)
-                    .and_then(iso8601_unix_ms)
-                    .map_or(String::new(), |iso| iso[..10].to_string());
-                format!("UTC on {day} (hh:mm:ss)")
-            }
+            Some(_) => "UTC (hh:mm:ss)".into(),
             None => "time since boot (s)".into(),
         }
     }
 
-    /// A time axis tick.
-    fn x_tick(&self, t_s: f64) -> String {
+    /// A time axis tick at `x` on the axis.
+    fn x_tick(&self, x: f64) -> String {
         match &self.utc {
-            Some(pairs) => utc_ms_at(pairs, t_s)
-                .and_then(iso8601_unix_ms)
-                .map_or(String::new(), |iso| iso[11..19].to_string()),
-            None => tick_label(t_s),
+            Some(_) => clock_text(x, self.utc_decimals()),
+            None => tick_label(x),
         }
     }
 
@@ -293,7 +326,10 @@ impl Figure for TimePlot {
                 .margin_top(6)
                 .x_label_area_size(x_label_px)
                 .y_label_area_size(Y_LABEL_AREA_PX)
-                .build_cartesian_2d(self.window_s.clone(), y.clone())
+                .build_cartesian_2d(
+                    self.x(self.window_s.start)..self.x(self.window_s.end),
+                    y.clone(),
+                )
                 .map_err(err)?;
             let x_desc = if k == last {
                 self.x_desc()
@@ -312,7 +348,7 @@ impl Figure for TimePlot {
                 .draw()
                 .map_err(err)?;
             let span = |&(a, b): &(f64, f64), colour: RGBAColor| {
-                Rectangle::new([(a, y.start), (b, y.end)], colour.filled())
+                Rectangle::new([(self.x(a), y.start), (self.x(b), y.end)], colour.filled())
             };
             // The shaded spans, each kind in the key of the top panel if present.
             let shaded = [
@@ -345,7 +381,7 @@ impl Figure for TimePlot {
             let markers = chart
                 .draw_series(self.markers_s.iter().map(|&t| {
                     PathElement::new(
-                        vec![(t, y.start), (t, y.end)],
+                        vec![(self.x(t), y.start), (self.x(t), y.end)],
                         MARKER_COLOUR.stroke_width(2),
                     )
                 }))
@@ -360,7 +396,10 @@ impl Figure for TimePlot {
             }
             for points in series {
                 chart
-                    .draw_series(LineSeries::new(points.iter().copied(), LINE_COLOUR))
+                    .draw_series(LineSeries::new(
+                        points.iter().map(|&(t, v)| (self.x(t), v)),
+                        LINE_COLOUR,
+                    ))
                     .map_err(err)?;
             }
             let keyed = !(self.alerts_s.is_empty()
@@ -379,5 +418,34 @@ impl Figure for TimePlot {
             }
         }
         Ok(())
+    }
+}
+
+/// Seconds since a midnight as `hh:mm:ss` with `decimals` of a second
+/// (rounded; past 24 h it goes on into the next day's hours).
+fn clock_text(s: f64, decimals: usize) -> String {
+    let scale = 10f64.powi(decimals as i32);
+    let units = (s * scale).round() as i64;
+    let whole = units.div_euclid(scale as i64);
+    let frac = units.rem_euclid(scale as i64);
+    let (h, m, sec) = (whole / 3600 % 24, whole / 60 % 60, whole % 60);
+    if decimals == 0 {
+        format!("{h:02}:{m:02}:{sec:02}")
+    } else {
+        format!("{h:02}:{m:02}:{sec:02}.{frac:0decimals$}")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::clock_text;
+
+    #[test]
+    fn clock_text_rounds_to_its_decimals() {
+        assert_eq!(clock_text(37_816.0, 0), "10:30:16");
+        assert_eq!(clock_text(37_816.2, 1), "10:30:16.2");
+        assert_eq!(clock_text(37_816.249_999, 2), "10:30:16.25");
+        assert_eq!(clock_text(37_816.999_6, 3), "10:30:17.000");
+        assert_eq!(clock_text(86_400.5, 1), "00:00:00.5");
     }
 }

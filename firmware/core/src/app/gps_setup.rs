@@ -1,7 +1,8 @@
 //! Drives the GPS bring-up ([`crate::drivers::gnss_bringup`]) over the
 //! board's UART: switches the baud rate, sends the commands, listens.
-//! Runs once at the start of the GPS task; everything it decides is the
-//! state machine's.
+//! Runs at the start of the GPS task and again whenever the receiver is
+//! lost (`app::gps::run_link`); everything it decides is the state
+//! machine's.
 
 use embassy_futures::select::{select, Either};
 use embassy_time::{Duration, Instant, Timer};
@@ -62,7 +63,12 @@ pub async fn run<L: GpsLink>(link: &mut L, on_step: &mut impl FnMut(&Step)) -> O
                 Timer::after_micros(SETTLE_US).await;
                 setup.sent()
             }
-            Step::Done(outcome) => return outcome,
+            Step::Done(outcome) => {
+                // The last step may have listened at another baud (a
+                // silent probe ends at 115 200): log at the outcome's.
+                link.set_baud(outcome.baud);
+                return outcome;
+            }
         };
     }
 }

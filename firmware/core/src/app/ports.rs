@@ -41,11 +41,13 @@ pub trait ImuPort {
 /// The steering potentiometer, calibrated.
 #[allow(async_fn_in_trait)]
 pub trait SteeringPort {
-    /// The frame's angle from the ADC samples since the previous read (the
+    /// The frame's angle from the ADC samples it is owed (the
     /// [`crate::steering::Steering`] channel's `take`), degrees, left
     /// positive, `saturated` when a sample hit either end of the ADC range;
-    /// [`SensorError::Stale`] when no sample came.
-    async fn read(&mut self) -> Result<SteeringSample, SensorError>;
+    /// [`SensorError::Stale`] when no sample came. The frame is read
+    /// `late_us` after its scheduled time: samples converted since belong
+    /// to the next frame ([`crate::adc_ring::SampleBacklog`]).
+    async fn read(&mut self, late_us: u64) -> Result<SteeringSample, SensorError>;
 }
 
 /// The wheel's hall sensor, whose edges the hardware timestamps.
@@ -61,6 +63,13 @@ pub trait GpsPort {
     /// Waits for bytes and copies what arrived into `buf`; returns how many
     /// (0 only at the end of a replayed capture).
     async fn read(&mut self, buf: &mut [u8]) -> usize;
+
+    /// Bytes that had arrived before the last `read` returned but did not
+    /// fit its buffer: that chunk's last byte came this many character
+    /// times before the read returned (the GPS task back-dates by it).
+    fn pending(&self) -> usize {
+        0
+    }
 }
 
 /// The rider's marker button.

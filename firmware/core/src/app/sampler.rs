@@ -245,9 +245,13 @@ pub async fn run<I, S, W, M, A, L>(
         let late_us = u32::try_from(now_us.saturating_sub(scheduled_us)).unwrap_or(u32::MAX);
         sampler.stats.max_lateness_us = sampler.stats.max_lateness_us.max(late_us);
         ports.wheel.drain_edges(&mut |t| sampler.wheel_edge(t));
+        let imu = ports.imu.read().await;
+        // The IMU read may have taken a while (a re-initialisation): the
+        // steering samples are owed up to the schedule, not up to now.
+        let steer_late_us = Instant::now().as_micros().saturating_sub(scheduled_us);
         let inputs = Inputs {
-            imu: ports.imu.read().await,
-            steering: ports.steering.read().await,
+            imu,
+            steering: ports.steering.read(steer_late_us).await,
             marker: ports.marker.is_pressed(),
             last_gps_fix_us: shared.last_fix_us(),
         };

@@ -56,6 +56,11 @@ pub const FAULT_SETUP_UNCONFIRMED: u8 = 7;
 /// asked for (the receiver's own limit).
 pub const FAULT_SETUP_SLOW: u8 = 8;
 
+/// GPS fault 9: while logging, no valid sentence came for
+/// `app::gps::LOSS_TIMEOUT_US` (a receiver that browned out or was
+/// re-plugged, back at its stored baud): the bring-up runs again.
+pub const FAULT_RECEIVER_LOST: u8 = 9;
+
 /// Epochs per second that count as the 20 Hz asked for.
 const MIN_RATE_HZ: u32 = 15;
 

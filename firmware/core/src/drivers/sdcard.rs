@@ -13,8 +13,9 @@
 //! and pushed back (or swapped) must be identified again, after the wake-up
 //! clocks and at the slow clock: [`Card`] forgets the card after any error
 //! and does both before the next access. A card whose blocks keep failing
-//! their CRC (long wires, a marginal socket) runs at half the clock after
-//! [`CRC_ERRORS_BEFORE_SLOWING`] in a row, down to [`MIN_DATA_CLOCK_HZ`].
+//! their CRC, read or written (long wires, a marginal socket), runs at half
+//! the clock after [`CRC_ERRORS_BEFORE_SLOWING`] in a row, down to
+//! [`MIN_DATA_CLOCK_HZ`].
 
 use core::cell::Cell;
 
@@ -130,7 +131,10 @@ impl<B: SpiBus, CS: OutputPin, D: DelayNs> Card<B, CS, D> {
     fn settle<T>(&self, result: Result<T, SdCardError>) -> Result<T, SdCardError> {
         if let Err(e) = &result {
             self.identified.set(false);
-            if matches!(e, SdCardError::CrcError(..)) {
+            // embedded-sdmmc 0.10 reports a written block's rejected CRC
+            // (data response 0x0B) as a write error: the line is as bad
+            // going out as a read CRC mismatch shows it coming in.
+            if matches!(e, SdCardError::CrcError(..) | SdCardError::WriteError) {
                 self.count_crc_error();
             }
         }

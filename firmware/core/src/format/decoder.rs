@@ -26,6 +26,13 @@ use super::record::Record;
 /// missing explain, by more than this, is a time jump (µs).
 pub const TIME_JUMP_SLACK_US: u64 = 1_000_000;
 
+/// Consecutive frame steps (no loss, no jump between them) compared with
+/// the stated frame period ...
+pub const SPACING_WINDOW: u32 = 100;
+/// ... of which this many off the period by more than 5 % mean the log
+/// info's sample rate contradicts the frames (jitter or an odd gap does not).
+pub const SPACING_OFF_MIN: u32 = 90;
+
 /// A stretch of missing data between two valid blocks.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -73,6 +80,14 @@ pub enum OutOfRange {
     GpsFields(u32),
     /// A UTC sync record outside 2000-2099; the record is dropped.
     UtcSync,
+    /// Frames spaced unlike the log info's sample rate says (reported once
+    /// per log): readers that take the stated rate are off by the ratio.
+    FrameSpacing {
+        /// The rate the log info states, Hz.
+        stated_hz: u16,
+        /// The average spacing of the frames that contradict it, µs.
+        spacing_us: u32,
+    },
 }
 
 /// Something the decoder found, in file order.
@@ -182,6 +197,11 @@ pub struct Decoder {
     open_skip: Option<(u64, SkipCause)>,
     /// The blocks decoded last, to recognise copies and rewrites.
     recent: Recent,
+    /// Frame steps compared with the stated period in this window, those
+    /// off it, and the sum of those; whether a contradiction was reported.
+    spacing: (u32, u32, u64, bool),
+    /// The sample rate the log info states (0: none yet).
+    stated_hz: u16,
 }
 
 /// What [`Decoder::decode_block`] did with a block.
@@ -409,7 +429,7 @@ impl Decoder {
                     self.stats.records += 1;
                     if let Record::Frame(f) = &record {
                         self.stats.frames += 1;
-                        self.check_time(f.t_us, visit);
+                        self.check_time(header.seq, f.t_us, visit);
                     }
                     if !self.check_values(header.seq, &mut record, visit) {
                         continue;
@@ -442,7 +462,7 @@ impl Decoder {
 
     /// Reports a frame at `t_us` that jumps back, or forward by more than
     /// the frames known to be missing explain.
-    fn check_time<'c>(&mut self, t_us: u64, visit: &mut impl FnMut(Event<'c>)) {
+    fn check_time<'c>(&mut self, seq: u32, t_us: u64, visit: &mut impl FnMut(Event<'c>)) {
         if let Some(prev) = self.last_frame_us {
             let period = if self.period_us == 0 {
                 1_000_000 / u64::from(DEFAULT_SAMPLE_RATE_HZ)
@@ -468,10 +488,39 @@ impl Decoder {
                     from_us: prev,
                     to_us: t_us,
                 });
+            } else if self.frames_missing == 0 && self.period_us != 0 {
+                self.check_spacing(seq, t_us - prev, visit);
             }
         }
         self.last_frame_us = Some(t_us);
         self.frames_missing = 0;
+    }
+
+    /// Compares one frame step with the stated period; reports, once, a
+    /// window of steps that mostly contradict it.
+    fn check_spacing<'c>(&mut self, seq: u32, step_us: u64, visit: &mut impl FnMut(Event<'c>)) {
+        let (steps, off, off_sum, reported) = &mut self.spacing;
+        if *reported {
+            return;
+        }
+        *steps += 1;
+        if step_us.abs_diff(self.period_us).saturating_mul(20) > self.period_us {
+            *off += 1;
+            *off_sum = off_sum.saturating_add(step_us);
+        }
+        if *steps < SPACING_WINDOW {
+            return;
+        }
+        if *off >= SPACING_OFF_MIN {
+            *reported = true;
+            let what = OutOfRange::FrameSpacing {
+                stated_hz: self.stated_hz,
+                spacing_us: u32::try_from(*off_sum / u64::from(*off)).unwrap_or(u32::MAX),
+            };
+            self.stats.out_of_range += 1;
+            visit(Event::OutOfRange { seq, what });
+        }
+        (*steps, *off, *off_sum) = (0, 0, 0);
     }
 
     /// Drops or replaces values the firmware cannot have written, reporting
@@ -490,6 +539,9 @@ impl Decoder {
                     OutOfRange::SampleRate(stated)
                 });
                 self.period_us = 1_000_000 / u64::from(info.sample_rate_hz);
+                self.stated_hz = info.sample_rate_hz;
+                let reported = self.spacing.3;
+                self.spacing = (0, 0, 0, reported);
                 bad
             }
             Record::Gps(fix) => match fix.drop_out_of_range() {

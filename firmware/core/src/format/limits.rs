@@ -33,11 +33,21 @@ pub const DEFAULT_SAMPLE_RATE_HZ: u16 = 100;
 pub const UNIX_MS_RANGE: (u64, u64) = (946_684_800_000, 4_102_444_800_000);
 
 impl UtcTime {
-    /// Whether this is a real UTC date and time of day (a leap second
-    /// included) in the years NMEA can state.
+    /// Whether this is a real UTC date and time of day in the years NMEA
+    /// can state. A leap second (23:59:60) is valid only at the end of a
+    /// month that can end with one: June or December first, March or
+    /// September second (ITU-R TF.460-6); every leap second so far has
+    /// ended June or December.
     #[must_use]
-    pub const fn is_valid(self) -> bool {
-        self.days_since_2000 < UTC_DAYS_END && self.ms_of_day < DAY_MS_WITH_LEAP
+    pub fn is_valid(self) -> bool {
+        if self.days_since_2000 >= UTC_DAYS_END || self.ms_of_day >= DAY_MS_WITH_LEAP {
+            return false;
+        }
+        if self.ms_of_day < DAY_MS_WITH_LEAP - 1000 {
+            return true;
+        }
+        let (year, month, day) = self.date();
+        matches!(month, 3 | 6 | 9 | 12) && day == super::record::days_in_month(year, month)
     }
 }
 
@@ -101,9 +111,41 @@ mod tests {
     use crate::format::FixMode;
 
     #[test]
+    fn a_leap_second_is_valid_only_where_one_can_be() {
+        let day = |y, m, d| UtcTime::days_from_date(y, m, d).unwrap();
+        let leap = |days_since_2000| UtcTime {
+            days_since_2000,
+            ms_of_day: 86_400_500,
+        };
+        // 2016-12-31 and 2015-06-30 had one; 2026-02-14 and 2016-12-30 cannot.
+        assert!(leap(day(2016, 12, 31)).is_valid());
+        assert!(leap(day(2015, 6, 30)).is_valid());
+        assert!(!leap(day(2026, 2, 14)).is_valid());
+        assert!(!leap(day(2016, 12, 30)).is_valid());
+        assert!(UtcTime {
+            days_since_2000: day(2026, 2, 14),
+            ms_of_day: 86_399_999,
+        }
+        .is_valid());
+    }
+
+    #[test]
+    fn dates_the_month_does_not_have_are_none() {
+        assert_eq!(UtcTime::days_from_date(2026, 2, 30), None);
+        assert_eq!(UtcTime::days_from_date(2026, 2, 29), None);
+        assert!(UtcTime::days_from_date(2024, 2, 29).is_some());
+        assert_eq!(UtcTime::days_from_date(2100, 2, 29), None);
+        assert_eq!(UtcTime::days_from_date(2026, 4, 31), None);
+        assert_eq!(
+            UtcTime::days_from_date(2026, 3, 1),
+            UtcTime::days_from_date(2026, 2, 28).map(|d| d + 1)
+        );
+    }
+
+    #[test]
     fn a_leap_second_is_a_valid_utc_time_but_24_00_is_not_a_day_of_its_own() {
         let t = |ms_of_day| UtcTime {
-            days_since_2000: 7000,
+            days_since_2000: UtcTime::days_from_date(2016, 12, 31).unwrap(),
             ms_of_day,
         };
         assert!(t(86_400_500).is_valid());

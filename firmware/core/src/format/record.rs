@@ -223,10 +223,11 @@ impl UtcTime {
         (year, month, day)
     }
 
-    /// Days since 2000-01-01 of a civil date, `None` outside 2000..=2179.
+    /// Days since 2000-01-01 of a civil date, `None` outside 2000..=2179
+    /// or for a day the month does not have (2026-02-30).
     #[must_use]
     pub fn days_from_date(year: i32, month: u32, day: u32) -> Option<u16> {
-        if !(1..=12).contains(&month) || !(1..=31).contains(&day) {
+        if !(1..=12).contains(&month) || day == 0 || day > days_in_month(year, month) {
             return None;
         }
         let y = i64::from(year) - i64::from(month <= 2);
@@ -237,6 +238,18 @@ impl UtcTime {
         let doe = yoe * 365 + yoe / 4 - yoe / 100 + doy;
         let days = era * 146_097 + doe - 719_468 - 10_957;
         u16::try_from(days).ok()
+    }
+}
+
+/// Days in `month` (1-12) of `year` in the Gregorian calendar.
+#[must_use]
+pub const fn days_in_month(year: i32, month: u32) -> u32 {
+    let leap = (year % 4 == 0 && year % 100 != 0) || year % 400 == 0;
+    match month {
+        2 if leap => 29,
+        2 => 28,
+        4 | 6 | 9 | 11 => 30,
+        _ => 31,
     }
 }
 

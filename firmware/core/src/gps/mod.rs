@@ -243,6 +243,13 @@ impl GpsReceiver {
         stats
     }
 
+    /// How long `chars` characters take on the wire at the configured
+    /// baud, µs (0 when back-dating is off).
+    #[must_use]
+    pub fn chars_us(&self, chars: usize) -> u64 {
+        self.char_time_ns().saturating_mul(chars as u64) / 1000
+    }
+
     fn char_time_ns(&self) -> u64 {
         // 8N1: start bit, 8 data bits, stop bit.
         10_000_000_000u64

@@ -279,7 +279,14 @@ fn from_gga(d: &GgaData) -> Option<Update> {
         tod_ms: d.fix_time.map(tod_ms),
         lat_e7: d.latitude.map(deg_e7),
         lon_e7: d.longitude.map(deg_e7),
-        alt_cm: d.altitude.map(|m| quantise_i32(f64::from(m), 100.0)),
+        // NaN or infinite altitudes land outside the limits (not at 0 m).
+        alt_cm: d.altitude.map(|m| {
+            if m.is_finite() {
+                quantise_i32(f64::from(m), 100.0)
+            } else {
+                i32::MIN
+            }
+        }),
         sats: d.fix_satellites.map(|n| n.min(u32::from(u8::MAX)) as u8),
         hdop_d: d.hdop.map(hdop_d),
         validity,
@@ -359,9 +366,12 @@ fn knots_to_cm_s(knots: f32) -> Option<u16> {
         .then(|| quantise_i32(cm_s, 1.0).clamp(0, i32::from(u16::MAX)) as u16)
 }
 
+/// A course of 360.00 deg (some receivers send it) is north, stored as 0:
+/// the card format's courses are below 360 deg.
 fn course_cdeg(deg: f32) -> Option<u16> {
     let cdeg = f64::from(deg) * 100.0;
-    (cdeg.is_finite() && (0.0..=36_000.0).contains(&cdeg)).then(|| quantise_i32(cdeg, 1.0) as u16)
+    (cdeg.is_finite() && (0.0..=36_000.0).contains(&cdeg))
+        .then(|| (quantise_i32(cdeg, 1.0) % i32::from(limits::COURSE_CDEG_END)) as u16)
 }
 
 fn hdop_d(hdop: f32) -> u8 {
@@ -403,6 +413,33 @@ mod tests {
         assert_eq!(u.sats, Some(14));
         assert_eq!(u.hdop_d, Some(9));
         assert_eq!(u.validity, Validity::Valid);
+    }
+
+    /// `body` as a sentence with its checksum.
+    fn sealed(body: &str) -> String {
+        let sum = body.bytes().fold(0u8, |a, b| a ^ b);
+        format!("${body}*{sum:02X}")
+    }
+
+    #[test]
+    fn a_nan_altitude_is_out_of_range_not_sea_level() {
+        let text = sealed("GNGGA,055234.200,4739.71890,N,12219.58362,W,1,14,0.9,NaN,M,-21.6,M,,");
+        match parse(&text) {
+            Sentence::OutOfRange(Kind::Gga) | Sentence::Unparseable(Kind::Gga) => {}
+            other => panic!("{text}: {other:?}"),
+        }
+    }
+
+    #[test]
+    fn a_course_of_360_is_north() {
+        let (_, u) = update(&sealed(
+            "GPRMC,132820.60,A,4134.49821229,N,09345.03351845,W,3.252,360.00,180320,11.5985,E,D",
+        ));
+        assert_eq!(u.course_cdeg, Some(0));
+        let (_, u) = update(&sealed(
+            "GPRMC,132820.60,A,4134.49821229,N,09345.03351845,W,3.252,359.99,180320,11.5985,E,D",
+        ));
+        assert_eq!(u.course_cdeg, Some(35_999));
     }
 
     #[test]

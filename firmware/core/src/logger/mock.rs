@@ -17,6 +17,8 @@ pub enum MockError {
     Removed,
     /// A block index past the end of the card.
     OutOfRange,
+    /// A block marked unreadable ([`MockCard::set_unreadable`]).
+    ReadFailed,
 }
 
 impl core::fmt::Display for MockError {
@@ -25,6 +27,7 @@ impl core::fmt::Display for MockError {
             Self::PowerCut => "power cut",
             Self::Removed => "card removed",
             Self::OutOfRange => "block index out of range",
+            Self::ReadFailed => "block unreadable",
         })
     }
 }
@@ -42,6 +45,7 @@ pub struct MockCard {
     stalled_ms: Cell<u64>,
     writes: Cell<u32>,
     reads: Cell<u32>,
+    unreadable: Cell<Option<u32>>,
 }
 
 impl MockCard {
@@ -56,6 +60,7 @@ impl MockCard {
             stalled_ms: Cell::new(0),
             writes: Cell::new(0),
             reads: Cell::new(0),
+            unreadable: Cell::new(None),
         }
     }
 
@@ -63,6 +68,12 @@ impl MockCard {
     /// those fails and nothing is written from then on. `None`: never.
     pub fn set_fuel(&self, writes: Option<u32>) {
         self.fuel.set(writes);
+    }
+
+    /// Every read of a range holding block `block` fails (a block whose
+    /// CRC never matches); `None`: every block reads.
+    pub fn set_unreadable(&self, block: Option<u32>) {
+        self.unreadable.set(block);
     }
 
     /// Pulls the card out (`true`) or puts it back.
@@ -116,6 +127,10 @@ impl BlockDevice for MockCard {
             return Err(MockError::PowerCut);
         }
         let range = self.range(start, blocks.len())?;
+        let bad = self.unreadable.get().map(|b| b as usize * Block::LEN);
+        if bad.is_some_and(|b| range.contains(&b)) {
+            return Err(MockError::ReadFailed);
+        }
         let image = self.image.borrow();
         for (block, src) in blocks.iter_mut().zip(image[range].chunks_exact(Block::LEN)) {
             block.contents.copy_from_slice(src);

@@ -6,6 +6,8 @@
 
 #![allow(dead_code)] // each test binary uses its own part of the model
 
+pub mod link;
+
 /// `$body*hh\r\n` (the set-up module's `nmea` holds only short commands).
 pub fn nmea(body: &str) -> Vec<u8> {
     let checksum = body.bytes().fold(0u8, |acc, b| acc ^ b);
@@ -39,6 +41,9 @@ pub struct Receiver {
     pub silent: bool,
     /// Deterministic noise generator state.
     pub seed: u64,
+    /// Epochs sent so far by [`Receiver::transmit_timed`] (each has its
+    /// own UTC time).
+    pub epochs_sent: u32,
 }
 
 impl Receiver {
@@ -53,6 +58,7 @@ impl Receiver {
             noise: false,
             silent: false,
             seed: 0x9E37_79B9_7F4A_7C15,
+            epochs_sent: 0,
         }
     }
 
@@ -112,6 +118,52 @@ impl Receiver {
             let n = out.len() * baud as usize / self.baud as usize;
             (0..n).map(|_| self.noise_byte() | 0x80).collect()
         }
+    }
+
+    /// What the UART at `baud` receives during `for_us`, each byte with the
+    /// time its stop bit ends, µs from the start: each epoch's burst starts
+    /// on the receiver's epoch clock and goes out back to back at its baud;
+    /// read at another baud, the same stretch of line is as many bytes of
+    /// the UART's own baud, none of them text.
+    pub fn transmit_timed(&mut self, baud: u32, for_us: u64) -> Vec<(u64, u8)> {
+        if self.silent {
+            return Vec::new();
+        }
+        if self.booting > 0 {
+            self.booting -= 1;
+            return Vec::new();
+        }
+        let char_ns = |baud: u32| 10_000_000_000 / u64::from(baud);
+        if self.noise {
+            let n = u64::from(baud / 10) * for_us / 1_000_000;
+            return (1..=n)
+                .map(|i| (i * char_ns(baud) / 1000, self.noise_byte()))
+                .collect();
+        }
+        let epoch_len = self.epoch(0).len() as u64;
+        let rate = u64::from(self.rate_hz)
+            .min(u64::from(self.baud / 10) / epoch_len)
+            .max(1);
+        let mut out = Vec::new();
+        for k in 0..rate * for_us / 1_000_000 {
+            let start_ns = k * 1_000_000_000 / rate;
+            let bytes = self.epoch(self.epochs_sent);
+            self.epochs_sent += 1;
+            if baud == self.baud {
+                out.extend(
+                    (1..)
+                        .zip(bytes)
+                        .map(|(i, b)| ((start_ns + i * char_ns(baud)) / 1000, b)),
+                );
+            } else {
+                let n = bytes.len() as u64 * u64::from(baud) / u64::from(self.baud);
+                for i in 1..=n {
+                    let b = self.noise_byte() | 0x80;
+                    out.push(((start_ns + i * char_ns(baud)) / 1000, b));
+                }
+            }
+        }
+        out
     }
 
     /// Applies one command received at `baud`.

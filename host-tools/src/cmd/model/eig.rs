@@ -3,14 +3,13 @@
 //! per eigenvalue, both members of a complex pair) is an interface others
 //! rely on: the critical speeds go to stderr with it, never into it.
 
-use std::fmt::Write as _;
-use std::io::Write as _;
+use std::io::Write;
 use std::path::PathBuf;
 
 use serde::Serialize;
 use wobble_model::{critical_speeds, CriticalSpeed, Sweep};
 
-use super::{load, sweep, Speeds};
+use super::{load_as, sweep, Speeds, Variant};
 use crate::output::Output;
 use crate::CliError;
 
@@ -23,6 +22,15 @@ pub enum Format {
     Csv,
     /// One JSON object per eigenvalue, then one per critical speed.
     Jsonl,
+}
+
+/// The contact model of `--contacts`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Contacts {
+    /// The file's tyre model.
+    Tyres,
+    /// Lateral no-slip at both contacts.
+    NoSlip,
 }
 
 /// Arguments of `wobblog model eig`.
@@ -41,6 +49,11 @@ pub struct Args {
     /// tyres without slip) instead of its own model.
     #[arg(long)]
     pub whipple: bool,
+    /// The contacts: `tyres` (the file's model) or `no-slip`, its
+    /// non-holonomic counterpart (the same bodies, no lateral slip at either
+    /// contact, torso and twist free: the seed paper's thick line of Figure 4).
+    #[arg(long, value_enum, default_value_t = Contacts::Tyres, conflicts_with = "whipple")]
+    pub contacts: Contacts,
     /// Write here instead of standard output (whole or not at all).
     #[arg(short, long)]
     pub output: Option<PathBuf>,
@@ -54,71 +67,83 @@ struct Row<'a> {
     im_rad_per_s: f64,
 }
 
-/// Runs `wobblog model eig`.
+/// Runs `wobblog model eig`. The rows are written as they are formatted
+/// (one speed at a time), never held as a whole text.
 pub fn run(args: &Args) -> Result<(), CliError> {
-    let (_, model) = load(&args.params, args.whipple)?;
+    let variant = match (args.whipple, args.contacts) {
+        (true, _) => Variant::Whipple,
+        (false, Contacts::Tyres) => Variant::Own,
+        (false, Contacts::NoSlip) => Variant::NoSlip,
+    };
+    let (_, model) = load_as(&args.params, variant)?;
     let mut out = Output::create_or_stdout(args.output.as_deref(), &[&args.params])?;
     let sweep = sweep(&model, &args.speeds.0, &args.params)?;
     let critical = critical_speeds(&model, &sweep);
-    let text = match args.format {
+    let written = match args.format {
         Format::Csv => {
             for c in &critical {
                 eprintln!("wobblog: {}", describe(c));
             }
-            csv_text(&sweep)
+            write_csv(&mut out, &sweep)
         }
-        Format::Table => table_text(&sweep, &critical),
-        Format::Jsonl => jsonl_text(&sweep, &critical),
+        Format::Table => write_table(&mut out, &sweep, &critical),
+        Format::Jsonl => write_jsonl(&mut out, &sweep, &critical),
     };
-    out.write_all(text.as_bytes()).map_err(|e| out.error(e))?;
+    written.map_err(|e| out.error(e))?;
     out.commit()
 }
 
-/// Rows in speed order; within a speed by mode, then imaginary part.
-fn rows(sweep: &Sweep) -> Vec<Row<'_>> {
-    let mut rows = Vec::with_capacity(sweep.speeds_mps.len() * sweep.branches.len());
-    for (k, &u) in sweep.speeds_mps.iter().enumerate() {
-        let mut at: Vec<_> = sweep
-            .branches
-            .iter()
-            .map(|b| (b.mode, b.values[k]))
-            .collect();
-        at.sort_by(|a, b| {
-            a.0.cmp(&b.0)
-                .then(a.1.im.total_cmp(&b.1.im))
-                .then(a.1.re.total_cmp(&b.1.re))
-        });
-        rows.extend(at.into_iter().map(|(mode, v)| Row {
-            speed_mps: u,
-            mode: mode.name(),
-            re_per_s: v.re,
-            // The solver's round-off on a real eigenvalue is no oscillation.
-            im_rad_per_s: if v.im.abs() <= wobble_model::sweep::REAL_TOL {
-                0.0
-            } else {
-                v.im
-            },
-        }));
-    }
-    rows
+/// The rows at the `k`-th speed, by mode, then imaginary part.
+fn rows_at(sweep: &Sweep, k: usize) -> impl Iterator<Item = Row<'static>> {
+    let u = sweep.speeds_mps[k];
+    let mut at: Vec<_> = sweep
+        .branches
+        .iter()
+        .map(|b| (b.mode, b.values[k]))
+        .collect();
+    at.sort_by(|a, b| {
+        a.0.cmp(&b.0)
+            .then(a.1.im.total_cmp(&b.1.im))
+            .then(a.1.re.total_cmp(&b.1.re))
+    });
+    at.into_iter().map(move |(mode, v)| Row {
+        speed_mps: u,
+        mode: mode.name(),
+        re_per_s: v.re,
+        // The solver's round-off on a real eigenvalue is no oscillation.
+        im_rad_per_s: if v.im.abs() <= wobble_model::sweep::REAL_TOL {
+            0.0
+        } else {
+            v.im
+        },
+    })
 }
 
-fn csv_text(sweep: &Sweep) -> String {
-    let mut o = String::from("speed_mps,mode,re_per_s,im_rad_per_s\n");
+/// Every row, in speed order.
+fn rows(sweep: &Sweep) -> impl Iterator<Item = Row<'static>> + '_ {
+    (0..sweep.speeds_mps.len()).flat_map(move |k| rows_at(sweep, k))
+}
+
+fn write_csv(o: &mut dyn Write, sweep: &Sweep) -> std::io::Result<()> {
+    o.write_all(b"speed_mps,mode,re_per_s,im_rad_per_s\n")?;
     for r in rows(sweep) {
-        let _ = writeln!(
+        writeln!(
             o,
             "{},{},{},{}",
             r.speed_mps, r.mode, r.re_per_s, r.im_rad_per_s
-        );
+        )?;
     }
-    o
+    Ok(())
 }
 
-fn table_text(sweep: &Sweep, critical: &[CriticalSpeed]) -> String {
-    let mut o = String::from("speed_mps  mode          re_per_s  im_rad_per_s   freq_hz\n");
+fn write_table(
+    o: &mut dyn Write,
+    sweep: &Sweep,
+    critical: &[CriticalSpeed],
+) -> std::io::Result<()> {
+    o.write_all(b"speed_mps  mode          re_per_s  im_rad_per_s   freq_hz\n")?;
     for r in rows(sweep) {
-        let _ = writeln!(
+        writeln!(
             o,
             "{:9.3}  {:<9}  {:11.5}  {:12.5}  {:8.4}",
             r.speed_mps,
@@ -126,38 +151,39 @@ fn table_text(sweep: &Sweep, critical: &[CriticalSpeed]) -> String {
             r.re_per_s,
             r.im_rad_per_s,
             r.im_rad_per_s.abs() / std::f64::consts::TAU
-        );
+        )?;
     }
-    o.push_str("\ncritical speeds:\n");
+    o.write_all(b"\ncritical speeds:\n")?;
     if critical.is_empty() {
-        o.push_str("  none in this speed range\n");
+        o.write_all(b"  none in this speed range\n")?;
     }
     for c in critical {
-        let _ = writeln!(o, "  {}", describe(c));
+        writeln!(o, "  {}", describe(c))?;
     }
-    o
+    Ok(())
 }
 
-fn jsonl_text(sweep: &Sweep, critical: &[CriticalSpeed]) -> String {
-    let mut o = String::new();
+fn write_jsonl(
+    o: &mut dyn Write,
+    sweep: &Sweep,
+    critical: &[CriticalSpeed],
+) -> std::io::Result<()> {
     for r in rows(sweep) {
-        o.push_str(&serde_json::to_string(&r).unwrap_or_default());
-        o.push('\n');
+        serde_json::to_writer(&mut *o, &r)?;
+        o.write_all(b"\n")?;
     }
     for c in critical {
-        o.push_str(
-            &serde_json::json!({
-                "critical_speed_mps": c.speed_mps,
-                "mode": c.mode.name(),
-                "unstable_above": c.unstable_above,
-                "kind": c.kind(),
-                "im_rad_per_s": c.im_rad_per_s,
-            })
-            .to_string(),
-        );
-        o.push('\n');
+        let line = serde_json::json!({
+            "critical_speed_mps": c.speed_mps,
+            "mode": c.mode.name(),
+            "unstable_above": c.unstable_above,
+            "kind": c.kind(),
+            "im_rad_per_s": c.im_rad_per_s,
+        });
+        serde_json::to_writer(&mut *o, &line)?;
+        o.write_all(b"\n")?;
     }
-    o
+    Ok(())
 }
 
 /// `weave speed 4.292382536 m/s (stable above, oscillatory, 2.97 Hz)`.

@@ -5,6 +5,7 @@
 //! and measured points can be laid over it (Figure 8).
 
 use plotters::coord::Shift;
+use plotters::element::DashedPathElement;
 use plotters::prelude::*;
 use wobble_model::sweep::REAL_TOL;
 use wobble_model::{Mode, Sweep};
@@ -179,9 +180,21 @@ impl EigenFigure {
                     } else {
                         branch.mode.to_string()
                     };
-                    let width = if layer.line == Line::Thin { 1 } else { 3 };
+                    // The key's swatch drawn as the line is: dotted and
+                    // dashed layers must be told apart there too.
+                    let (width, dash, gap) = match layer.line {
+                        Line::Thick => (3, 24, 0),
+                        Line::Thin => (1, 24, 0),
+                        Line::Dotted => (2, 2, 4),
+                        Line::Dashed => (2, 8, 6),
+                    };
                     series.label(name).legend(move |(px, py)| {
-                        PathElement::new(vec![(px, py), (px + 18, py)], c.stroke_width(width))
+                        DashedPathElement::new(
+                            vec![(px, py), (px + 24, py)],
+                            dash,
+                            gap,
+                            c.stroke_width(width),
+                        )
                     });
                     labelled.push(key);
                 }

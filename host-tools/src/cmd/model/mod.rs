@@ -111,11 +111,34 @@ pub fn load_set(path: &Path) -> Result<ParamSet, CliError> {
 /// Reads a parameter file and builds its model (its Whipple limit with
 /// `whipple`).
 pub fn load(path: &Path, whipple: bool) -> Result<(ParamSet, Model), CliError> {
+    load_as(
+        path,
+        if whipple {
+            Variant::Whipple
+        } else {
+            Variant::Own
+        },
+    )
+}
+
+/// Which model of a parameter file.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Variant {
+    /// The file's own model.
+    Own,
+    /// Its Whipple limit (rider locked, rigid head, no slip).
+    Whipple,
+    /// Its non-holonomic counterpart (no slip, torso and twist free).
+    NoSlip,
+}
+
+/// Reads a parameter file and builds the `variant` of its model.
+pub fn load_as(path: &Path, variant: Variant) -> Result<(ParamSet, Model), CliError> {
     let set = load_set(path)?;
-    let model = if whipple {
-        Model::whipple_of(&set)
-    } else {
-        Model::from_set(&set)
+    let model = match variant {
+        Variant::Own => Model::from_set(&set),
+        Variant::Whipple => Model::whipple_of(&set),
+        Variant::NoSlip => Model::no_slip_of(&set),
     }
     .map_err(|e| param_error(&e))?;
     Ok((set, model))

@@ -1,12 +1,13 @@
-//! `wobblog model plot`: the seed paper's Figure 4 for a parameter file,
-//! optionally with the Whipple limit of the same bicycle.
+//! `wobblog model plot`: the seed paper's Figure 4 for a parameter file:
+//! with `--both` the non-holonomic counterpart (no lateral slip, torso and
+//! twist free) thick and the tyre model thin, as in the paper.
 
 use std::path::PathBuf;
 
 use wobble_model::{Mode, Model};
 
 use super::figure::{EigenFigure, Layer, Line};
-use super::{load, sweep, Speeds};
+use super::{load, param_error, sweep, Speeds};
 use crate::output::Output;
 use crate::plot::{render, ImageKind};
 use crate::CliError;
@@ -32,7 +33,8 @@ pub struct Args {
     /// Speeds FROM:TO:STEP, m/s.
     #[arg(long, default_value = "0:10:0.05")]
     pub speeds: Speeds,
-    /// Also draw the Whipple limit of the bicycle (dashed).
+    /// Also draw the non-holonomic counterpart of the bicycle (thick; the
+    /// tyre model then thin): the paper's Figure 4.
     #[arg(long)]
     pub both: bool,
     /// Also draw the twist and the modes named `other` (tyre lags, ...).
@@ -45,19 +47,21 @@ pub fn run(args: &Args) -> Result<(), CliError> {
     ImageKind::of(&args.output)?;
     let (set, model) = load(&args.params, false)?;
     let out = Output::create(&args.output, &[&args.params])?;
-    let mut layers = vec![Layer {
-        label: label(&model),
-        sweep: sweep(&model, &args.speeds.0, &args.params)?,
-        line: Line::Thick,
-    }];
-    if args.both && matches!(model, Model::Wobble(_)) {
-        let (_, whipple) = load(&args.params, true)?;
+    let both = args.both && matches!(model, Model::Wobble(_));
+    let mut layers = Vec::new();
+    if both {
+        let no_slip = Model::no_slip_of(&set).map_err(|e| param_error(&e))?;
         layers.push(Layer {
-            label: "Whipple limit".into(),
-            sweep: sweep(&whipple, &args.speeds.0, &args.params)?,
-            line: Line::Dashed,
+            label: "no lateral slip (non-holonomic)".into(),
+            sweep: sweep(&no_slip, &args.speeds.0, &args.params)?,
+            line: Line::Thick,
         });
     }
+    layers.push(Layer {
+        label: label(&model),
+        sweep: sweep(&model, &args.speeds.0, &args.params)?,
+        line: if both { Line::Thin } else { Line::Thick },
+    });
     let mut modes = NAMED_MODES.to_vec();
     if args.all_modes {
         modes.extend([Mode::Twist, Mode::Other]);
@@ -74,6 +78,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
 fn label(model: &Model) -> String {
     match model {
         Model::Whipple(_) => "Whipple".into(),
-        Model::Wobble(_) => "wobble model".into(),
+        Model::Wobble(_) => "wobble model (tyres)".into(),
+        Model::NoSlip(_) => "no lateral slip".into(),
     }
 }

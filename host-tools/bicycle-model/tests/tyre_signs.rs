@@ -1,0 +1,169 @@
+//! The tyre terms' signs and sizes against a hand derivation at the rear
+//! contact, where the geometry is trivial: the rear contact point is the
+//! origin, on the roll axis, so a lateral force there acts on the lateral
+//! velocity `v` alone (partial velocity `e_y`) and a moment about `x` on the
+//! roll alone.
+//!
+//! Roll the bicycle right by `eps` (rear wheel camber `gamma = eps`), with the
+//! rear camber lag settled (`gamma2' = eps`) and everything else zero:
+//! - camber thrust pushes the contact towards the lean side (Pacejka 2012,
+//!   ch. 1: a cambered wheel's lateral force points to the side it leans):
+//!   generalised force on `v` = `+N_r c_Fg eps`;
+//! - twisting moment (yaw, `+z` down): on `r`, `+N_r c_Mg eps`;
+//! - overturning couple: a toroidal tyre of crown radius `rho` leaning right
+//!   touches the ground `rho eps` to the right of its mid-plane; the upward
+//!   normal force `-N e_z` there has the moment `y F_z = -N rho eps` about `x`:
+//!   it opposes the lean. With the front wheel (camber `eps` too at zero steer)
+//!   the roll's generalised force is `-g K_phiphi eps - (N_r rho_r + N_f rho_f) eps`.
+//!
+//! And a single tyre's relaxation: a lateral velocity `V` of the rear
+//! contact is a slip `alpha = -V / u`, and `(sigma/u) alpha'' + alpha' = alpha`
+//! gives `d(alpha2')/dt = -V / sigma_r` from rest; the front camber lag,
+//! unsettled (`gamma1' = 0`), grows at `u eps / sigma_g`.
+//!
+//! Flipping the sign of the camber force or of the overturning couple in the
+//! model fails this test.
+
+use std::path::Path;
+
+use nalgebra::DVector;
+use wobble_model::multibody::{N_COORDS, PHI, R, V};
+use wobble_model::wobble::WobbleModel;
+use wobble_model::ParamSet;
+
+fn model() -> WobbleModel {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("params/test-bicycle.toml");
+    WobbleModel::from_set(&ParamSet::load(&path).unwrap()).unwrap()
+}
+
+const W0: usize = N_COORDS;
+const T0: usize = N_COORDS + 6;
+
+/// The generalised forces `M w'` and the tyre lag rates at state `x`.
+fn forces(m: &WobbleModel, u: f64, x: &DVector<f64>) -> (DVector<f64>, DVector<f64>) {
+    let dx = m.state_matrix(u) * x;
+    let q = &m.lin.m * dx.rows(W0, 6);
+    (q, dx.rows(T0, 4).into_owned())
+}
+
+#[test]
+fn camber_thrust_twisting_moment_and_overturning_couple_at_the_rear_contact() {
+    let m = model();
+    let p = m.params;
+    let (n_front, n_rear) = p.wheel_loads_n();
+    let eps = 1e-3;
+    let u = 5.0;
+    let mut x = DVector::zeros(14);
+    x[PHI] = eps;
+    x[T0 + 3] = eps; // gamma2' settled
+    let (q, lags) = forces(&m, u, &x);
+    let rel = |got: f64, want: f64| (got - want).abs() <= 1e-9 * want.abs().max(1e-9);
+    let thrust = n_rear * p.rear_tyre.camber_stiffness * eps;
+    assert!(thrust > 0.0);
+    assert!(rel(q[V], thrust), "on v: {} against {thrust}", q[V]);
+    let twist = n_rear * p.rear_tyre.twisting_coefficient * eps;
+    assert!(rel(q[R], twist), "on r: {} against {twist}", q[R]);
+    let overturning = -(n_rear * p.rear_tyre.overturning_coefficient
+        + n_front * p.front_tyre.overturning_coefficient)
+        * eps;
+    let gravity = -m.lin.k[(2 + PHI, PHI)] * eps;
+    assert!(
+        rel(q[2 + PHI], gravity + overturning),
+        "on roll: {} against {gravity} + {overturning}",
+        q[2 + PHI]
+    );
+    assert!(
+        rel(lags[3], 0.0) || lags[3].abs() < 1e-12,
+        "settled rear camber lag"
+    );
+    let front_camber_rate = u * eps / p.front_tyre.camber_relaxation_length;
+    assert!(
+        rel(lags[1], front_camber_rate),
+        "{} against {front_camber_rate}",
+        lags[1]
+    );
+}
+
+#[test]
+fn a_lateral_velocity_is_a_slip_relaxed_over_sigma() {
+    let m = model();
+    let p = m.params;
+    let big_v = 0.01;
+    for u in [1.0, 5.0, 12.0] {
+        let mut x = DVector::zeros(14);
+        x[W0 + V] = big_v;
+        let (_, lags) = forces(&m, u, &x);
+        let rear = -big_v / p.rear_tyre.relaxation_length;
+        let front = -big_v / p.front_tyre.relaxation_length;
+        assert!((lags[2] - rear).abs() < 1e-12, "{} against {rear}", lags[2]);
+        assert!(
+            (lags[0] - front).abs() < 1e-12,
+            "{} against {front}",
+            lags[0]
+        );
+        // And the slip then decays at u / sigma: d(alpha')/dt = -(u/sigma) alpha'.
+        let mut y = DVector::zeros(14);
+        y[T0 + 2] = 1.0;
+        let (_, lags) = forces(&m, u, &y);
+        assert!((lags[2] + u / p.rear_tyre.relaxation_length).abs() < 1e-12);
+    }
+}
+
+/// The twist mode with the frame locked: the fork and front wheel turn about
+/// the twist axis `t = (cos lambda, 0, -sin lambda)` through the steer axis at
+/// height `steer_head.z`, on the head spring. By hand (parallel axes) its
+/// inertia is `sum t' I_b t + m_b |t x (c_b - o)|^2`, and the mode's natural
+/// frequency with frame and pitch locked `sqrt(k / I_t)`; the model's mass
+/// matrix has exactly that inertia. (Its stiffness adds the weight of the
+/// whole bicycle through the pitch the twist forces on the front contact,
+/// which no hand figure here checks.)
+#[test]
+fn twist_inertia_and_frequency_with_the_frame_locked() {
+    use nalgebra::{Matrix3, Vector3};
+    use wobble_model::multibody::BETA;
+    let m = model();
+    let p = m.params;
+    let lam = p.steer_axis_tilt;
+    let t = Vector3::new(lam.cos(), 0.0, -lam.sin());
+    let o = Vector3::new(
+        p.wheelbase + p.trail + p.twist_z * lam.tan(),
+        0.0,
+        p.twist_z,
+    );
+    let fw = p.front_wheel;
+    let bodies = [
+        (
+            p.fork.mass,
+            Vector3::new(p.fork.x, 0.0, p.fork.z),
+            Matrix3::new(
+                p.fork.inertia_xx,
+                0.0,
+                p.fork.inertia_xz,
+                0.0,
+                p.fork.inertia_yy,
+                0.0,
+                p.fork.inertia_xz,
+                0.0,
+                p.fork.inertia_zz,
+            ),
+        ),
+        (
+            fw.mass,
+            Vector3::new(p.wheelbase, 0.0, -fw.radius),
+            Matrix3::from_diagonal(&Vector3::new(fw.inertia_xx, fw.inertia_yy, fw.inertia_xx)),
+        ),
+    ];
+    let inertia: f64 = bodies
+        .iter()
+        .map(|(mass, c, i)| (t.transpose() * i * t)[0] + mass * t.cross(&(c - o)).norm_squared())
+        .sum();
+    let mbb = m.lin.m[(2 + BETA, 2 + BETA)];
+    assert!(
+        (mbb - inertia).abs() < 1e-12 * inertia,
+        "{mbb} against {inertia}"
+    );
+    // With frame and pitch locked the twist mode is sqrt(k / I_t): 0.254 kg m^2
+    // and 3000 N m/rad give 17.3 Hz.
+    let hz = (p.head_stiffness / mbb).sqrt() / std::f64::consts::TAU;
+    assert!((hz - 17.3).abs() < 0.05, "{hz} Hz");
+}
