@@ -235,3 +235,39 @@ fn interval_coverage_and_error_over_seeds() {
     assert!(2 * covered >= n, "{table}covered {covered} of {n}");
     assert!(worst <= 0.07, "{table}worst {worst}");
 }
+
+/// `--model`: the test bicycle's file fitted (steering-head stiffness and
+/// damping) to the kicks of the test bicycle's and the damped head's
+/// campaigns gives their wobble speeds within 5 %, inside its interval.
+#[test]
+fn model_informed_estimate_finds_the_wobble_speed() {
+    let params = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../host-tools/bicycle-model/params/test-bicycle.toml");
+    let keys: Vec<String> = wobblog::cmd::margin_model::DEFAULT_PARAMS
+        .iter()
+        .map(|k| (*k).to_owned())
+        .collect();
+    for l in loaded()
+        .iter()
+        .filter(|l| ["test-bicycle", "head-damping"].contains(&l.campaign.variant.as_str()))
+    {
+        let kicks: Vec<(f64, f64, f64, f64)> = points(l)
+            .iter()
+            .map(|k| (k.speed_mps, k.freq_hz, k.sigma_per_s, k.sigma_sd_per_s))
+            .collect();
+        let m = wobblog::cmd::margin_model::estimate(&params, &keys, &kicks, 0).unwrap();
+        let truth = l.campaign.wobble_speed_mps;
+        let w = m.wobble_speed_mps.unwrap();
+        assert!(
+            (w / truth - 1.0).abs() <= 0.05,
+            "{} {truth}: {m:?}",
+            l.campaign.variant
+        );
+        let [lo, hi] = m.ci95_mps;
+        assert!(
+            lo.unwrap() <= truth && truth <= hi.unwrap(),
+            "{} {truth}: {m:?}",
+            l.campaign.variant
+        );
+    }
+}

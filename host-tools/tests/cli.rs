@@ -148,3 +148,73 @@ fn info_to_a_closed_pipe_does_not_panic() {
     );
     assert!(!String::from_utf8_lossy(&out.stderr).contains("panicked"));
 }
+
+#[test]
+fn decode_help_and_the_man_page_list_every_column_with_its_unit() {
+    let help = wobblog().args(["decode", "--help"]).output().unwrap();
+    let help = String::from_utf8(help.stdout).unwrap();
+    let man = wobblog().arg("man").output().unwrap();
+    let man = String::from_utf8(man.stdout).unwrap();
+    for column in wobblog::export::columns::COLUMNS {
+        assert!(help.contains(column.name), "{} not in --help", column.name);
+        assert!(
+            man.contains(column.name),
+            "{} not in the man page",
+            column.name
+        );
+    }
+    for line in [
+        "t_s            time since boot, s",
+        "ax_g ay_g az_g acceleration, g",
+        "angular rate, deg/s",
+        "steer_deg      steering angle, deg",
+        "speed_mps      wheel speed, m/s",
+        "gps_speed_mps  GPS ground speed, m/s",
+        "utc            UTC, ISO 8601",
+    ] {
+        assert!(help.contains(line), "{line:?} not in\n{help}");
+    }
+}
+
+#[test]
+fn json_and_format_jsonl_are_one_convention() {
+    let dir = tempfile::tempdir().unwrap();
+    let log = sample_log(dir.path());
+    for command in ["info", "events", "wobble"] {
+        let json = wobblog()
+            .arg(command)
+            .arg(&log)
+            .arg("--json")
+            .output()
+            .unwrap();
+        let jsonl = wobblog()
+            .arg(command)
+            .arg(&log)
+            .args(["--format", "jsonl"])
+            .output()
+            .unwrap();
+        assert!(json.status.success() && jsonl.status.success(), "{command}");
+        assert_eq!(json.stdout, jsonl.stdout, "{command}");
+        let contradiction = wobblog()
+            .arg(command)
+            .arg(&log)
+            .args(["--json", "--format", "text"])
+            .output()
+            .unwrap();
+        assert_eq!(contradiction.status.code(), Some(2), "{command}");
+    }
+    let json = wobblog()
+        .arg("summary")
+        .arg(dir.path())
+        .arg("--json")
+        .output()
+        .unwrap();
+    let jsonl = wobblog()
+        .arg("summary")
+        .arg(dir.path())
+        .args(["--format", "jsonl"])
+        .output()
+        .unwrap();
+    assert!(json.status.success());
+    assert_eq!(json.stdout, jsonl.stdout);
+}

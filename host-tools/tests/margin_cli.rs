@@ -159,6 +159,23 @@ fn errors_name_the_input() {
         .output()
         .unwrap();
     assert_eq!(out.status.code(), Some(2));
+    // `--param` needs `--model`; a missing parameter file is named.
+    let out = wobblog()
+        .args(["margin", "x.wbl", "--param", "steer_head.damping"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    let some = campaign(&speeds(2.0, 3.4, 6));
+    let params = some.path().join("nothing.toml");
+    let out = wobblog()
+        .arg("margin")
+        .arg(some.path())
+        .arg("--model")
+        .arg(&params)
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("nothing.toml"));
     // One unreadable log among good ones: the others still count, the
     // exit code says one failed.
     let good = campaign(&speeds(2.0, 3.4, 8));

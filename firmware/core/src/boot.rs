@@ -179,6 +179,31 @@ pub const fn optcr_with_bor_level3(optcr: u32) -> u32 {
     optcr & !BOR_LEV_MASK & !OPTCR_CONTROL_MASK
 }
 
+/// Boots in a row that ended in a software reset (a panic or a fault)
+/// after which the logger stops opening a new log file per boot.
+pub const PANIC_LOOP_BOOTS: u32 = 3;
+/// A boot that has run this long ends the streak, µs.
+pub const PANIC_STREAK_CLEAR_US: u64 = 60_000_000;
+
+/// This boot's count of software resets in a row, from the count kept
+/// across the reset (`None` when the kept word is not valid: after a
+/// power-on RAM holds noise) and the reset cause.
+#[must_use]
+pub fn panic_streak(kept: Option<u32>, cause: ResetCause) -> u32 {
+    match cause {
+        ResetCause::Software => kept.unwrap_or(0).saturating_add(1),
+        _ => 0,
+    }
+}
+
+/// Whether a boot with `streak` is in a panic loop: it writes nothing (a
+/// panic at every boot would otherwise leave a new, nearly empty log file
+/// per boot) and shows the software-reset code until a power cycle.
+#[must_use]
+pub const fn in_panic_loop(streak: u32) -> bool {
+    streak >= PANIC_LOOP_BOOTS
+}
+
 /// The system fault to record at boot for the stored brown-out level.
 #[must_use]
 pub fn bor_fault(level: BorLevel) -> Option<u8> {
@@ -233,6 +258,25 @@ impl BorCheck {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_panic_at_every_boot_is_a_loop_after_three_and_anything_else_ends_it() {
+        let mut kept = None;
+        let mut loops = Vec::new();
+        for _ in 0..5 {
+            let n = panic_streak(kept, ResetCause::Software);
+            loops.push(in_panic_loop(n));
+            kept = Some(n);
+        }
+        assert_eq!(loops, [false, false, true, true, true]);
+        // A power-on, the reset button, the watchdog: a fresh start.
+        for cause in [ResetCause::PowerOn, ResetCause::Pin, ResetCause::Watchdog] {
+            assert_eq!(panic_streak(Some(7), cause), 0);
+        }
+        // Noise after a power-on is never taken for a count.
+        assert_eq!(panic_streak(None, ResetCause::Software), 1);
+        assert_eq!(panic_streak(Some(u32::MAX), ResetCause::Software), u32::MAX);
+    }
 
     #[test]
     fn the_boot_only_reports_a_low_brown_out_level() {

@@ -125,6 +125,7 @@ fn a_receiver_reset_to_9600_mid_ride_is_back_at_20_hz_within_a_few_seconds() {
     // 2.15 s check: back within 9 s of the reset (the line's window adds
     // up to 1 s).
     assert!(gap_s < 9.0, "GPS back {gap_s:.2} s after the reset");
+    println!("FIGURES gps recovery: 20 Hz fixes again {gap_s:.2} s after the receiver reset to 9600 baud");
     let after = ride.fixes.iter().filter(|f| f.t_us > resumed).count();
     let end_us = ride.fixes.last().unwrap().t_us;
     let rate_after = after as f64 / ((end_us - resumed) as f64 / 1e6);

@@ -89,6 +89,7 @@ fn main() -> ! {
     defmt::info!("{} starting", FIRMWARE);
     let reset = startup::take_reset_cause();
     defmt::info!("reset cause: {}", reset);
+    let streak = startup::take_panic_streak(reset);
     let crystal = startup::start_hse();
     if !crystal {
         defmt::error!(
@@ -129,6 +130,18 @@ fn main() -> ! {
         startup::blink_code(&mut led, code);
     }
 
+    if boot::in_panic_loop(streak) {
+        // Nothing is written: no new log file per boot. The code repeats
+        // until a power cycle (the watchdog is not started).
+        defmt::error!(
+            "{} software resets in a row: not logging until power-off",
+            streak
+        );
+        let mut led = Output::new(board.rider.alert_led.reborrow(), Level::Low, Speed::Low);
+        loop {
+            startup::blink_code(&mut led, boot::FAULT_RESET_SOFTWARE);
+        }
+    }
     let button = marker_held(&mut board);
     let (card, loaded) = card_and_config(board.card);
     let config = loaded.config;

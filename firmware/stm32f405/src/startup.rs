@@ -5,11 +5,16 @@
 //! flags mean, which option word to program, which fault to record) are the
 //! core's `boot` module.
 
+use core::mem::MaybeUninit;
+use core::ptr::addr_of_mut;
 use cortex_m_rt::{exception, ExceptionFrame};
 use embassy_stm32::gpio::Output;
 use embassy_stm32::pac::{self, FLASH, RCC};
 use embassy_time::{block_for, Duration};
-use wobble_core::boot::{optcr_with_bor_level3, BorCheck, BorLevel, ResetCause, FLASH_SR_ERRORS};
+
+use wobble_core::boot::{
+    optcr_with_bor_level3, panic_streak, BorCheck, BorLevel, ResetCause, FLASH_SR_ERRORS,
+};
 
 use crate::clocks::HSE_STARTUP_TIMEOUT_MS;
 
@@ -214,6 +219,34 @@ unsafe fn DefaultHandler(irqn: i16) {
         }
     }
     defmt::error!("unexpected interrupt {}: masked", irqn);
+}
+
+/// The software-reset streak kept across resets: a magic word and the
+/// count, in `.uninit` (not zeroed at reset; noise after a power-on, which
+/// the magic word tells apart).
+#[link_section = ".uninit.PANIC_STREAK"]
+static mut PANIC_STREAK: MaybeUninit<[u32; 2]> = MaybeUninit::uninit();
+const STREAK_MAGIC: u32 = 0x5742_4C21;
+
+fn keep_streak(n: u32) {
+    // SAFETY: written only in thread mode (boot, then the watchdog task),
+    // never borrowed.
+    unsafe { addr_of_mut!(PANIC_STREAK).write_volatile(MaybeUninit::new([STREAK_MAGIC, n])) }
+}
+
+/// This boot's software-reset streak (`wobble_core::boot::panic_streak`),
+/// kept for the next boot.
+pub fn take_panic_streak(cause: ResetCause) -> u32 {
+    // SAFETY: as in `keep_streak`; any bit pattern is a valid `[u32; 2]`.
+    let [magic, count] = unsafe { addr_of_mut!(PANIC_STREAK).read_volatile().assume_init() };
+    let n = panic_streak((magic == STREAK_MAGIC).then_some(count), cause);
+    keep_streak(n);
+    n
+}
+
+/// The logger ran long enough: the next panic starts a new streak.
+pub fn clear_panic_streak() {
+    keep_streak(0);
 }
 
 /// Turns on the clock security system once the clocks run from the

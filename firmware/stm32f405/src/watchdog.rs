@@ -18,6 +18,7 @@ use embassy_stm32::Peri;
 use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
 use embassy_sync::blocking_mutex::Mutex;
 use embassy_time::{Instant, Timer};
+use wobble_core::boot::PANIC_STREAK_CLEAR_US;
 use wobble_core::watchdog::{Liveness, Verdict, TIMEOUT_REQUEST_US};
 
 /// How often the task behind the writer asks.
@@ -109,6 +110,9 @@ pub async fn feed(iwdg: Peri<'static, IWDG>) -> ! {
             defmt::info!("stack: {} of {} bytes used at most", used, size);
         }
         asks = asks.wrapping_add(1);
+        if u64::from(asks) * ASK_MS * 1000 == PANIC_STREAK_CLEAR_US {
+            crate::startup::clear_panic_streak();
+        }
         Timer::after_millis(ASK_MS).await;
     }
 }

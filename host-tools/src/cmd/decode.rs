@@ -14,8 +14,25 @@ use crate::time::{utc_ms_at, SyncPair, TimeWindow, WindowArgs};
 use crate::CliError;
 use wobble_core::format::{Event, GpsFix, Record};
 
+/// The columns of a decoded row with their units, for `--help` and the
+/// man page (`columns::COLUMNS` in this order; a test holds them together).
+pub const COLUMNS_HELP: &str = "\
+Columns (units in the names):
+  t_s            time since boot, s
+  ax_g ay_g az_g acceleration, g (1 g = 9.80665 m/s2)
+  gx_dps gy_dps gz_dps
+                 angular rate, deg/s
+  steer_deg      steering angle, deg
+  speed_mps      wheel speed, m/s
+  gps_lat_deg    GPS latitude, deg (empty or null without a fix)
+  gps_lon_deg    GPS longitude, deg
+  gps_speed_mps  GPS ground speed, m/s
+  gps_fix        none, 2d or 3d
+  utc            UTC, ISO 8601 (through the GPS sync pairs; empty before the first)";
+
 /// Arguments of `wobblog decode`.
 #[derive(clap::Args)]
+#[command(after_help = COLUMNS_HELP)]
 pub struct Args {
     /// The card log (`RUNnnnnn.WBL`).
     pub log: PathBuf,

@@ -16,16 +16,15 @@ use wobble_core::format::{Event, Record};
 pub struct Args {
     /// The card log (`RUNnnnnn.WBL`).
     pub log: PathBuf,
-    /// One JSON object per line (`{"t_s": .., "utc": "..Z", "event":
-    /// "alert_on", ..}`; `utc` where the log has it) instead of a table.
-    #[arg(long)]
-    pub json: bool,
+    /// `--json` (or `--format jsonl`) for JSON instead of text.
+    #[command(flatten)]
+    pub output: crate::cmd::logs::JsonArgs,
 }
 
 /// Runs `wobblog events`.
 pub fn run(args: &Args) -> Result<(), CliError> {
     let mut out = Output::stdout();
-    match list(&args.log, args.json, &mut out)? {
+    match list(&args.log, args.output.is_json()?, &mut out)? {
         Ok(()) => out.commit(),
         Err(e) => Err(out.error(e)),
     }

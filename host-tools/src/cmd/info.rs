@@ -13,15 +13,15 @@ use crate::CliError;
 pub struct Args {
     /// The card log (`RUNnnnnn.WBL`).
     pub log: PathBuf,
-    /// Print one JSON object instead of text.
-    #[arg(long)]
-    pub json: bool,
+    /// `--json` (or `--format jsonl`) for JSON instead of text.
+    #[command(flatten)]
+    pub output: crate::cmd::logs::JsonArgs,
 }
 
 /// Runs `wobblog info`.
 pub fn run(args: &Args) -> Result<(), CliError> {
     let summary = summarise(&args.log)?;
-    let text = if args.json {
+    let text = if args.output.is_json()? {
         let json =
             serde_json::to_string_pretty(&summary).map_err(|e| CliError::file(&args.log, e))?;
         json + "\n"

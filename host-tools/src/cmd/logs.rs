@@ -47,6 +47,43 @@ pub fn for_each_log(
     }
 }
 
+/// `--json`, or its alias `--format jsonl`: one convention for every
+/// command that prints a table or JSON (`summary` and `decode` take
+/// `--format` too, and `summary --json` is its `--format jsonl`).
+#[derive(clap::Args, Clone, Copy, Debug, Default)]
+pub struct JsonArgs {
+    /// JSON (one object per line) instead of text; the same as `--format jsonl`.
+    #[arg(long)]
+    pub json: bool,
+    /// `text` (the default) or `jsonl` (the same as `--json`).
+    #[arg(long, value_enum, value_name = "FORMAT")]
+    pub format: Option<TextOrJsonl>,
+}
+
+/// The `--format` of a command that prints text or JSON.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum TextOrJsonl {
+    /// Text for reading.
+    Text,
+    /// One JSON object per line.
+    Jsonl,
+}
+
+impl JsonArgs {
+    /// Whether JSON is asked for.
+    ///
+    /// # Errors
+    /// `--json` with `--format text`.
+    pub fn is_json(&self) -> Result<bool, CliError> {
+        match (self.json, self.format) {
+            (true, Some(TextOrJsonl::Text)) => {
+                Err(CliError::Usage("--json contradicts --format text".into()))
+            }
+            (json, format) => Ok(json || format == Some(TextOrJsonl::Jsonl)),
+        }
+    }
+}
+
 /// Loss warnings printed per log; `info` and `events` list the rest.
 const WARNINGS_SHOWN: usize = 10;
 

@@ -11,6 +11,7 @@ use crate::analysis::margin::{predict, KickPoint, Margin};
 use crate::analysis::{find_kicks, Kick, Run};
 use crate::cmd::detect::log_config;
 use crate::cmd::logs::{for_each_log, print_stdout, warn_losses};
+use crate::cmd::margin_model::{estimate, ModelEstimate, DEFAULT_PARAMS};
 use crate::cmd::summary::logs_in;
 use crate::output::Output;
 use crate::plot::margin::{KickDot, MarginPlot};
@@ -31,6 +32,14 @@ pub struct Args {
     /// the predicted crossing into this `.png` or `.svg` file.
     #[arg(long, value_name = "OUT")]
     pub plot: Option<PathBuf>,
+    /// Also fit the wobble model of this parameter file to the kicks and
+    /// give the fitted model's wobble speed with its interval.
+    #[arg(long, value_name = "PARAMS")]
+    pub model: Option<PathBuf>,
+    /// A parameter to fit with `--model` (repeat; default the steering
+    /// head's stiffness and damping).
+    #[arg(long = "param", value_name = "KEY", requires = "model")]
+    pub params: Vec<String>,
 }
 
 /// One kick as reported.
@@ -68,6 +77,9 @@ pub struct Report {
     pub warnings: Vec<String>,
     /// Every kick, in the order of the logs.
     pub kicks: Vec<KickRow>,
+    /// The model-informed estimate, with `--model`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub model: Option<ModelEstimate>,
 }
 
 /// The logs named by `inputs`: files as given, directories' `*.WBL` files
@@ -140,6 +152,7 @@ pub fn report(mut rows: Vec<KickRow>) -> (Report, Margin) {
         line: margin.line,
         warnings: margin.warnings.clone(),
         kicks: rows,
+        model: None,
     };
     (report, margin)
 }
@@ -150,7 +163,10 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         ImageKind::of(plot)?;
     }
     let logs = expand(&args.inputs)?;
-    let inputs: Vec<&Path> = logs.iter().map(PathBuf::as_path).collect();
+    let mut inputs: Vec<&Path> = logs.iter().map(PathBuf::as_path).collect();
+    if let Some(params) = &args.model {
+        inputs.push(params);
+    }
     let plot_out = args
         .plot
         .as_deref()
@@ -160,7 +176,24 @@ pub fn run(args: &Args) -> Result<(), CliError> {
     if rows.is_empty() && result.is_err() {
         return result;
     }
-    let (report, margin) = report(rows);
+    let (mut report, margin) = report(rows);
+    if let Some(params) = &args.model {
+        let keys: Vec<String> = if args.params.is_empty() {
+            DEFAULT_PARAMS.iter().map(|k| (*k).to_owned()).collect()
+        } else {
+            args.params.clone()
+        };
+        let used: Vec<(f64, f64, f64, f64)> = report
+            .kicks
+            .iter()
+            .filter(|r| r.used)
+            .map(|r| {
+                let k = &r.kick;
+                (k.speed_mps, k.freq_hz, k.sigma_per_s, k.sigma_sd_per_s)
+            })
+            .collect();
+        report.model = Some(estimate(params, &keys, &used, report.kicks_rejected)?);
+    }
     let text = if args.json {
         let mut line = serde_json::to_string(&report)
             .map_err(|e| CliError::Failed(format!("cannot write the report: {e}")))?;
@@ -183,8 +216,11 @@ pub fn run(args: &Args) -> Result<(), CliError> {
                 })
                 .collect(),
             margin,
-            model_curve: None,
-            model_speed: None,
+            model_curve: report.model.as_ref().map(|m| m.curve.clone()),
+            model_speed: report
+                .model
+                .as_ref()
+                .and_then(|m| m.wobble_speed_mps.map(|w| (w, m.ci95_mps))),
         };
         render(&figure, out)?;
     }
@@ -237,6 +273,27 @@ fn render_text(r: &Report, logs: usize) -> String {
         let _ = writeln!(o, "warning: {w}");
     }
     let _ = writeln!(o, "method: {}", r.method);
+    if let Some(m) = &r.model {
+        let _ = writeln!(
+            o,
+            "model ({}): wobble speed {}, 95 % interval {} to {}",
+            m.params_file,
+            speed_text(
+                m.wobble_speed_mps,
+                "none (the fitted model's wobble never turns unstable)"
+            ),
+            speed_text(m.ci95_mps[0], "unbounded"),
+            speed_text(m.ci95_mps[1], "unbounded")
+        );
+        for p in &m.params {
+            let _ = writeln!(
+                o,
+                "  {} = {:.4} +/- {:.4} {} (95 %)",
+                p.key, p.value, p.ci95, p.unit
+            );
+        }
+        let _ = writeln!(o, "  method: {}", m.method);
+    }
     if !r.kicks.is_empty() {
         let _ = writeln!(
             o,

@@ -11,6 +11,7 @@ pub mod gpx;
 pub mod info;
 pub mod logs;
 pub mod margin;
+pub mod margin_model;
 pub mod model;
 pub mod nmea;
 pub mod plot;

@@ -27,6 +27,9 @@ pub struct Args {
     /// Output format.
     #[arg(long, value_enum, default_value_t = SummaryFormat::Table)]
     pub format: SummaryFormat,
+    /// The same as `--format jsonl`, as on `info`, `events` and `wobble`.
+    #[arg(long, conflicts_with = "format")]
+    pub json: bool,
 }
 
 /// One run's row.
@@ -113,7 +116,12 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         rows.push(RunRow::of(&ride));
         Ok(())
     });
-    let printed = print_stdout(&render(&rows, args.format));
+    let format = if args.json {
+        SummaryFormat::Jsonl
+    } else {
+        args.format
+    };
+    let printed = print_stdout(&render(&rows, format));
     result.and(printed)
 }
 

@@ -19,9 +19,9 @@ pub struct Args {
     /// Card logs (`RUNnnnnn.WBL`).
     #[arg(required = true)]
     pub logs: Vec<PathBuf>,
-    /// Print one JSON object per run (one per line) instead of a table.
-    #[arg(long)]
-    pub json: bool,
+    /// `--json` (or `--format jsonl`) for JSON instead of text.
+    #[command(flatten)]
+    pub output: crate::cmd::logs::JsonArgs,
     /// Also draw every episode as a point of sigma against 2 pi f into this
     /// `.png` or `.svg` file.
     #[arg(long, value_name = "OUT")]
@@ -57,6 +57,7 @@ pub struct EpisodeUtc {
 /// Runs `wobblog wobble`. A log that cannot be read is reported and
 /// skipped; the others are still analysed, and the exit code says one failed.
 pub fn run(args: &Args) -> Result<(), CliError> {
+    let json = args.output.is_json()?;
     if let Some(plot) = &args.plot {
         ImageKind::of(plot)?;
     }
@@ -92,7 +93,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
     });
     let mut text = String::new();
     for report in &reports {
-        if args.json {
+        if json {
             let line = serde_json::to_string(report)
                 .map_err(|e| CliError::file(Path::new(&report.log), e))?;
             text.push_str(&line);

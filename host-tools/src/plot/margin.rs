@@ -101,7 +101,15 @@ impl Figure for MarginPlot {
         // The kicks, the line and zero set the scale; an error bar longer
         // than that is cut at the edge.
         let dots = self.kicks.iter().map(|k| k.sigma_per_s);
-        let model = self.model_curve.iter().flatten().map(|p| p.1);
+        // The model's curve only where the figure shows speeds.
+        let curve: Vec<(f64, f64)> = self
+            .model_curve
+            .iter()
+            .flatten()
+            .copied()
+            .filter(|p| x_range.contains(&p.0))
+            .collect();
+        let model = curve.iter().map(|p| p.1);
         let line = band.iter().map(|b| b.1 .0);
         let y_range = padded_range(dots.chain(model).chain(line).chain([0.0]), 1.0);
         let mut chart = ChartBuilder::on(&root)
@@ -176,7 +184,7 @@ impl Figure for MarginPlot {
                     PathElement::new(vec![(x, y), (x + 20, y)], CROSSING.stroke_width(2))
                 });
         }
-        if let Some(curve) = &self.model_curve {
+        if self.model_curve.is_some() {
             let label = self.model_speed.map_or("fitted model".to_string(), |s| {
                 format!("fitted model, wobble speed {:.2} m/s", s.0)
             });
