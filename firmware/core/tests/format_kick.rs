@@ -5,24 +5,8 @@
 use wobble_core::format::block::{BlockHeader, BLOCK_LEN, VERSION_MINOR};
 use wobble_core::format::*;
 
-fn frame(t_us: u64) -> Record<'static> {
-    Record::Frame(Frame {
-        t_us,
-        ..Frame::default()
-    })
-}
-
-fn encode(records: &[Record<'_>]) -> Vec<u8> {
-    let mut enc = BlockEncoder::new();
-    let mut file = Vec::new();
-    for r in records {
-        if let Some(b) = enc.push(r).unwrap() {
-            file.extend_from_slice(b);
-        }
-    }
-    file.extend_from_slice(enc.finish().unwrap());
-    file
-}
+mod format_support;
+use format_support::{encode, frame};
 
 fn decode(file: &[u8]) -> (Vec<Record<'static>>, DecodeStats) {
     let mut dec = Decoder::new();

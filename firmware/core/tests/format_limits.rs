@@ -5,31 +5,8 @@
 use wobble_core::format::block::crc32;
 use wobble_core::format::*;
 
-fn frame(t_us: u64) -> Record<'static> {
-    Record::Frame(Frame {
-        t_us,
-        ..Frame::default()
-    })
-}
-
-fn encode(records: &[Record<'_>]) -> Vec<u8> {
-    let mut enc = BlockEncoder::new();
-    let mut file = Vec::new();
-    for r in records {
-        if let Some(b) = enc.push(r).unwrap() {
-            file.extend_from_slice(b);
-        }
-    }
-    file.extend_from_slice(enc.finish().unwrap());
-    file
-}
-
-fn decode(file: &[u8]) -> (Vec<Event<'_>>, DecodeStats) {
-    let mut dec = Decoder::new();
-    let mut events = Vec::new();
-    dec.feed(file, true, &mut |e| events.push(e));
-    (events, *dec.stats())
-}
+mod format_support;
+use format_support::{decode_events as decode, encode, frame};
 
 fn jumps(file: &[u8]) -> Vec<(u64, u64)> {
     decode(file)
