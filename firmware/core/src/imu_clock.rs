@@ -173,7 +173,7 @@ impl SampleClock {
         // A waiting sample seen before this pulse is not its sample: its
         // own pulse was lost.
         while let Some(w) = self.waiting.front().copied() {
-            if !w.seen_us.is_some_and(|seen| t_us > seen) {
+            if w.seen_us.is_none_or(|seen| t_us <= seen) {
                 break;
             }
             self.waiting.pop_front();
