@@ -93,22 +93,20 @@ impl SpiDevice for Bus {
         let mut address = None;
         for op in ops {
             match op {
-                Operation::Write(w) => match address {
-                    None => {
-                        address = Some(w[0]);
-                        if let (false, [value, ..]) = (w[0] & reg::READ != 0, &w[1..]) {
-                            match w[0] {
-                                reg::PWR_MGMT0 => s.on = true,
-                                reg::DEVICE_CONFIG => s.on = false,
-                                reg::SIGNAL_PATH_RESET if value & reg::FIFO_FLUSH != 0 => {
-                                    s.fifo.clear();
-                                }
-                                _ => {}
+                // The first byte is the address; a write's value follows.
+                Operation::Write(w) if address.is_none() => {
+                    address = Some(w[0]);
+                    if let (false, [value, ..]) = (w[0] & reg::READ != 0, &w[1..]) {
+                        match w[0] {
+                            reg::PWR_MGMT0 => s.on = true,
+                            reg::DEVICE_CONFIG => s.on = false,
+                            reg::SIGNAL_PATH_RESET if value & reg::FIFO_FLUSH != 0 => {
+                                s.fifo.clear();
                             }
+                            _ => {}
                         }
                     }
-                    Some(_) => {}
-                },
+                }
                 Operation::Read(out) => {
                     let answer = match address.map(|a| a & !reg::READ) {
                         Some(reg::WHO_AM_I) => vec![reg::WHO_AM_I_VALUE],

@@ -35,12 +35,20 @@ mod tests {
         let mut config = SpiConfig::default();
         config.frequency = Hertz(clocks::IMU_SPI_HZ);
         let bus = Spi::new(
-            pins.spi, pins.sck, pins.mosi, pins.miso, pins.tx_dma, pins.rx_dma, Irqs, config,
+            pins.spi,
+            pins.sck,
+            pins.mosi,
+            pins.miso,
+            pins.tx_dma,
+            pins.rx_dma,
+            Irqs,
+            config,
         );
         let cs = Output::new(pins.cs, Level::High, Speed::VeryHigh);
         let device = ExclusiveDevice::new(bus, cs, Delay).unwrap_or_else(|e| match e {});
         let driver_config = icm42688::Config::default();
-        let channel = defmt::unwrap!(Imu::try_new(driver_config.imu_config(ImuConfig::DEFAULT)).ok());
+        let channel =
+            defmt::unwrap!(Imu::try_new(driver_config.imu_config(ImuConfig::DEFAULT)).ok());
         let port = ImuAdapter::with_data_ready(
             Icm42688::new(device, driver_config),
             channel,
@@ -69,7 +77,11 @@ mod tests {
         let period = span / (times.len() - 1) as f32;
         defmt::info!("sensor period {} us", period);
         let nominal = NOMINAL_PERIOD_US as f32;
-        defmt::assert!((period / nominal - 1.0).abs() < PERIOD_TOLERANCE, "period {} us", period);
+        defmt::assert!(
+            (period / nominal - 1.0).abs() < PERIOD_TOLERANCE,
+            "period {} us",
+            period
+        );
         // One pulse per period, none missing or doubled: each interval is
         // the mean to within 1 % (the oscillator is stable over seconds).
         for pair in times.windows(2) {

@@ -56,6 +56,9 @@ mod tests {
             Either::First(never) => match never {},
             Either::Second(()) => {}
         }
-        defmt::info!("ran {} ms under the watchdog", (Instant::now() - start).as_millis());
+        defmt::info!(
+            "ran {} ms under the watchdog",
+            (Instant::now() - start).as_millis()
+        );
     }
 }
