@@ -115,6 +115,9 @@ fn main() -> std::io::Result<()> {
     write("markers.wbl", &b"WBLK".repeat(LEN / 4))?;
     write("candidates.wbl", &b"WBLK\x01\x00\x10\x00".repeat(LEN / 8))?;
     // Length 484: a full payload, so no zero padding could tell these apart.
-    write("full_candidates.wbl", &b"WBLK\x01\x00\xe4\x01".repeat(LEN / 8))?;
+    write(
+        "full_candidates.wbl",
+        &b"WBLK\x01\x00\xe4\x01".repeat(LEN / 8),
+    )?;
     write("busy.wbl", &busy(LEN))
 }

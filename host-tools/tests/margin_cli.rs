@@ -196,8 +196,14 @@ fn hostile_log_names_are_escaped_in_the_table_and_exact_in_json() {
     let text = String::from_utf8(out.stdout).unwrap();
     let raw = |c: char| c.is_control() && c != '\n' || c == '\u{202e}';
     assert!(!text.chars().any(raw), "{text:?}");
-    assert!(text.contains("RUN\\u{1b}[2J\\u{202e}\\n  9.99  forged.WBL"), "{text}");
-    assert!(!text.lines().any(|l| l.starts_with("  9.99")), "a forged line: {text}");
+    assert!(
+        text.contains("RUN\\u{1b}[2J\\u{202e}\\n  9.99  forged.WBL"),
+        "{text}"
+    );
+    assert!(
+        !text.lines().any(|l| l.starts_with("  9.99")),
+        "a forged line: {text}"
+    );
     let (code, v, _) = margin_json(&[dir.path().as_os_str()]);
     assert_eq!(code, Some(0));
     let logs: Vec<&str> = v["kicks"]

@@ -52,7 +52,14 @@ fn a_stream_of_reordered_blocks_decodes_like_the_file_in_order() {
         let info: serde_json::Value =
             serde_json::from_str(&through_pipe(&["info", "--json"], &input)).unwrap();
         let want: serde_json::Value = serde_json::from_str(&want_info).unwrap();
-        for key in ["samples", "duration_s", "lost_blocks", "frames_lost", "first_utc", "segments"] {
+        for key in [
+            "samples",
+            "duration_s",
+            "lost_blocks",
+            "frames_lost",
+            "first_utc",
+            "segments",
+        ] {
             assert_eq!(info[key], want[key], "{what}: {key}");
         }
     }

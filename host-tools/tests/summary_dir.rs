@@ -118,8 +118,14 @@ fn hostile_log_names_are_escaped_in_the_table_and_csv_and_exact_in_json() {
                 assert_eq!(row["log"], name, "the exact name");
             }
         } else {
-            assert!(text.contains("a\\u{1b}]0;owned\\u{7}.WBL"), "{format}: {text}");
-            assert!(text.contains("b\\u{9b}2J\\u{202e}LBW.WBL"), "{format}: {text}");
+            assert!(
+                text.contains("a\\u{1b}]0;owned\\u{7}.WBL"),
+                "{format}: {text}"
+            );
+            assert!(
+                text.contains("b\\u{9b}2J\\u{202e}LBW.WBL"),
+                "{format}: {text}"
+            );
             assert!(text.contains("c\\nRUN09999.WBL"), "{format}: {text}");
         }
     }

@@ -47,7 +47,10 @@ fn through_receiver(lines: &[String]) -> (Vec<GpsFix>, u32) {
         t_us += 1_000_000;
     }
     rx.finish(t_us + 5_000_000, &mut keep);
-    (fixes, rx.stats().faults[usize::from(FAULT_OUT_OF_RANGE) - 1])
+    (
+        fixes,
+        rx.stats().faults[usize::from(FAULT_OUT_OF_RANGE) - 1],
+    )
 }
 
 fn update(text: &str) -> sentence::Update {
@@ -104,14 +107,27 @@ fn a_leap_second_is_the_sixty_first_second_of_the_minute() {
 
 #[test]
 fn an_hdop_the_record_cannot_hold_is_unknown_and_counted_not_clamped() {
-    let hdop = |h: &str| update(&gga_hdop("123519", "4807.038", "01131.000", "08", h, "545.4"));
+    let hdop = |h: &str| {
+        update(&gga_hdop(
+            "123519",
+            "4807.038",
+            "01131.000",
+            "08",
+            h,
+            "545.4",
+        ))
+    };
     assert_eq!(hdop("25.4").hdop_d, Some(254));
     assert!(!hdop("25.4").hdop_out_of_range);
     assert_eq!(hdop("0.0").hdop_d, Some(0));
     for bad in ["25.5", "99.99", "-1.0", "1e30"] {
         let u = hdop(bad);
         assert_eq!((u.hdop_d, u.hdop_out_of_range), (None, true), "HDOP {bad}");
-        assert_eq!(u.lat_e7, Some(481_173_000), "HDOP {bad}: the position stays");
+        assert_eq!(
+            u.lat_e7,
+            Some(481_173_000),
+            "HDOP {bad}: the position stays"
+        );
     }
     let gsa = update(&line("GPGSA,A,3,02,05,11,12,,,,,,,,,99.9,99.99,99.9"));
     assert_eq!((gsa.hdop_d, gsa.hdop_out_of_range), (None, true));
@@ -121,7 +137,10 @@ fn an_hdop_the_record_cannot_hold_is_unknown_and_counted_not_clamped() {
     let (fixes, faults) = through_receiver(&[rmc_line.clone(), bad]);
     assert_eq!(faults, 1);
     assert_eq!(fixes.len(), 1);
-    assert_eq!((fixes[0].hdop_d, fixes[0].lat_e7), (None, Some(481_173_000)));
+    assert_eq!(
+        (fixes[0].hdop_d, fixes[0].lat_e7),
+        (None, Some(481_173_000))
+    );
     let good = gga_hdop("123519", "4807.038", "01131.000", "08", "1.3", "545.4");
     let (fixes, faults) = through_receiver(&[rmc_line, good]);
     assert_eq!((faults, fixes[0].hdop_d), (0, Some(13)));

@@ -154,10 +154,16 @@ mod tests {
 
     #[test]
     fn a_window_rolled_over_every_offset_matches() {
-        let bytes: Vec<u8> = (0..3 * WINDOW as u32).map(|i| (i.wrapping_mul(2_654_435_761) >> 24) as u8).collect();
+        let bytes: Vec<u8> = (0..3 * WINDOW as u32)
+            .map(|i| (i.wrapping_mul(2_654_435_761) >> 24) as u8)
+            .collect();
         let mut window = CrcWindow::default();
         for at in 0..=bytes.len() - WINDOW {
-            assert_eq!(window.crc_at(&bytes, at), crc32(&bytes[at..at + WINDOW]), "offset {at}");
+            assert_eq!(
+                window.crc_at(&bytes, at),
+                crc32(&bytes[at..at + WINDOW]),
+                "offset {at}"
+            );
         }
     }
 }

@@ -269,8 +269,9 @@ impl GpsReceiver {
             // error, counted; the fix goes without its UTC, as the decoder
             // would drop it (`format::limits`).
             fix.utc = None;
-            self.faults
-                .count(FAULT_OUT_OF_RANGE, fix.t_us, &mut |f| out(GpsEvent::Fault(f)));
+            self.faults.count(FAULT_OUT_OF_RANGE, fix.t_us, &mut |f| {
+                out(GpsEvent::Fault(f))
+            });
         }
         self.stats.fixes = self.stats.fixes.saturating_add(1);
         out(GpsEvent::Fix(fix));
