@@ -52,7 +52,7 @@ pub fn open_seekable(path: &Path) -> Result<(File, u64), CliError> {
             path,
             format!(
                 "copying the stream to a temporary file in {} (to decode its blocks in order): {e}",
-                crate::text::shown(&std::env::temp_dir())
+                crate::text::shown(std::env::temp_dir())
             ),
         )
     };

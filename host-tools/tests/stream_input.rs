@@ -18,6 +18,9 @@ fn reordered(path: &std::path::Path, order: impl Fn(usize) -> Vec<usize>) -> Vec
         .collect()
 }
 
+/// A block order, given the number of blocks.
+type Order = dyn Fn(usize) -> Vec<usize>;
+
 /// `wobblog ARGS /dev/stdin` with `input` piped in, which must succeed.
 fn through_pipe(args: &[&str], input: &[u8]) -> String {
     stdout_of(wobblog().args(args).arg("/dev/stdin").write_stdin(input))
@@ -34,7 +37,7 @@ fn a_stream_of_reordered_blocks_decodes_like_the_file_in_order() {
     // the first sync pair, and gets the same bytes both times).
     let want = stdout_of(wobblog().arg("decode").arg(&log));
     let want_info = stdout_of(wobblog().args(["info", "--json"]).arg(&log));
-    let orders: [(&str, Box<dyn Fn(usize) -> Vec<usize>>); 4] = [
+    let orders: [(&str, Box<Order>); 4] = [
         ("in order", Box::new(|n| (0..n).collect())),
         ("reversed", Box::new(|n| (0..n).rev().collect())),
         (
