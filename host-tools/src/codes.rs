@@ -77,7 +77,7 @@ pub const FAULT_MEANINGS: [(FaultSource, u8, &str); 36] = [
     (
         FaultSource::Gps,
         FAULT_OUT_OF_RANGE,
-        "sentence with a field out of range (position off the globe, minutes of 60 or more, absurd speed, altitude or satellites)",
+        "sentence with a field out of range (position off the globe, minutes of 60 or more, absurd speed, altitude or satellites: the sentence is not used); an HDOP over 25.4 or negative (left unknown, the rest used), or a 23:59:60 on a day that cannot end with a leap second (the fix goes without its UTC)",
     ),
     (FaultSource::Gps, FAULT_SETUP_UNCONFIRMED, "set-up: no command set confirmed (logging at the receiver's own baud and rate)"),
     (FaultSource::Gps, FAULT_SETUP_SLOW, "set-up: configured, but fixes come slower than 15 Hz"),
