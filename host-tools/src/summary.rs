@@ -3,7 +3,7 @@
 use std::collections::BTreeMap;
 
 use serde::Serialize;
-use wobble_core::format::{DecodeStats, Event, Record};
+use wobble_core::format::{DecodeStats, Event, KickRingDown, Record};
 
 use crate::losses::Losses;
 use crate::rows::{Row, RowAssembler};
@@ -87,6 +87,14 @@ pub struct Summary {
     pub alerts: Vec<AlertSpan>,
     /// Rider markers, s.
     pub markers: Vec<f64>,
+    /// Kick ring-downs measured on board (kick records; `wobblog events`
+    /// lists them, `wobblog margin` uses them).
+    pub kicks: u64,
+    /// The kick records themselves, in file order.
+    #[serde(skip)]
+    pub kick_records: Vec<KickRingDown>,
+    /// Records decoded, by kind (`frame`, `gps`, `kick`, ...).
+    pub records: BTreeMap<&'static str, u64>,
     /// Fault records by source: number of faults counted.
     pub faults: BTreeMap<&'static str, u64>,
     /// Everything lost, in detail.
@@ -125,6 +133,24 @@ impl Summary {
             Some((stretch, _)) if hi - lo > 2.0 * covered => Some((stretch, true)),
             _ => Some(((lo, hi), false)),
         }
+    }
+}
+
+/// The name of `record`'s kind, as `info` counts them (FORMAT.md's names).
+#[must_use]
+pub fn record_kind(record: &Record<'_>) -> &'static str {
+    match record {
+        Record::Frame(_) => "frame",
+        Record::Gps(_) => "gps",
+        Record::UtcSync(_) => "utc_sync",
+        Record::Alert(_) => "alert",
+        Record::Marker(_) => "marker",
+        Record::Dropout(_) => "dropout",
+        Record::Fault(_) => "fault",
+        Record::LogInfo(_) => "log_info",
+        Record::Channel(_) => "channel",
+        Record::Config(_) => "config",
+        Record::Kick(_) => "kick",
     }
 }
 
@@ -177,6 +203,7 @@ impl SummaryBuilder {
         let Event::Record(record) = event else { return };
         let s = &mut self.summary;
         let t_s = record.t_us() as f64 / 1e6;
+        *s.records.entry(record_kind(record)).or_default() += 1;
         match record {
             Record::Frame(f) => {
                 s.samples += 1;
@@ -220,8 +247,11 @@ impl SummaryBuilder {
                 s.run = Some(info.run);
                 s.sample_rate_hz = Some(info.sample_rate_hz);
             }
-            // `wobblog events` lists the kicks.
-            Record::Channel(_) | Record::Kick(_) => {}
+            Record::Kick(k) => {
+                s.kicks += 1;
+                s.kick_records.push(*k);
+            }
+            Record::Channel(_) => {}
             Record::Config(line) => s.config.push(line.text.to_string()),
         }
         let stats = &mut self.row_stats;

@@ -119,6 +119,9 @@ fn render(path: &std::path::Path, s: &Summary) -> String {
         );
     }
     let _ = writeln!(o, "markers:      {}", s.markers.len());
+    let _ = writeln!(o, "kicks:        {} ring-downs measured on board", s.kicks);
+    let records: Vec<String> = s.records.iter().map(|(k, v)| format!("{v} {k}")).collect();
+    let _ = writeln!(o, "records:      {}", records.join(", "));
     let faults: Vec<String> = s.faults.iter().map(|(k, v)| format!("{k} {v}")).collect();
     let _ = writeln!(
         o,
