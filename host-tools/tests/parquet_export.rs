@@ -149,7 +149,7 @@ fn parquet_carries_the_log_metadata_and_a_dictionary_gps_fix() {
     assert_eq!(kv["device_id"], "07".repeat(12));
     assert_eq!(kv["sample_rate_hz"], "100");
     assert_eq!(kv["config"], "wheel.circumference_m=2.1\nalert.enabled=on");
-    assert_eq!(kv["first_utc"], "2020-03-18T10:00:01.000Z");
+    assert_eq!(kv["first_utc"], "2020-03-18T10:00:01.000000Z");
     assert_eq!(kv["unit.steer_deg"], "deg");
     assert_eq!(kv["unit.gx_dps"], "deg/s");
     assert_eq!(kv["unit.speed_mps"], "m/s");

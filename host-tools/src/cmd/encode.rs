@@ -12,10 +12,10 @@ use wobble_core::format::{
 };
 
 use crate::csv_input::{number_in, Cell, TimeSteps};
-use crate::export::CSV_COLUMNS;
+use crate::export::{CSV_COLUMNS, MISSING_NUMBER};
 use crate::output::Output;
 use crate::resample::{CsvRow, Resampler};
-use crate::time::parse_iso8601;
+use crate::time::parse_iso8601_us;
 use crate::CliError;
 
 /// Arguments of `wobblog encode`.
@@ -57,6 +57,10 @@ pub fn run(args: &Args) -> Result<(), CliError> {
 /// Index of each known column in the CSV, if present, and of `utc`.
 struct Columns([Option<usize>; CSV_COLUMNS.len()], Option<usize>);
 
+/// The indices in [`CSV_COLUMNS`] of the GPS numbers: latitude,
+/// longitude, ground speed.
+const GPS_NUMBERS: [usize; 3] = [9, 10, 11];
+
 /// The column `decode` writes UTC into.
 const UTC_COLUMN: &str = "utc";
 
@@ -94,18 +98,18 @@ fn refuse_unknown_columns(header: &csv::StringRecord, in_name: &Path) -> Result<
 
 /// The sync pairs that give every row its CSV UTC back: a pair at a row
 /// whenever the last pair does not already give that row's UTC, to the
-/// millisecond as `decode` prints it (so a log decoded and encoded again
-/// has pairs only where its clock and UTC drifted apart by a millisecond).
+/// microsecond as `decode` prints it (so a log decoded and encoded again
+/// has pairs only where its clock and UTC drifted apart).
 #[derive(Default)]
 struct SyncWriter {
     last: Option<UtcSync>,
 }
 
 impl SyncWriter {
-    /// The pair to write before the frame at `t_us` whose UTC is `utc_ms`
+    /// The pair to write before the frame at `t_us` whose UTC is `utc_us`
     /// (`None`: the row has no UTC), or why the row cannot be stored.
-    fn update(&mut self, t_us: u64, utc_ms: Option<i64>) -> Result<Option<UtcSync>, String> {
-        let Some(ms) = utc_ms else {
+    fn update(&mut self, t_us: u64, utc_us: Option<i64>) -> Result<Option<UtcSync>, String> {
+        let Some(us) = utc_us else {
             return match self.last {
                 Some(_) => Err("is empty after a row with a UTC: a log's UTC cannot stop".into()),
                 None => Ok(None),
@@ -113,15 +117,28 @@ impl SyncWriter {
         };
         let given = self.last.and_then(|s| {
             let since_us = i64::try_from(t_us.checked_sub(s.t_us)?).ok()?;
-            let us = i64::try_from(s.unix_ms).ok()?.checked_mul(1000)? + since_us;
-            Some(us.div_euclid(1000))
+            i64::try_from(s.unix_ms)
+                .ok()?
+                .checked_mul(1000)?
+                .checked_add(since_us)
         });
-        if given == Some(ms) {
+        if given == Some(us) {
             return Ok(None);
         }
-        let sync = UtcSync {
-            t_us,
-            unix_ms: u64::try_from(ms).unwrap_or(u64::MAX),
+        // A pair holds whole milliseconds: it sits the sub-millisecond part
+        // of the row's UTC before the row. In the first millisecond since
+        // boot there is no room before it, and the row's UTC is rounded to
+        // the millisecond.
+        let sub_ms = us.rem_euclid(1000).unsigned_abs();
+        let sync = match t_us.checked_sub(sub_ms) {
+            Some(at) => UtcSync {
+                t_us: at,
+                unix_ms: u64::try_from(us.div_euclid(1000)).unwrap_or(u64::MAX),
+            },
+            None => UtcSync {
+                t_us,
+                unix_ms: u64::try_from((us + 500).div_euclid(1000)).unwrap_or(u64::MAX),
+            },
         };
         if !sync.is_valid() {
             return Err("is outside the years a GPS states (2000 to 2099)".into());
@@ -241,7 +258,7 @@ impl<W: Write> LogWriter<'_, W> {
         // Before the frame, so the pair is in force for it.
         let sync = self
             .syncs
-            .update(row.frame.t_us, row.utc_ms)
+            .update(row.frame.t_us, row.utc_us)
             .map_err(|e| self.columns.utc_cell(self.line).error(self.in_name, e))?;
         if let Some(sync) = sync {
             self.push(&Record::UtcSync(sync))?;
@@ -288,10 +305,12 @@ fn parse_row(
         column: c + 1,
         name: CSV_COLUMNS[i],
     };
+    // `decode` writes a missing GPS number as NaN: for those columns it is
+    // no value (elsewhere NaN is refused as a value no log stores).
     let field = |i: usize| {
         columns.0[i]
             .and_then(|c| Some((c, record.get(c)?)))
-            .filter(|(_, f)| !f.is_empty())
+            .filter(|(_, f)| !f.is_empty() && !(GPS_NUMBERS.contains(&i) && *f == MISSING_NUMBER))
     };
     // A missing column is zero (or no GPS); an empty cell of a column that
     // is there is refused (it would be stored as a zero nobody measured); a
@@ -386,16 +405,16 @@ fn parse_row(
             ));
         }
     };
-    let utc_ms = match columns.1.and_then(|c| record.get(c)) {
+    let utc_us = match columns.1.and_then(|c| record.get(c)) {
         Some("") | None => None,
-        Some(text) => Some(parse_iso8601(text).ok_or_else(|| {
+        Some(text) => Some(parse_iso8601_us(text).ok_or_else(|| {
             columns.utc_cell(line).error(
                 path,
                 format!("is not a UTC time like 2020-03-18T13:28:20.600Z: {text:?}"),
             )
         })?),
     };
-    Ok(CsvRow { frame, gps, utc_ms })
+    Ok(CsvRow { frame, gps, utc_us })
 }
 
 /// The GPS record to write at `t_us`, if any: when the fix changes, when it
