@@ -15,12 +15,13 @@ pub mod no_slip;
 pub mod params;
 pub mod simulate;
 pub mod sweep;
+pub mod synthetic;
 mod track;
 pub mod whipple;
 pub mod wobble;
 
 pub use critical::{critical_speeds, CriticalSpeed};
-pub use model::{Model, StateRole};
+pub use model::{Model, Pencil, StateRole};
 pub use nalgebra::Complex;
 pub use params::{ModelKind, ParamError, ParamSet, Problem, Quantity, Unit};
-pub use sweep::{Branch, Mode, Sweep, SweepError};
+pub use sweep::{Branch, Mode, Survey, Sweep, SweepError};

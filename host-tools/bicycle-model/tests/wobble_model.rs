@@ -231,11 +231,11 @@ fn wobble_keeps_its_name_whatever_the_hip_stiffness() {
 #[test]
 fn state_matrix_is_the_affine_pencil() {
     let model = Model::from_set(&set("test-bicycle.toml")).unwrap();
-    let (a0, a1) = model.pencil().expect("the wobble model is affine in u");
+    let pencil = model.pencil().expect("the wobble model is affine in u");
     for u in [0.3, 2.0, 7.5, 14.0, 40.0] {
         let a = model.state_matrix(u);
         let scale = a.amax();
-        assert!((&a0 + &a1 * u - &a).amax() < 1e-12 * scale, "at {u} m/s");
+        assert!((pencil.at(u) - &a).amax() < 1e-12 * scale, "at {u} m/s");
     }
     assert!(Model::from_set(&set("benchmark.toml"))
         .unwrap()
@@ -287,12 +287,12 @@ fn no_slip_counterpart_with_a_rigid_head_is_the_rider_lean_bicycle() {
 #[ignore = "writes a file for the LAPACK comparison"]
 fn write_pencil() {
     let out = std::env::var("PENCIL_OUT").expect("PENCIL_OUT names the file to write");
-    let (a0, a1) = Model::from_set(&set("test-bicycle.toml"))
+    let pencil = Model::from_set(&set("test-bicycle.toml"))
         .unwrap()
         .pencil()
         .unwrap();
     let mut text = String::new();
-    for m in [a0, a1] {
+    for m in [pencil.a0, pencil.a1] {
         for r in m.row_iter() {
             let cells: Vec<String> = r.iter().map(|v| format!("{v:e}")).collect();
             text.push_str(&cells.join(","));
