@@ -84,14 +84,17 @@ pub fn campaign_logs(dir: &Path) -> Result<Vec<LogEntry>, CliError> {
     Ok(entries)
 }
 
+/// A card's name (none for a card given itself) and its logs.
+pub type Card = (Option<String>, Vec<PathBuf>);
+
 /// The logs of a card (`*.WBL` at the top of `dir`: one card, no name) or
 /// of a folder of cards (none at the top: each subdirectory with logs is a
 /// card, named after it), cards and logs sorted by name.
 ///
 /// # Errors
 /// An unreadable directory, or no log at either level.
-pub fn cards_in(dir: &Path) -> Result<Vec<(Option<String>, Vec<PathBuf>)>, CliError> {
-    let mut cards: Vec<(Option<String>, Vec<PathBuf>)> = Vec::new();
+pub fn cards_in(dir: &Path) -> Result<Vec<Card>, CliError> {
+    let mut cards: Vec<Card> = Vec::new();
     let top = logs_in(dir)?;
     if top.is_empty() {
         let mut subdirs: Vec<PathBuf> = std::fs::read_dir(dir)

@@ -310,7 +310,7 @@ fn parse_row(
     let field = |i: usize| {
         columns.0[i]
             .and_then(|c| Some((c, record.get(c)?)))
-            .filter(|(_, f)| !f.is_empty() && !(GPS_NUMBERS.contains(&i) && *f == MISSING_NUMBER))
+            .filter(|(_, f)| !(f.is_empty() || GPS_NUMBERS.contains(&i) && *f == MISSING_NUMBER))
     };
     // A missing column is zero (or no GPS); an empty cell of a column that
     // is there is refused (it would be stored as a zero nobody measured); a
@@ -438,23 +438,31 @@ fn gps_update(last: &Option<(u64, GpsFix)>, now: Option<GpsFix>, t_us: u64) -> O
 mod tests {
     use super::*;
 
-    /// 2020-03-18T10:00:01.000Z, ms since 1970.
-    const MS: i64 = 1_584_525_601_000;
+    /// 2020-03-18T10:00:01.000Z, µs since 1970.
+    const US: i64 = 1_584_525_601_000_000;
 
     #[test]
     fn a_pair_is_written_only_where_the_last_one_is_wrong() {
         let mut syncs = SyncWriter::default();
         assert_eq!(syncs.update(0, None), Ok(None));
-        let first = syncs.update(1_000_000, Some(MS)).unwrap().unwrap();
-        assert_eq!((first.t_us, first.unix_ms), (1_000_000, MS as u64));
+        let first = syncs.update(1_000_000, Some(US)).unwrap().unwrap();
+        assert_eq!((first.t_us, first.unix_ms), (1_000_000, (US / 1000) as u64));
         // 10 ms later the pair gives 10 ms more, to the microsecond.
-        assert_eq!(syncs.update(1_010_000, Some(MS + 10)), Ok(None));
-        // 9.999 ms later it gives 9 ms (decode rounds down).
-        assert_eq!(syncs.update(1_009_999, Some(MS + 9)), Ok(None));
-        // A clock 1 ms off: a new pair at this frame.
-        let next = syncs.update(1_020_000, Some(MS + 21)).unwrap().unwrap();
-        assert_eq!((next.t_us, next.unix_ms), (1_020_000, MS as u64 + 21));
-        assert_eq!(syncs.update(1_030_000, Some(MS + 31)), Ok(None));
+        assert_eq!(syncs.update(1_010_000, Some(US + 10_000)), Ok(None));
+        assert_eq!(syncs.update(1_009_999, Some(US + 9_999)), Ok(None));
+        // A clock 250 µs off: a new pair, 250 µs before this frame, holding
+        // the whole millisecond.
+        let next = syncs.update(1_020_000, Some(US + 20_250)).unwrap().unwrap();
+        assert_eq!(
+            (next.t_us, next.unix_ms),
+            (1_019_750, (US / 1000) as u64 + 20)
+        );
+        assert_eq!(syncs.update(1_030_000, Some(US + 30_250)), Ok(None));
+        // In the first millisecond since boot there is no room before the
+        // frame: the nearest millisecond.
+        let mut early = SyncWriter::default();
+        let pair = early.update(400, Some(US + 600)).unwrap().unwrap();
+        assert_eq!((pair.t_us, pair.unix_ms), (400, (US / 1000) as u64 + 1));
     }
 
     #[test]
@@ -464,8 +472,11 @@ mod tests {
             .update(0, Some(0))
             .unwrap_err()
             .contains("2000 to 2099"));
-        assert!(syncs.update(0, Some(4_102_444_800_000)).is_err());
-        assert!(syncs.update(0, Some(4_102_444_799_999)).unwrap().is_some());
+        assert!(syncs.update(0, Some(4_102_444_800_000_000)).is_err());
+        assert!(syncs
+            .update(0, Some(4_102_444_799_999_000))
+            .unwrap()
+            .is_some());
         assert!(syncs
             .update(10_000, None)
             .unwrap_err()
