@@ -82,6 +82,7 @@ fn ride(secs: f64, speed: impl Fn(f64) -> f64, steer: impl Fn(f64, f64) -> f64) 
                 accel_g: [(tick % 5) as f32 / 2048.0, 0.0, 1.0],
                 gyro_dps: [0.0, (tick % 3) as f32 / 32.0, 0.0],
                 stuck: false,
+                skipped: 0,
             }),
             steering: Ok(SteeringSample {
                 deg: steer(t_s, distance_m / circumference_m) as f32,

@@ -1,5 +1,6 @@
-//! The extended wobble model: its Whipple limits, and the behaviour the
-//! seed paper reports for its test bicycle.
+//! The extended wobble model: its Whipple limits, and the first test
+//! bicycle's wobble (the simulated corpus's; the seed paper's claims on the
+//! re-derived test bicycle are in `paper_claims.rs`).
 
 use std::path::Path;
 
@@ -43,7 +44,11 @@ fn hz(v: Complex<f64>) -> f64 {
 
 #[test]
 fn constrained_limit_is_the_lumped_whipple_bicycle_exactly() {
-    for file in ["test-bicycle.toml", "test-bicycle-light-rider.toml"] {
+    for file in [
+        "test-bicycle.toml",
+        "paper-test-bicycle.toml",
+        "paper-test-bicycle-light-rider.toml",
+    ] {
         let p = WobbleParams::from_set(&set(file)).unwrap();
         let (geo, bodies) = p.description();
         let [m, c1, k0g, k2] = constrained_whipple(&multibody::linearise(&geo, &bodies));
@@ -126,25 +131,6 @@ fn test_bicycle_wobbles_near_6_hz_unstable_from_about_4_mps() {
     let speed = speed.expect("a wobble speed");
     assert!((3.5..4.5).contains(&speed), "wobble speed {speed}");
     assert!(w[5].re < 0.0 && w[95].re > 0.0);
-}
-
-#[test]
-fn a_light_rider_raises_wobble_speed_and_frequency() {
-    let (heavy, heavy_speed) = wobble(&set("test-bicycle.toml"));
-    let (light, light_speed) = wobble(&set("test-bicycle-light-rider.toml"));
-    let heavy_speed = heavy_speed.unwrap();
-    assert!(
-        light_speed.is_none_or(|s| s > heavy_speed + 1.0),
-        "{light_speed:?} vs {heavy_speed}"
-    );
-    for (k, u) in speeds().into_iter().enumerate() {
-        // The heavier rider's wobble frequency rises faster with speed, so
-        // the light rider's is higher up to the wobble speed only.
-        if u <= heavy_speed {
-            assert!(hz(light[k]) > hz(heavy[k]), "at {u} m/s");
-        }
-        assert!(light[k].re < heavy[k].re, "at {u} m/s");
-    }
 }
 
 fn scaled(file: &str, key: &str, factor: f64) -> ParamSet {

@@ -195,10 +195,9 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         report.model = Some(estimate(params, &keys, &used, report.kicks_rejected)?);
     }
     let text = if args.json {
-        let mut line = serde_json::to_string(&report)
+        let line = serde_json::to_string(&report)
             .map_err(|e| CliError::Failed(format!("cannot write the report: {e}")))?;
-        line.push('\n');
-        line
+        crate::text::json_terminal_safe(line) + "\n"
     } else {
         render_text(&report, logs.len())
     };
@@ -233,7 +232,10 @@ fn speed_text(v: Option<f64>, what: &str) -> String {
 }
 
 /// The table form: the answer in words, then every kick.
+/// Names and keys that come from files or the command line are shown with
+/// control and bidirectional characters escaped.
 fn render_text(r: &Report, logs: usize) -> String {
+    use crate::text::escape_controls;
     use std::fmt::Write;
     let mut o = String::new();
     let kicks = crate::words::plural(r.kicks.len(), "kick");
@@ -277,7 +279,7 @@ fn render_text(r: &Report, logs: usize) -> String {
         let _ = writeln!(
             o,
             "model ({}): wobble speed {}, 95 % interval {} to {}",
-            m.params_file,
+            escape_controls(&m.params_file),
             speed_text(
                 m.wobble_speed_mps,
                 "none (the fitted model's wobble never turns unstable)"
@@ -289,10 +291,13 @@ fn render_text(r: &Report, logs: usize) -> String {
             let _ = writeln!(
                 o,
                 "  {} = {:.4} +/- {:.4} {} (95 %)",
-                p.key, p.value, p.ci95, p.unit
+                escape_controls(&p.key),
+                p.value,
+                p.ci95,
+                escape_controls(&p.unit)
             );
         }
-        let _ = writeln!(o, "  method: {}", m.method);
+        let _ = writeln!(o, "  method: {}", escape_controls(&m.method));
     }
     if !r.kicks.is_empty() {
         let _ = writeln!(
@@ -311,7 +316,7 @@ fn render_text(r: &Report, logs: usize) -> String {
             k.kick.sigma_sd_per_s,
             k.kick.amp_deg,
             if k.used { "yes" } else { "no" },
-            k.log
+            escape_controls(&k.log)
         );
     }
     o

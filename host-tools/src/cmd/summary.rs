@@ -135,9 +135,12 @@ fn opt(v: Option<f64>) -> String {
     v.map_or(String::new(), |v| format!("{v:.2}"))
 }
 
+/// A row's cells for the table and CSV forms, which are read on a
+/// terminal: the log's name with control and bidirectional characters
+/// escaped (the JSON lines keep the exact name, in JSON escapes).
 fn cells(r: &RunRow) -> [String; 11] {
     [
-        r.log.clone(),
+        crate::text::escape_controls(&r.log).into_owned(),
         format!("{:.2}", r.duration_s),
         format!("{:.1}", r.distance_m),
         format!("{:.2}", r.max_speed_mps),
@@ -172,7 +175,7 @@ pub fn render(rows: &[RunRow], format: SummaryFormat) -> String {
         SummaryFormat::Jsonl => rows
             .iter()
             .filter_map(|r| serde_json::to_string(r).ok())
-            .map(|line| line + "\n")
+            .map(|line| crate::text::json_terminal_safe(line) + "\n")
             .collect(),
         SummaryFormat::Csv => {
             let mut w = csv::Writer::from_writer(Vec::new());
