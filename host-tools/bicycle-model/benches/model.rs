@@ -6,6 +6,7 @@ use std::path::Path;
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use wobble_model::fit::fit;
+use wobble_model::neutral::neutral_speeds;
 use wobble_model::synthetic::Synthetic;
 use wobble_model::{critical_speeds, Model, ParamSet, Sweep};
 
@@ -25,8 +26,17 @@ fn sweep_1000(c: &mut Criterion) {
             critical_speeds(&model, &sweep)
         });
     });
-    // The floor: the eigenvalues alone at the same 1000 speeds.
+    // The critical speeds alone: bracketed on the sweep and refined by
+    // Brent's method, against solving the pencil (bialternate sum, 91 x 91).
+    let sweep = Sweep::run(&model, &speeds, |_| {}).unwrap();
+    c.bench_function("wobble model, critical speeds by Brent on the sweep", |b| {
+        b.iter(|| critical_speeds(&model, black_box(&sweep)));
+    });
     let pencil = model.pencil().unwrap();
+    c.bench_function("wobble model, critical speeds from the pencil", |b| {
+        b.iter(|| neutral_speeds(black_box(&pencil), (0.0, 10.0)));
+    });
+    // The floor: the eigenvalues alone at the same 1000 speeds.
     c.bench_function("wobble model, 1000 eigenvalue calls", |b| {
         b.iter(|| {
             for &u in black_box(&speeds) {

@@ -11,6 +11,7 @@ pub mod fit;
 pub mod model;
 pub mod multibody;
 mod naming;
+pub mod neutral;
 pub mod no_slip;
 pub mod params;
 pub mod simulate;

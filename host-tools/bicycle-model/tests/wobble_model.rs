@@ -287,3 +287,40 @@ fn write_pencil() {
     }
     std::fs::write(out, text).unwrap();
 }
+
+/// The critical speeds the sweep brackets on a grid and refines by Brent's
+/// method are the speeds the affine pencil puts an eigenvalue on the
+/// imaginary axis (bialternate sum, no grid), to 1e-9 m/s, with the same
+/// frequency; on the test bicycle with its standard and a tense rider.
+#[test]
+fn critical_speeds_are_the_pencils_neutral_speeds() {
+    use wobble_model::neutral::neutral_speeds;
+    for hip in [None, Some(2000.0)] {
+        let mut s = set("test-bicycle.toml");
+        if let Some(k) = hip {
+            s.set_value("hip.stiffness", k, "tense rider").unwrap();
+        }
+        let model = Model::from_set(&s).unwrap();
+        let speeds: Vec<f64> = (1..=120).map(|i| f64::from(i) * 0.1).collect();
+        let sweep = Sweep::run(&model, &speeds, |_| {}).unwrap();
+        let brent = critical_speeds(&model, &sweep);
+        let neutral = neutral_speeds(&model.pencil().unwrap(), (0.1, 12.0));
+        println!("hip {hip:?}: brent {brent:?}\n  pencil {neutral:?}");
+        assert!(!brent.is_empty());
+        for c in &brent {
+            let n = neutral
+                .iter()
+                .min_by(|a, b| {
+                    (a.speed_mps - c.speed_mps)
+                        .abs()
+                        .total_cmp(&(b.speed_mps - c.speed_mps).abs())
+                })
+                .unwrap();
+            assert!(
+                (n.speed_mps - c.speed_mps).abs() < 1e-9,
+                "{c:?} against the pencil's {n:?}"
+            );
+            assert!((n.im_rad_per_s - c.im_rad_per_s).abs() < 1e-6 * c.im_rad_per_s.max(1.0));
+        }
+    }
+}
