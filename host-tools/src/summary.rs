@@ -253,8 +253,8 @@ impl SummaryBuilder {
                 s.run = Some(info.run);
                 s.sample_rate_hz = Some(info.sample_rate_hz);
             }
-            // `wobblog events` lists the kicks.
-            Record::Channel(_) | Record::Kick(_) => {}
+            // `wobblog events` lists the kicks and the margin warning.
+            Record::Channel(_) | Record::Kick(_) | Record::Margin(_) => {}
             Record::Config(line) => s.config.push(line.text.to_string()),
         }
         let stats = &mut self.row_stats;

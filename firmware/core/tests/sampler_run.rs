@@ -15,8 +15,7 @@ use wobble_core::app::ports::{
 };
 use wobble_core::app::sampler::{self, Sampler, SamplerPorts, FRAME_PERIOD_US};
 use wobble_core::channels::{RecordQueue, SharedStatus};
-use wobble_core::config::Config;
-use wobble_core::detector::PatternConfig;
+use wobble_core::config::{AlertConfig, Config};
 use wobble_core::format::Record;
 use wobble_core::frame_assembly::FrameConfig;
 use wobble_core::stall::LONGEST_STALL_US;
@@ -95,7 +94,7 @@ fn frames_of_a_catch_up_burst_are_stamped_on_their_own_ticks() {
         WheelSpeed::try_new(WheelConfig::DEFAULT).expect("default wheel"),
         FrameConfig::DEFAULT,
         Config::default().detector().expect("default detector"),
-        PatternConfig::DEFAULT,
+        AlertConfig::default(),
     );
     let mut ports = SamplerPorts {
         imu: StallingImu {

@@ -8,8 +8,8 @@ use wobble_core::app::sampler::{
     Inputs, Sampler, FAULT_IMU_BAD_SAMPLE, FAULT_IMU_NO_RESPONSE, FAULT_IMU_SKIPPED,
     FAULT_INTERVAL_US, FAULT_STEER_OVERRUN, FAULT_STEER_READ, FRAME_PERIOD_US,
 };
-use wobble_core::config::Config;
-use wobble_core::detector::{AlertEvent, AlertOutput, PatternConfig};
+use wobble_core::config::{AlertConfig, Config};
+use wobble_core::detector::{AlertEvent, AlertOutput};
 use wobble_core::format::{Fault, FaultSource, Frame, FrameStatus, Record};
 use wobble_core::frame_assembly::{FrameAssembler, FrameConfig, TickInputs};
 use wobble_core::wheel::{WheelConfig, WheelSpeed};
@@ -38,7 +38,7 @@ fn sampler() -> Sampler {
         WheelSpeed::try_new(WheelConfig::DEFAULT).expect("default wheel"),
         FrameConfig::DEFAULT,
         Config::default().detector().expect("default detector"),
-        PatternConfig::DEFAULT,
+        AlertConfig::default(),
     )
 }
 

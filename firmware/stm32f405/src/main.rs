@@ -294,7 +294,7 @@ fn sampler_parts(
         defmt::unwrap!(WheelSpeed::try_new(config.wheel).ok()),
         FrameConfig::DEFAULT,
         defmt::unwrap!(config.detector().ok()),
-        config.alert.pattern,
+        config.alert,
     );
     (sampler, ports)
 }

@@ -18,9 +18,10 @@ use super::ports::{
     SteeringPort, SteeringSample, WheelPort,
 };
 use crate::channels::{RecordQueue, SharedStatus};
-use crate::detector::{AlertEvent, AlertPattern, Detector, PatternConfig};
+use crate::config::AlertConfig;
+use crate::detector::{AlertEvent, AlertPattern, Detector, MarginEvent, MarginWarning};
 use crate::faults::FaultCounter;
-use crate::format::{FaultSource, FrameStatus, Marker, Record};
+use crate::format::{FaultSource, FrameStatus, MarginRecord, MarginState, Marker, Record};
 use crate::frame_assembly::{FrameAssembler, FrameConfig, TickInputs};
 use crate::wheel::WheelSpeed;
 
@@ -79,6 +80,7 @@ pub struct Sampler {
     wheel: WheelSpeed,
     assembler: FrameAssembler,
     detector: Detector,
+    margin: MarginWarning,
     pattern: AlertPattern,
     imu_faults: FaultCounter<3>,
     steer_faults: FaultCounter<2>,
@@ -89,20 +91,21 @@ pub struct Sampler {
 }
 
 impl Sampler {
-    /// A sampler with the configured wheel estimator, frame assembly and
-    /// detector.
+    /// A sampler with the configured wheel estimator, frame assembly,
+    /// detector, margin warning and rider patterns.
     #[must_use]
     pub fn new(
         wheel: WheelSpeed,
         frame: FrameConfig,
         detector: Detector,
-        pattern: PatternConfig,
+        alert: AlertConfig,
     ) -> Self {
         Self {
             wheel,
             assembler: FrameAssembler::new(frame),
             detector,
-            pattern: AlertPattern::new(pattern),
+            margin: MarginWarning::new(alert.margin_mps),
+            pattern: AlertPattern::new(alert.pattern, alert.approach),
             imu_faults: FaultCounter::new(FaultSource::Imu, FAULT_INTERVAL_US),
             steer_faults: FaultCounter::new(FaultSource::Steering, FAULT_INTERVAL_US),
             marker_held: false,
@@ -187,9 +190,35 @@ impl Sampler {
             self.pattern
                 .set_alert(now_us, matches!(ev, AlertEvent::On { .. }));
         }
+        let speed = Some(frame.speed_mps());
         if let Some(kick) = self.detector.take_kick() {
             let rate_hz = self.detector.config().sample_rate_hz;
             out(Record::Kick(kick.to_record(now_us, rate_hz)));
+            if let Some(estimate) = self.margin.add_kick(&kick) {
+                let state = MarginState::Estimate;
+                out(Record::Margin(MarginRecord::new(
+                    now_us,
+                    state,
+                    speed,
+                    Some(&estimate),
+                )));
+            }
+        }
+        if let Some(ev) = self.margin.update(now_us, speed) {
+            let approaching = ev == MarginEvent::Approaching;
+            let state = if approaching {
+                MarginState::Approaching
+            } else {
+                MarginState::Clear
+            };
+            let estimate = self.margin.estimate();
+            out(Record::Margin(MarginRecord::new(
+                now_us,
+                state,
+                speed,
+                estimate.as_ref(),
+            )));
+            self.pattern.set_approaching(now_us, approaching);
         }
         self.pattern.update(now_us, alert_out);
         if self.detector.alert_active() {

@@ -26,7 +26,7 @@ pub const MAGIC: [u8; 4] = *b"WBLK";
 /// Format major version written and read by this code.
 pub const VERSION_MAJOR: u8 = 1;
 /// Format minor version written by this code.
-pub const VERSION_MINOR: u8 = 1;
+pub const VERSION_MINOR: u8 = 2;
 
 /// One block's bytes.
 pub type Block = [u8; BLOCK_LEN];
