@@ -45,6 +45,7 @@ fn kind_name(record: &Record<'_>) -> &'static str {
         Record::Dropout(_) => "dropout",
         Record::Fault(_) => "fault",
         Record::Kick(_) => "kick",
+        Record::Margin(_) => "margin",
         Record::LogInfo(_) => "log_info",
         Record::Channel(_) => "channel",
         Record::Config(_) => "config",
