@@ -5,7 +5,8 @@
 //! busy 7.3 h ride whose every column moves (the slowest to export), the
 //! clean log with its blocks in reverse order (decoded in sequence order),
 //! back-to-back sync markers, and markers whose length fields pass (each
-//! one a candidate block whose CRC must be computed).
+//! one a candidate block whose CRC must be checked), with a short payload
+//! and with a full one.
 //!
 //! ```text
 //! cargo run -p wobblog --release --example absurd_logs -- OUT_DIR
@@ -113,5 +114,10 @@ fn main() -> std::io::Result<()> {
     write("reversed.wbl", &reversed)?;
     write("markers.wbl", &b"WBLK".repeat(LEN / 4))?;
     write("candidates.wbl", &b"WBLK\x01\x00\x10\x00".repeat(LEN / 8))?;
+    // Length 484: a full payload, so no zero padding could tell these apart.
+    write(
+        "full_candidates.wbl",
+        &b"WBLK\x01\x00\xe4\x01".repeat(LEN / 8),
+    )?;
     write("busy.wbl", &busy(LEN))
 }

@@ -4,7 +4,8 @@
 //! reasons.
 
 use wobble_core::app::sampler::{
-    FAULT_IMU_BAD_SAMPLE, FAULT_IMU_NO_RESPONSE, FAULT_STEER_OVERRUN, FAULT_STEER_READ,
+    FAULT_IMU_BAD_SAMPLE, FAULT_IMU_NO_RESPONSE, FAULT_IMU_SKIPPED, FAULT_STEER_OVERRUN,
+    FAULT_STEER_READ,
 };
 use wobble_core::boot::{
     FAULT_BOR_FAILED, FAULT_BOR_LOW, FAULT_BOR_PROGRAMMED, FAULT_HSE_FAILED, FAULT_RESET_BROWN_OUT,
@@ -26,7 +27,7 @@ use wobble_core::gps::{
 use wobble_core::logger::{FAULT_CARD_ABSENT, FAULT_CARD_FULL, FAULT_CARD_WRITE};
 
 /// Every fault code the firmware records: (source, code, meaning).
-pub const FAULT_MEANINGS: [(FaultSource, u8, &str); 35] = [
+pub const FAULT_MEANINGS: [(FaultSource, u8, &str); 36] = [
     (
         FaultSource::Imu,
         FAULT_IMU_NO_RESPONSE,
@@ -36,6 +37,11 @@ pub const FAULT_MEANINGS: [(FaultSource, u8, &str); 35] = [
         FaultSource::Imu,
         FAULT_IMU_BAD_SAMPLE,
         "stale or impossible sample (stuck sensor)",
+    ),
+    (
+        FaultSource::Imu,
+        FAULT_IMU_SKIPPED,
+        "a sample the sensor made reached no frame (a gap in its data-ready times, FIFO overflow or invalid packet)",
     ),
     (
         FaultSource::Steering,
@@ -71,12 +77,12 @@ pub const FAULT_MEANINGS: [(FaultSource, u8, &str); 35] = [
     (
         FaultSource::Gps,
         FAULT_OUT_OF_RANGE,
-        "sentence with a field out of range (position off the globe, minutes of 60 or more, absurd speed, altitude or satellites)",
+        "sentence with a field out of range (position off the globe, minutes of 60 or more, absurd speed, altitude or satellites: the sentence is not used); an HDOP over 25.4 or negative (left unknown, the rest used), or a 23:59:60 on a day that cannot end with a leap second (the fix goes without its UTC)",
     ),
-    (FaultSource::Gps, FAULT_SETUP_SILENT, "set-up: no valid NMEA at any baud rate (logging at 9600)"),
     (FaultSource::Gps, FAULT_SETUP_UNCONFIRMED, "set-up: no command set confirmed (logging at the receiver's own baud and rate)"),
     (FaultSource::Gps, FAULT_SETUP_SLOW, "set-up: configured, but fixes come slower than 15 Hz"),
     (FaultSource::Gps, FAULT_RECEIVER_LOST, "receiver lost: no valid sentence for 3 s while logging; the set-up runs again"),
+    (FaultSource::Gps, FAULT_SETUP_SILENT, "set-up: no valid NMEA at any baud rate (logging at 9600)"),
     (
         FaultSource::Card,
         FAULT_CARD_ABSENT,
@@ -231,6 +237,24 @@ mod tests {
                 "FORMAT.md has no row starting {expected:?}"
             );
         }
+    }
+
+    /// Each (source, code) has one meaning: a code shared by two faults
+    /// would name one of them wrongly in every report.
+    #[test]
+    fn each_code_means_one_thing() {
+        for (i, (source, code, _)) in FAULT_MEANINGS.iter().enumerate() {
+            for (other, other_code, _) in &FAULT_MEANINGS[i + 1..] {
+                assert!(
+                    !(source == other && code == other_code),
+                    "{source:?} code {code} listed twice"
+                );
+            }
+        }
+        assert_eq!(
+            fault_meaning(FaultSource::Gps, 10),
+            "set-up: no valid NMEA at any baud rate (logging at 9600)"
+        );
     }
 
     #[test]

@@ -5,8 +5,8 @@ use std::cmp::{Ordering, Reverse};
 use std::collections::BinaryHeap;
 
 use serde::Serialize;
-use wobble_core::format::Event;
 use wobble_core::format::Record;
+use wobble_core::format::{Event, MarginRecord, MarginState};
 
 use crate::codes::{dropout_meaning, fault_meaning};
 use crate::losses::{cause_name, LostBlocks};
@@ -49,6 +49,13 @@ pub enum EventKind {
         /// Standard error of `sigma_per_s`, 1/s.
         sigma_se_per_s: f64,
     },
+    /// A kick updated the on-board estimate of the wobble speed.
+    MarginEstimate(Margin),
+    /// The on-board margin warning started: the speed came within
+    /// `alert.margin_mps` of the estimate's lower bound.
+    Approaching(Margin),
+    /// The margin warning stopped: the speed stayed clear of it.
+    ApproachingOff(Margin),
     /// The rider pressed the marker button.
     Marker {
         /// Marker number since boot.
@@ -116,6 +123,63 @@ pub enum EventKind {
     },
 }
 
+/// What a margin record says: the speed at the time and the wobble speed
+/// the ride's kicks predict on board.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Margin {
+    /// Wheel speed at the time, m/s (`null`: unknown).
+    pub speed_mps: Option<f64>,
+    /// The predicted wobble speed, m/s (`null`: only a lower bound, or no
+    /// estimate).
+    pub wobble_speed_mps: Option<f64>,
+    /// Its 95 % interval, m/s: `[lower, upper]`, `null` where open (or no
+    /// estimate).
+    pub ci95_mps: [Option<f64>; 2],
+    /// Kicks the estimate was made from.
+    pub kicks: u8,
+}
+
+impl Margin {
+    /// The fields of a margin record.
+    #[must_use]
+    pub fn of(m: &MarginRecord) -> Self {
+        let mps = |v: Option<u16>| v.map(|v| f64::from(v) / 1000.0);
+        Self {
+            speed_mps: mps(m.speed_mm_s),
+            wobble_speed_mps: mps(m.estimate_mm_s),
+            ci95_mps: [mps(m.lower_mm_s), mps(m.upper_mm_s)],
+            kicks: m.kicks,
+        }
+    }
+
+    /// The event of a margin record (`None` for a state of a later minor
+    /// version, which this reader cannot name).
+    #[must_use]
+    pub fn event(m: &MarginRecord) -> Option<EventKind> {
+        let fields = Self::of(m);
+        Some(match m.state {
+            MarginState::Estimate => EventKind::MarginEstimate(fields),
+            MarginState::Approaching => EventKind::Approaching(fields),
+            MarginState::Clear => EventKind::ApproachingOff(fields),
+            MarginState::Other(_) => return None,
+        })
+    }
+
+    fn describe(&self) -> String {
+        let v = |x: Option<f64>| x.map_or("-".to_owned(), |v| format!("{v:.2}"));
+        let speed = self
+            .speed_mps
+            .map_or("speed unknown".to_owned(), |v| format!("at {v:.2} m/s"));
+        format!(
+            "wobble speed {} m/s (95 % {}-{}) from {} kicks, {speed}",
+            v(self.wobble_speed_mps),
+            v(self.ci95_mps[0]),
+            self.ci95_mps[1].map_or("open".to_owned(), |h| format!("{h:.2}")),
+            self.kicks
+        )
+    }
+}
+
 impl EventKind {
     /// The kind's name, as in the JSON `event` field.
     #[must_use]
@@ -124,6 +188,9 @@ impl EventKind {
             Self::AlertOn { .. } => "alert_on",
             Self::AlertOff => "alert_off",
             Self::Kick { .. } => "kick",
+            Self::MarginEstimate(_) => "margin_estimate",
+            Self::Approaching(_) => "approaching",
+            Self::ApproachingOff(_) => "approaching_off",
             Self::Marker { .. } => "marker",
             Self::Fault { .. } => "fault",
             Self::Dropout { .. } => "dropout",
@@ -151,6 +218,9 @@ impl EventKind {
                 "{freq_hz:.2} Hz, sigma {sigma_per_s:.2} +- {sigma_se_per_s:.2} 1/s, {amp_deg:.2} deg, {}",
                 speed_mps.map_or("speed unknown".to_owned(), |v| format!("{v:.2} m/s"))
             ),
+            Self::MarginEstimate(m) | Self::Approaching(m) | Self::ApproachingOff(m) => {
+                m.describe()
+            }
             Self::Marker { id } => format!("marker {id}"),
             Self::Fault {
                 source,
@@ -359,6 +429,7 @@ fn record_event(record: &Record<'_>) -> Option<EventKind> {
             amp_deg: f64::from(k.amp_cdeg) / 100.0,
             sigma_se_per_s: f64::from(k.sigma_se_milli_per_s) / 1000.0,
         },
+        Record::Margin(m) => return Margin::event(m),
         Record::Marker(m) => EventKind::Marker { id: m.id },
         Record::Fault(f) => EventKind::Fault {
             source: f.source.as_str(),

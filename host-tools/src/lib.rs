@@ -18,6 +18,7 @@ pub mod plot;
 pub mod reader;
 pub mod resample;
 pub mod rows;
+pub mod spool;
 pub mod summary;
 pub mod text;
 pub mod time;

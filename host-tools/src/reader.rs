@@ -17,14 +17,16 @@ const PROGRESS_MIN_LEN: u64 = 64 << 20;
 
 /// Decodes the log at `path`, calling `visit` for every event.
 ///
-/// A file (anything that can seek) is read twice: a first pass finds its
-/// valid blocks; when their sequence numbers do not strictly increase
-/// through the file (blocks reordered, copied, or two with one number),
-/// the reports of skipped bytes come first and the blocks are then decoded
-/// in sequence order (file order among blocks with one number), each
-/// unique one once. Otherwise, and for a pipe, the blocks are decoded in
-/// file order. Memory use is the chunk size plus, for a reordered log,
-/// 16 bytes per block (3 % of the file). A file in which not a single valid
+/// The log is read twice: a first pass finds its valid blocks; when their
+/// sequence numbers do not strictly increase through the file (blocks
+/// reordered, copied, or two with one number), the reports of skipped
+/// bytes come first and the blocks are then decoded in sequence order
+/// (file order among blocks with one number), each unique one once.
+/// Otherwise the blocks are decoded in file order. A stream (a pipe,
+/// standard input) is copied to a temporary file first
+/// ([`crate::spool`]), so it is decoded the same way. Memory use is the
+/// chunk size plus, for a reordered log, 16 bytes per block (3 % of the
+/// file). A file in which not a single valid
 /// block is found is an error: it is not a card log, or nothing of it
 /// survived.
 pub fn read_log(path: &Path, mut visit: impl FnMut(Event<'_>)) -> Result<DecodeStats, CliError> {
@@ -65,20 +67,14 @@ pub fn read_log_until(
     first_len: usize,
     mut visit: impl FnMut(Event<'_>) -> ControlFlow<()>,
 ) -> Result<DecodeStats, CliError> {
-    let mut file = File::open(path).map_err(|e| CliError::file(path, e))?;
-    let meta = file.metadata().map_err(|e| CliError::file(path, e))?;
-    let len = meta.len();
+    let (mut file, len) = crate::spool::open_seekable(path)?;
     let io = |e| CliError::file(path, e);
-    let stats = if meta.is_file() {
-        let scan = scan(&mut file, len).map_err(io)?;
-        if scan.in_order {
-            file.seek(SeekFrom::Start(0)).map_err(io)?;
-            stream(&mut file, len, first_len, &mut visit).map_err(io)?
-        } else {
-            in_sequence_order(&mut file, scan, &mut visit).map_err(io)?
-        }
-    } else {
+    let scan = scan(&mut file, len).map_err(io)?;
+    let stats = if scan.in_order {
+        file.seek(SeekFrom::Start(0)).map_err(io)?;
         stream(&mut file, len, first_len, &mut visit).map_err(io)?
+    } else {
+        in_sequence_order(&mut file, scan, &mut visit).map_err(io)?
     };
     if stats.blocks == 0 {
         let what = if len == 0 {

@@ -7,7 +7,7 @@ use wobble_core::format::{DecodeStats, Event, KickRingDown, Record};
 
 use crate::losses::Losses;
 use crate::rows::{Row, RowAssembler};
-use crate::time::iso8601_unix_ms;
+use crate::time::iso8601_unix_us;
 
 /// One wobble alert, from its switching on to its switching off.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
@@ -20,6 +20,36 @@ pub struct AlertSpan {
     pub freq_hz: f32,
     /// Steering amplitude when it switched on, degrees.
     pub amp_deg: f32,
+}
+
+/// How many records of one kind a log holds, and how often they came.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct RecordCount {
+    /// Records of the kind.
+    pub count: u64,
+    /// Records per second of the time the frames cover (`duration_s`);
+    /// absent when the frames cover no time.
+    pub rate_hz: Option<f64>,
+}
+
+/// The name `info` gives records of `record`'s kind.
+fn kind_name(record: &Record<'_>) -> &'static str {
+    match record {
+        Record::Frame(_) => "frame",
+        Record::Gps(g) if g.lat_e7.is_some() && g.lon_e7.is_some() => "gps_fix",
+        Record::Gps(_) => "gps_no_position",
+        Record::UtcSync(_) => "utc_sync",
+        Record::Alert(a) if a.on => "alert_on",
+        Record::Alert(_) => "alert_off",
+        Record::Marker(_) => "marker",
+        Record::Dropout(_) => "dropout",
+        Record::Fault(_) => "fault",
+        Record::Kick(_) => "kick",
+        Record::Margin(_) => "margin",
+        Record::LogInfo(_) => "log_info",
+        Record::Channel(_) => "channel",
+        Record::Config(_) => "config",
+    }
 }
 
 /// Summary of one log.
@@ -93,10 +123,11 @@ pub struct Summary {
     /// The kick records themselves, in file order.
     #[serde(skip)]
     pub kick_records: Vec<KickRingDown>,
-    /// Records decoded, by kind (`frame`, `gps`, `kick`, ...).
-    pub records: BTreeMap<&'static str, u64>,
     /// Fault records by source: number of faults counted.
     pub faults: BTreeMap<&'static str, u64>,
+    /// Records by kind (`frame`, `gps_fix`, `utc_sync`, ...): the log's
+    /// channels, as `ulog_info` lists a log's messages.
+    pub records: BTreeMap<&'static str, RecordCount>,
     /// Everything lost, in detail.
     pub losses: Losses,
     /// The GPS sync pairs (s since boot, UTC ms since 1970), in time order:
@@ -133,24 +164,6 @@ impl Summary {
             Some((stretch, _)) if hi - lo > 2.0 * covered => Some((stretch, true)),
             _ => Some(((lo, hi), false)),
         }
-    }
-}
-
-/// The name of `record`'s kind, as `info` counts them (FORMAT.md's names).
-#[must_use]
-pub fn record_kind(record: &Record<'_>) -> &'static str {
-    match record {
-        Record::Frame(_) => "frame",
-        Record::Gps(_) => "gps",
-        Record::UtcSync(_) => "utc_sync",
-        Record::Alert(_) => "alert",
-        Record::Marker(_) => "marker",
-        Record::Dropout(_) => "dropout",
-        Record::Fault(_) => "fault",
-        Record::LogInfo(_) => "log_info",
-        Record::Channel(_) => "channel",
-        Record::Config(_) => "config",
-        Record::Kick(_) => "kick",
     }
 }
 
@@ -203,7 +216,7 @@ impl SummaryBuilder {
         let Event::Record(record) = event else { return };
         let s = &mut self.summary;
         let t_s = record.t_us() as f64 / 1e6;
-        *s.records.entry(record_kind(record)).or_default() += 1;
+        s.records.entry(kind_name(record)).or_default().count += 1;
         match record {
             Record::Frame(f) => {
                 s.samples += 1;
@@ -251,7 +264,8 @@ impl SummaryBuilder {
                 s.kicks += 1;
                 s.kick_records.push(*k);
             }
-            Record::Channel(_) => {}
+            // `wobblog events` lists the margin warning.
+            Record::Channel(_) | Record::Margin(_) => {}
             Record::Config(line) => s.config.push(line.text.to_string()),
         }
         let stats = &mut self.row_stats;
@@ -293,11 +307,14 @@ impl SummaryBuilder {
         self.rows.finish(&mut |row: &Row| row_stats.take(row));
         self.close_segment();
         let mut s = self.summary;
-        let utc_text = |us: Option<i64>| us.and_then(|us| iso8601_unix_ms(us.div_euclid(1000)));
+        let utc_text = |us: Option<i64>| us.and_then(iso8601_unix_us);
         s.first_utc = utc_text(self.row_stats.first_utc_us);
         s.first_utc_us = self.row_stats.first_utc_us;
         s.last_utc = utc_text(self.row_stats.last_utc_us);
         s.duration_s = self.closed_us as f64 / 1e6;
+        for kind in s.records.values_mut() {
+            kind.rate_hz = (s.duration_s > 0.0).then(|| kind.count as f64 / s.duration_s);
+        }
         s.gps_coverage_pct = if s.samples == 0 {
             0.0
         } else {

@@ -28,6 +28,29 @@ fn needs_escape(c: char) -> bool {
     c.is_control() || matches!(c, '\u{202A}'..='\u{202E}' | '\u{2066}'..='\u{2069}')
 }
 
+/// JSON text with the characters [`escape_controls`] escapes that JSON
+/// leaves as they are (DEL, C1 controls, bidirectional formatting) written
+/// as `\uXXXX` escapes: the same JSON value, safe to print on a terminal.
+/// (Outside strings JSON text is ASCII, so every such character is inside
+/// a string, where a `\u` escape means that character.)
+#[must_use]
+pub fn json_terminal_safe(json: String) -> String {
+    if !json.chars().any(needs_escape) {
+        return json;
+    }
+    use std::fmt::Write;
+    let mut out = String::with_capacity(json.len() + 16);
+    for c in json.chars() {
+        // Raw newlines, returns and tabs are JSON's whitespace between values.
+        if needs_escape(c) && !matches!(c, '\n' | '\r' | '\t') {
+            let _ = write!(out, "\\u{:04x}", u32::from(c));
+        } else {
+            out.push(c);
+        }
+    }
+    out
+}
+
 /// A file name as messages show it: [`escape_controls`] of its text, so a
 /// name cannot forge lines or send a terminal commands.
 #[must_use]
@@ -57,6 +80,15 @@ mod tests {
         #[test]
         fn no_control_character_survives(s in any::<String>()) {
             prop_assert!(!escape_controls(&s).chars().any(needs_escape));
+        }
+
+        #[test]
+        fn terminal_safe_json_is_the_same_value_without_controls(s in any::<String>()) {
+            let json = serde_json::to_string(&serde_json::json!({ "log": s })).unwrap();
+            let safe = json_terminal_safe(json);
+            prop_assert!(!safe.chars().any(needs_escape), "{}", safe);
+            let back: serde_json::Value = serde_json::from_str(&safe).unwrap();
+            prop_assert_eq!(back["log"].as_str(), Some(s.as_str()));
         }
     }
 }

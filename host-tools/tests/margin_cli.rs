@@ -260,3 +260,32 @@ fn card_kick_records_are_used_and_said_per_kick() {
     assert!(status.status.success());
     assert_eq!(analysis_support::info_json(&plain)["kicks"], 0);
 }
+
+#[test]
+fn hostile_log_names_are_escaped_in_the_table_and_exact_in_json() {
+    let dir = campaign(&speeds(2.0, 3.4, 6));
+    let name = "RUN\u{1b}[2J\u{202e}\n  9.99  forged.WBL";
+    pass(&dir.path().join(name), 3.0, 99);
+    let out = wobblog().arg("margin").arg(dir.path()).output().unwrap();
+    assert!(out.status.success());
+    let text = String::from_utf8(out.stdout).unwrap();
+    let raw = |c: char| c.is_control() && c != '\n' || c == '\u{202e}';
+    assert!(!text.chars().any(raw), "{text:?}");
+    assert!(
+        text.contains("RUN\\u{1b}[2J\\u{202e}\\n  9.99  forged.WBL"),
+        "{text}"
+    );
+    assert!(
+        !text.lines().any(|l| l.starts_with("  9.99")),
+        "a forged line: {text}"
+    );
+    let (code, v, _) = margin_json(&[dir.path().as_os_str()]);
+    assert_eq!(code, Some(0));
+    let logs: Vec<&str> = v["kicks"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter_map(|k| k["log"].as_str())
+        .collect();
+    assert!(logs.iter().any(|l| l.ends_with(name)), "{logs:?}");
+}

@@ -80,3 +80,88 @@ fn empty_or_missing_directory_fails_cleanly() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("no *.WBL"));
     assert_eq!(run(&dir.path().join("absent")).status.code(), Some(1));
 }
+
+#[test]
+fn a_folder_of_cards_gives_every_cards_runs() {
+    let dir = tempfile::tempdir().unwrap();
+    let (a, b) = (dir.path().join("card-a"), dir.path().join("card-b"));
+    std::fs::create_dir_all(&a).unwrap();
+    std::fs::create_dir_all(&b).unwrap();
+    std::fs::create_dir_all(dir.path().join("empty")).unwrap();
+    analysis_support::standard_log(&a.join("RUN00001.WBL"));
+    let mut calm = Ride::new(20.0, 3.0, 0.0, 0.0, 0.0);
+    calm.steer_deg.fill(0.0);
+    analysis_support::write_log(&b.join("RUN00001.WBL"), &calm, &Extras::default());
+    std::fs::write(b.join("RUN00002.WBL"), b"").unwrap();
+
+    let out = wobblog()
+        .arg("summary")
+        .arg(dir.path())
+        .arg("--json")
+        .output()
+        .unwrap();
+    // The empty log is named and left out; the other runs are there.
+    assert_eq!(out.status.code(), Some(1));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains("RUN00002.WBL"), "{stderr}");
+    let rows: Vec<Value> = String::from_utf8(out.stdout)
+        .unwrap()
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    let logs: Vec<&str> = rows.iter().map(|r| r["log"].as_str().unwrap()).collect();
+    assert_eq!(logs, ["card-a/RUN00001.WBL", "card-b/RUN00001.WBL"]);
+    assert_eq!(rows[0]["unstable_episodes"], 1);
+    assert_eq!(rows[1]["episodes"], 0);
+    assert_eq!(rows[1]["duration_s"].as_f64(), Some(20.0));
+}
+
+#[test]
+fn hostile_log_names_are_escaped_in_the_table_and_csv_and_exact_in_json() {
+    let dir = tempfile::tempdir().unwrap();
+    // ESC, BEL, a C1 CSI, a right-to-left override and a newline that
+    // would forge a row.
+    let names = [
+        "a\u{1b}]0;owned\u{7}.WBL",
+        "b\u{9b}2J\u{202e}LBW.WBL",
+        "c\nRUN09999.WBL  99.00.WBL",
+    ];
+    for name in names {
+        analysis_support::write_log(
+            &dir.path().join(name),
+            &Ride::new(5.0, 3.0, 0.0, 0.0, 0.0),
+            &Extras::default(),
+        );
+    }
+    let raw = |c: char| c.is_control() && c != '\n' || ('\u{202a}'..='\u{202e}').contains(&c);
+    for format in ["table", "csv", "jsonl"] {
+        let out = wobblog()
+            .arg("summary")
+            .arg(dir.path())
+            .args(["--format", format])
+            .output()
+            .unwrap();
+        assert!(out.status.success(), "{format}");
+        let text = String::from_utf8(out.stdout).unwrap();
+        assert!(!text.chars().any(raw), "{format}: {text:?}");
+        let lines: Vec<&str> = text.lines().collect();
+        let header = usize::from(format != "jsonl");
+        assert_eq!(lines.len(), header + names.len(), "{format}: {text}");
+        if format == "jsonl" {
+            for (line, name) in lines.iter().zip(names) {
+                let row: Value = serde_json::from_str(line).unwrap();
+                assert_eq!(row["log"], name, "the exact name");
+            }
+        } else {
+            assert!(
+                text.contains("a\\u{1b}]0;owned\\u{7}.WBL"),
+                "{format}: {text}"
+            );
+            assert!(
+                text.contains("b\\u{9b}2J\\u{202e}LBW.WBL"),
+                "{format}: {text}"
+            );
+            assert!(text.contains("c\\nRUN09999.WBL"), "{format}: {text}");
+        }
+    }
+}

@@ -1,4 +1,5 @@
-//! Card-format throughput: encoding frames, decoding a one-hour log.
+//! Card-format throughput: encoding frames, decoding a one-hour log,
+//! resynchronising through floods of sync markers.
 //!
 //! `cargo bench -p wobble-core --bench format`; figures in `firmware/docs/benchmarks.md`.
 
@@ -102,6 +103,16 @@ fn benches(c: &mut Criterion) {
             BatchSize::SmallInput,
         )
     });
+    // Resynchronising through 4 MiB of sync markers: bare, and 8 bytes
+    // apart with fields that pass (every one checked by its CRC).
+    for (name, pattern) in [
+        ("scan_marker_flood_4mib", &b"WBLK"[..]),
+        ("scan_candidate_flood_4mib", &b"WBLK\x01\x00\xe4\x01"[..]),
+    ] {
+        let flood = pattern.repeat((4 << 20) / pattern.len());
+        group.throughput(Throughput::Bytes(flood.len() as u64));
+        group.bench_function(name, |b| b.iter(|| decode(black_box(&flood))));
+    }
     group.finish();
 }
 

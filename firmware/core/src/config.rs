@@ -22,7 +22,7 @@ use core::fmt;
 use embedded_sdmmc::{BlockDevice, Mode, TimeSource, VolumeIdx, VolumeManager};
 
 use crate::detector::{
-    ConfigError as DetectorConfigError, Detector, DetectorConfig, PatternConfig,
+    ApproachConfig, ConfigError as DetectorConfigError, Detector, DetectorConfig, PatternConfig,
 };
 use crate::format::{Fault, FaultSource};
 use crate::imu::{AxisMap, Imu, ImuConfig, SignedAxis};
@@ -60,15 +60,38 @@ pub const MAX_LINE_FAULTS: usize = 8;
 /// (checked by a test with every value at its widest).
 pub const MAX_TEXT_LEN: usize = 2048;
 
-/// Whether the rider is told about a wobble, and how.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+/// Whether the rider is told about a wobble and about approaching the
+/// wobble speed, and how.
+#[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct AlertConfig {
-    /// Drive the buzzer and alert LED. When off, alerts are still detected
-    /// and logged, the rider just is not told (blind trials). Default on.
+    /// Drive the buzzer and alert LED. When off, alerts and margin
+    /// warnings are still detected and logged, the rider just is not told
+    /// (blind trials). Default on.
     pub enabled: bool,
-    /// Beep timing.
+    /// Beep timing of the wobble alert.
     pub pattern: PatternConfig,
+    /// The margin warning sounds when the speed comes within this much of
+    /// the lower bound of the wobble speed the ride's kicks predict, m/s
+    /// ([`crate::detector::MarginWarning`]). 0 to 5.
+    pub margin_mps: f32,
+    /// Beep timing of the margin warning.
+    pub approach: ApproachConfig,
+}
+
+/// Default of [`AlertConfig::margin_mps`], m/s: about one speed step of
+/// the kick-test protocol (`host-tools/docs/kick-testing.md`).
+pub const DEFAULT_MARGIN_MPS: f32 = 0.5;
+/// Largest [`AlertConfig::margin_mps`], m/s.
+pub const MAX_MARGIN_MPS: f32 = 5.0;
+
+impl AlertConfig {
+    /// Whether the values work together: a margin of 0 to
+    /// [`MAX_MARGIN_MPS`], and a beep group that fits its period.
+    #[must_use]
+    pub fn is_valid(&self) -> bool {
+        (0.0..=MAX_MARGIN_MPS).contains(&self.margin_mps) && self.approach.is_valid()
+    }
 }
 
 impl Default for AlertConfig {
@@ -76,6 +99,8 @@ impl Default for AlertConfig {
         Self {
             enabled: true,
             pattern: PatternConfig::DEFAULT,
+            margin_mps: DEFAULT_MARGIN_MPS,
+            approach: ApproachConfig::DEFAULT,
         }
     }
 }
@@ -134,7 +159,7 @@ const SECTIONS: [SectionRules; 5] = [
         reset: |c| c.detector = DetectorConfig::default(),
     },
     SectionRules {
-        valid: |_| true,
+        valid: |c| c.alert.is_valid(),
         reset: |c| c.alert = AlertConfig::default(),
     },
 ];
@@ -562,6 +587,11 @@ const KEYS: &[Key] = &[
     key!(Alert: alert.pattern.beep_on_us),
     key!(Alert: alert.pattern.beep_off_us),
     key!(Alert: alert.pattern.min_active_us),
+    key!(Alert: alert.margin_mps),
+    key!(Alert: alert.approach.beeps),
+    key!(Alert: alert.approach.beep_on_us),
+    key!(Alert: alert.approach.beep_off_us),
+    key!(Alert: alert.approach.period_us),
 ];
 
 /// Number of `key=value` lines [`Config::write_lines`] produces.
@@ -1063,6 +1093,29 @@ steering.three_point=1:2,3
     }
 
     #[test]
+    fn the_margin_warning_is_configured_and_checked_as_a_section() {
+        let loaded = Config::parse(
+            b"alert.margin_mps=0.8\nalert.approach.beeps=3\nalert.approach.period_us=2000000\n",
+        );
+        assert!(loaded.faults.is_empty(), "{:?}", loaded.faults);
+        let a = loaded.config.alert;
+        assert_eq!((a.margin_mps, a.approach.beeps), (0.8, 3));
+        assert_eq!(a.approach.period_us, 2_000_000);
+        assert_eq!(Config::default().alert.margin_mps, DEFAULT_MARGIN_MPS);
+        // A margin out of range, or a group longer than its period: the
+        // alert section falls back whole.
+        for text in [
+            &b"alert.enabled=false\nalert.margin_mps=-0.1\n"[..],
+            b"alert.enabled=false\nalert.margin_mps=6\n",
+            b"alert.enabled=false\nalert.approach.beeps=20\n",
+        ] {
+            let loaded = Config::parse(text);
+            assert_eq!(loaded.config.alert, AlertConfig::default());
+            assert_eq!(loaded.faults.count(FAULT_REJECTED), 1);
+        }
+    }
+
+    #[test]
     fn a_zero_hole_wheel_is_rejected() {
         let loaded = Config::parse(b"wheel.holes=0\n");
         assert_eq!(loaded.config.wheel, WheelConfig::DEFAULT);
@@ -1075,6 +1128,8 @@ steering.three_point=1:2,3
         c.wheel.circumference_m = 2.1234567;
         c.detector.amp_on_deg = 0.55;
         c.alert.enabled = false;
+        c.alert.margin_mps = 0.35;
+        c.alert.approach.beep_on_us = 55_000;
         c.imu.axis_map = AxisMap([SignedAxis::PosZ, SignedAxis::NegY, SignedAxis::PosX]);
         c.steering.three_point = Some([
             CalPoint {

@@ -190,6 +190,7 @@ mod tests {
             accel_g: [ax, 0.0, 1.0],
             gyro_dps: [0.0, 0.0, 10.0],
             stuck: false,
+            skipped: 0,
         }
     }
 

@@ -200,6 +200,9 @@ pub struct ImuSample {
     pub gyro_dps: [f32; 3],
     /// The sensor repeated identical samples: its values are not live.
     pub stuck: bool,
+    /// Samples the sensor made since the previous frame that reach no
+    /// frame ([`crate::imu_clock`]): each is a counted IMU fault.
+    pub skipped: u16,
 }
 
 /// IMU channel: accumulates raw samples, yields one value per frame.
@@ -240,23 +243,37 @@ impl Imu {
 
     /// Adds one raw sample.
     pub fn push(&mut self, raw: RawImu) {
+        self.watch(raw);
+        let [ax, ay, az] = raw.accel.map(i32::from);
+        let [gx, gy, gz] = raw.gyro.map(i32::from);
+        self.acc.push([ax, ay, az, gx, gy, gz]);
+    }
+
+    /// Counts one raw sample towards the stuck check only (samples placed
+    /// in time by [`crate::imu_clock`] are combined there, not here).
+    pub fn watch(&mut self, raw: RawImu) {
         if self.last == Some(raw) {
             self.repeats = self.repeats.saturating_add(1);
         } else {
             self.repeats = 0;
         }
         self.last = Some(raw);
-        let [ax, ay, az] = raw.accel.map(i32::from);
-        let [gx, gy, gz] = raw.gyro.map(i32::from);
-        self.acc.push([ax, ay, az, gx, gy, gz]);
     }
 
     /// The frame's value from the samples since the previous call; `None` if
     /// the IMU delivered none (the frame marks the channel stale).
     pub fn take(&mut self) -> Option<ImuSample> {
-        let [ax, ay, az, gx, gy, gz] = self.acc.take()?;
+        self.acc.take().map(|counts| self.scale(counts))
+    }
+
+    /// A frame's value from the six axes in sensor counts (accel x/y/z,
+    /// gyro x/y/z): scaled, rotated, and marked stuck if the samples
+    /// watched lately were.
+    #[must_use]
+    pub fn scale(&self, counts: [f32; 6]) -> ImuSample {
+        let [ax, ay, az, gx, gy, gz] = counts;
         let c = &self.config;
-        Some(ImuSample {
+        ImuSample {
             accel_g: c
                 .axis_map
                 .apply([ax, ay, az].map(|x| x * c.accel_g_per_lsb)),
@@ -264,7 +281,8 @@ impl Imu {
                 .axis_map
                 .apply([gx, gy, gz].map(|x| x * c.gyro_dps_per_lsb)),
             stuck: c.stuck_samples != 0 && self.repeats.saturating_add(1) >= c.stuck_samples,
-        })
+            skipped: 0,
+        }
     }
 }
 

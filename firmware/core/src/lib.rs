@@ -20,6 +20,7 @@ pub mod format;
 pub mod frame_assembly;
 pub mod gps;
 pub mod imu;
+pub mod imu_clock;
 pub mod logger;
 pub mod selftest;
 pub mod stall;

@@ -5,7 +5,7 @@
 use proptest::prelude::*;
 use wobble_core::config::Config;
 use wobble_core::detector::{
-    AlertEvent, AlertOutput, AlertPattern, Detector, DetectorConfig, PatternConfig,
+    AlertEvent, AlertOutput, AlertPattern, ApproachConfig, Detector, DetectorConfig, PatternConfig,
 };
 use wobble_core::wheel::WheelConfig;
 
@@ -322,7 +322,7 @@ proptest! {
     fn pattern_follows_alert(switches in prop::collection::vec((0u64..5_000_000, prop::bool::ANY), 0..12)) {
         let mut switches = switches;
         switches.sort_by_key(|s| s.0);
-        let mut p = AlertPattern::new(PatternConfig::DEFAULT);
+        let mut p = AlertPattern::new(PatternConfig::DEFAULT, ApproachConfig::DEFAULT);
         let mut out = Recorder::default();
         let mut alert = false;
         let mut last_on_edge = None;

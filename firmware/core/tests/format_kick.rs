@@ -59,8 +59,8 @@ fn the_record_is_laid_out_as_documented() {
     assert_eq!(&kick[..expected.len()], &expected[..]);
     let payload_len = usize::from(u16::from_le_bytes([file[6], file[7]]));
     assert_eq!(payload_len, 25 + expected.len(), "nothing after the kick");
+    // The record came with 1.1; every later minor version writes it alike.
     assert_eq!(file[5], VERSION_MINOR);
-    assert_eq!(VERSION_MINOR, 1);
 }
 
 #[test]

@@ -69,32 +69,32 @@ fn stuck_and_vanished_sensors_are_set_up_again_once_per_retry() {
     let (mut spi, mut port) = port(&traffic);
 
     block_on(port.start());
-    let first = block_on(port.read()).expect("live sample");
+    let first = block_on(port.read(0)).expect("live sample");
     assert!((first.accel_g[2] - 1.0).abs() < 1e-6 && (first.gyro_dps[0] - 2.0).abs() < 1e-6);
     for k in 1..=stuck {
-        let s = block_on(port.read()).expect("a sample");
+        let s = block_on(port.read(0)).expect("a sample");
         assert_eq!(s.stuck, k == stuck, "sample {k}");
     }
     clock.advance(RETRY);
-    assert!(!block_on(port.read()).expect("set up again, live").stuck);
+    assert!(!block_on(port.read(0)).expect("set up again, live").stuck);
 
     assert_eq!(
-        block_on(port.read()),
+        block_on(port.read(0)),
         Err(SensorError::NoResponse),
         "floating bus"
     );
     clock.advance(RETRY);
     assert_eq!(
-        block_on(port.read()),
+        block_on(port.read(0)),
         Err(SensorError::NoResponse),
         "identity check failed"
     );
     // Within the retry period: no traffic at all.
     clock.advance(RETRY - Duration::from_millis(10));
-    assert_eq!(block_on(port.read()), Err(SensorError::NoResponse));
+    assert_eq!(block_on(port.read(0)), Err(SensorError::NoResponse));
     clock.advance(Duration::from_millis(10));
     assert!(
-        block_on(port.read()).is_ok(),
+        block_on(port.read(0)).is_ok(),
         "set up again a retry after the failure"
     );
     assert_eq!(block_on(port.identity()), Some(reg::WHO_AM_I_VALUE));

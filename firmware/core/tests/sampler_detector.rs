@@ -8,8 +8,8 @@ use std::f64::consts::TAU;
 
 use wobble_core::app::ports::{ImuSample, SteeringSample};
 use wobble_core::app::sampler::{Inputs, Sampler, FRAME_PERIOD_US};
-use wobble_core::config::Config;
-use wobble_core::detector::{AlertEvent, AlertOutput, Detector, PatternConfig};
+use wobble_core::config::{AlertConfig, Config};
+use wobble_core::detector::{AlertEvent, AlertOutput, Detector};
 use wobble_core::format::{FrameStatus, Record};
 use wobble_core::frame_assembly::FrameConfig;
 use wobble_core::wheel::WheelSpeed;
@@ -54,7 +54,7 @@ fn ride(secs: f64, speed: impl Fn(f64) -> f64, steer: impl Fn(f64, f64) -> f64) 
         WheelSpeed::try_new(config.wheel).expect("default wheel"),
         FrameConfig::DEFAULT,
         config.detector().expect("default detector"),
-        PatternConfig::DEFAULT,
+        AlertConfig::default(),
     );
     let circumference_m = f64::from(config.wheel.circumference_m);
     let pitch_m = circumference_m / f64::from(config.wheel.holes);
@@ -82,6 +82,7 @@ fn ride(secs: f64, speed: impl Fn(f64) -> f64, steer: impl Fn(f64, f64) -> f64) 
                 accel_g: [(tick % 5) as f32 / 2048.0, 0.0, 1.0],
                 gyro_dps: [0.0, (tick % 3) as f32 / 32.0, 0.0],
                 stuck: false,
+                skipped: 0,
             }),
             steering: Ok(SteeringSample {
                 deg: steer(t_s, distance_m / circumference_m) as f32,

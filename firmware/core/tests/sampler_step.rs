@@ -5,11 +5,11 @@
 use proptest::prelude::*;
 use wobble_core::app::ports::{ImuSample, SensorError, SteeringSample};
 use wobble_core::app::sampler::{
-    Inputs, Sampler, FAULT_IMU_BAD_SAMPLE, FAULT_IMU_NO_RESPONSE, FAULT_INTERVAL_US,
-    FAULT_STEER_OVERRUN, FAULT_STEER_READ, FRAME_PERIOD_US,
+    Inputs, Sampler, FAULT_IMU_BAD_SAMPLE, FAULT_IMU_NO_RESPONSE, FAULT_IMU_SKIPPED,
+    FAULT_INTERVAL_US, FAULT_STEER_OVERRUN, FAULT_STEER_READ, FRAME_PERIOD_US,
 };
-use wobble_core::config::Config;
-use wobble_core::detector::{AlertEvent, AlertOutput, PatternConfig};
+use wobble_core::config::{AlertConfig, Config};
+use wobble_core::detector::{AlertEvent, AlertOutput};
 use wobble_core::format::{Fault, FaultSource, Frame, FrameStatus, Record};
 use wobble_core::frame_assembly::{FrameAssembler, FrameConfig, TickInputs};
 use wobble_core::wheel::{WheelConfig, WheelSpeed};
@@ -38,7 +38,7 @@ fn sampler() -> Sampler {
         WheelSpeed::try_new(WheelConfig::DEFAULT).expect("default wheel"),
         FrameConfig::DEFAULT,
         Config::default().detector().expect("default detector"),
-        PatternConfig::DEFAULT,
+        AlertConfig::default(),
     )
 }
 
@@ -49,6 +49,7 @@ fn imu(tick: u64) -> ImuSample {
         accel_g: [noise, -0.25, 1.0],
         gyro_dps: [0.5, noise * 32.0, -3.0],
         stuck: false,
+        skipped: 0,
     }
 }
 
@@ -146,6 +147,37 @@ fn an_imu_that_stops_answering_is_flagged_and_counted() {
     }
     let counted: u32 = recorded.iter().map(|f| u32::from(f.count)).sum();
     assert_eq!(counted, dead.end as u32 - dead.start as u32);
+}
+
+#[test]
+fn imu_samples_that_reach_no_frame_are_each_counted() {
+    let mut s = sampler();
+    let mut out = Outputs::default();
+    let mut recorded = Vec::new();
+    // Three samples skipped before tick 5, two before tick 50, then 2 s of
+    // frames for the counter to record the rest.
+    for tick in 1..=300u64 {
+        let mut input = inputs(tick);
+        let skipped = match tick {
+            5 => 3,
+            50 => 2,
+            _ => 0,
+        };
+        input.imu = Ok(ImuSample {
+            skipped,
+            ..imu(tick)
+        });
+        let records = step(&mut s, tick, &input, &mut out);
+        // The frame itself is live: the skip is a fault, not a stale value.
+        assert_eq!(frame_of(&records).status.0 & FrameStatus::IMU_STALE, 0);
+        recorded.extend(faults(&records));
+    }
+    assert!(recorded
+        .iter()
+        .all(|f| f.source == FaultSource::Imu && f.code == FAULT_IMU_SKIPPED));
+    assert_eq!(recorded[0].t_us, 5 * FRAME_PERIOD_US);
+    let counted: u32 = recorded.iter().map(|f| u32::from(f.count)).sum();
+    assert_eq!(counted, 5);
 }
 
 #[test]
@@ -361,6 +393,7 @@ fn arb_tick() -> impl Strategy<
             accel_g: [v[0], v[1], v[2]],
             gyro_dps: [v[3] * 40.0, v[4] * 40.0, v[5] * 40.0],
             stuck,
+            skipped: 0,
         });
     let imu = prop_oneof![
         6 => sample.prop_map(Ok),

@@ -42,7 +42,7 @@ use {defmt_rtt as _, panic_probe as _};
 
 use wobble_stm32f405::adapters::card::SdCard;
 use wobble_stm32f405::adapters::gps::GpsAdapter;
-use wobble_stm32f405::adapters::imu::ImuAdapter;
+use wobble_stm32f405::adapters::imu::{DataReadyAdapter, ImuAdapter};
 use wobble_stm32f405::adapters::rider::{AlertPins, MarkerButton, StatusLight};
 use wobble_stm32f405::adapters::steering::SteeringAdapter;
 use wobble_stm32f405::adapters::wheel::WheelAdapter;
@@ -263,7 +263,12 @@ fn sampler_parts(
     let driver_config = icm42688::Config::default();
     // `Config::parse` only lets through what the core's modules accept.
     let channel = defmt::unwrap!(Imu::try_new(driver_config.imu_config(config.imu)).ok());
-    let imu = ImuAdapter::new(Icm42688::new(device, driver_config), channel, Delay);
+    let imu = ImuAdapter::with_data_ready(
+        Icm42688::new(device, driver_config),
+        channel,
+        Delay,
+        DataReadyAdapter::default(),
+    );
 
     let steering = SteeringAdapter::new(
         steering_adc(steering.adc, steering.wiper, steering.dma),
@@ -289,7 +294,7 @@ fn sampler_parts(
         defmt::unwrap!(WheelSpeed::try_new(config.wheel).ok()),
         FrameConfig::DEFAULT,
         defmt::unwrap!(config.detector().ok()),
-        config.alert.pattern,
+        config.alert,
     );
     (sampler, ports)
 }

@@ -8,8 +8,8 @@
 //! (channel 0), USART2 RX on DMA1 stream 5 and TX on stream 6 (channel 4).
 
 use embassy_stm32::peripherals::{
-    ADC1, DMA1_CH5, DMA1_CH6, DMA2_CH2, DMA2_CH3, DMA2_CH4, IWDG, PA0, PA2, PA3, PA4, PA5, PA6,
-    PA7, PB0, PB1, PB12, PB13, PB14, PB15, PB9, PC0, PC4, SPI1, SPI2, TIM5, USART2,
+    ADC1, DMA1_CH5, DMA1_CH6, DMA2_CH2, DMA2_CH3, DMA2_CH4, IWDG, PA0, PA1, PA2, PA3, PA4, PA5,
+    PA6, PA7, PB0, PB1, PB12, PB13, PB14, PB15, PB9, PC0, PC4, SPI1, SPI2, TIM5, USART2,
 };
 use embassy_stm32::{bind_interrupts, dma, usart, Peri, Peripherals};
 
@@ -67,13 +67,17 @@ pub struct SteeringPins {
     pub dma: Peri<'static, DMA2_CH4>,
 }
 
-/// Hall sensor of the wheel on a 32-bit timer's input capture.
+/// Hall sensor of the wheel and the IMU's data-ready line on a 32-bit
+/// timer's input captures.
 pub struct WheelPins {
     /// TIM5, 32-bit, counting at 1 MHz.
     pub timer: Peri<'static, TIM5>,
     /// PA0: TIM5_CH1, the sensor's open-collector output (pulled up; the
     /// timer's own interrupt handler reads it, see `adapters::wheel`).
     pub hall: Peri<'static, PA0>,
+    /// PA1: TIM5_CH2, the IMU's INT1 (push-pull, a 100 µs pulse per
+    /// sample): the same timer latches each data-ready time.
+    pub imu_int1: Peri<'static, PA1>,
 }
 
 /// GPS receiver on USART2.
@@ -148,6 +152,7 @@ impl Board {
             wheel: WheelPins {
                 timer: p.TIM5,
                 hall: p.PA0,
+                imu_int1: p.PA1,
             },
             gps: GpsPins {
                 uart: p.USART2,

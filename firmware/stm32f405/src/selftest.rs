@@ -65,7 +65,7 @@ async fn imu_at_rest(imu: &mut ImuAdapter) -> Option<f32> {
     let (mut sum, mut n) = (0.0f32, 0u32);
     for _ in 0..100 {
         ticker.next().await;
-        if let Ok(s) = imu.read().await {
+        if let Ok(s) = imu.read(Instant::now().as_micros()).await {
             let [x, y, z] = s.accel_g;
             sum += sqrt(x * x + y * y + z * z);
             n += 1;

@@ -129,7 +129,7 @@ async fn sampler_task(
     let bus = EmulatedIcm42688::new(ride, scenario);
     let mut imu: ImuPort = Icm42688Port::new(Icm42688::new(bus, driver_config), imu, Delay);
     imu.start().await;
-    let mut s = Sampler::new(wheel, FrameConfig::DEFAULT, detector, config.alert.pattern);
+    let mut s = Sampler::new(wheel, FrameConfig::DEFAULT, detector, config.alert);
     let mut ports = SamplerPorts {
         imu,
         steering: ReplayedAdc::new(ride, steering, scenario),

@@ -3,7 +3,9 @@
 
 use std::path::Path;
 
-use wobble_core::format::{Alert, DecodeStats, Dropout, Event, Fault, Frame, GpsFix, Record};
+use wobble_core::format::{
+    Alert, DecodeStats, Dropout, Event, Fault, Frame, GpsFix, KickRingDown, MarginRecord, Record,
+};
 use wobblog::summary::{Summary, SummaryBuilder};
 
 use super::card;
@@ -23,6 +25,10 @@ pub struct Log {
     pub dropouts: Vec<Dropout>,
     /// Fault records.
     pub faults: Vec<Fault>,
+    /// Kick ring-down records.
+    pub kicks: Vec<KickRingDown>,
+    /// Margin warning records.
+    pub margins: Vec<MarginRecord>,
     /// Whether the first record is the log info header.
     pub starts_with_header: bool,
     /// The decoder's totals.
@@ -56,6 +62,8 @@ fn decode_file(name: &str, data: &[u8], work_dir: &Path) -> Result<Log, String> 
         alerts: Vec::new(),
         dropouts: Vec::new(),
         faults: Vec::new(),
+        kicks: Vec::new(),
+        margins: Vec::new(),
         starts_with_header: false,
         stats: DecodeStats::default(),
         summary: Summary::default(),
@@ -75,6 +83,8 @@ fn decode_file(name: &str, data: &[u8], work_dir: &Path) -> Result<Log, String> 
             Record::Alert(a) => log.alerts.push(a),
             Record::Dropout(d) => log.dropouts.push(d),
             Record::Fault(f) => log.faults.push(f),
+            Record::Kick(k) => log.kicks.push(k),
+            Record::Margin(m) => log.margins.push(m),
             _ => {}
         }
     })

@@ -5,9 +5,10 @@ use std::hint::black_box;
 use std::path::Path;
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use wobble_model::fit::{fit, Observation, Weights};
-use wobble_model::sweep::mode_at;
-use wobble_model::{critical_speeds, Mode, Model, ParamSet, Sweep};
+use wobble_model::fit::fit;
+use wobble_model::neutral::neutral_speeds;
+use wobble_model::synthetic::Synthetic;
+use wobble_model::{critical_speeds, Model, ParamSet, Sweep};
 
 fn test_bicycle() -> ParamSet {
     ParamSet::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("params/test-bicycle.toml")).unwrap()
@@ -25,12 +26,21 @@ fn sweep_1000(c: &mut Criterion) {
             critical_speeds(&model, &sweep)
         });
     });
+    // The critical speeds alone: bracketed on the sweep and refined by
+    // Brent's method, against solving the pencil (bialternate sum, 91 x 91).
+    let sweep = Sweep::run(&model, &speeds, |_| {}).unwrap();
+    c.bench_function("wobble model, critical speeds by Brent on the sweep", |b| {
+        b.iter(|| critical_speeds(&model, black_box(&sweep)));
+    });
+    let pencil = model.pencil().unwrap();
+    c.bench_function("wobble model, critical speeds from the pencil", |b| {
+        b.iter(|| neutral_speeds(black_box(&pencil), (0.0, 10.0)));
+    });
     // The floor: the eigenvalues alone at the same 1000 speeds.
-    let (a0, a1) = model.pencil().unwrap();
     c.bench_function("wobble model, 1000 eigenvalue calls", |b| {
         b.iter(|| {
             for &u in black_box(&speeds) {
-                black_box(wobble_model::eig::eigenvalues(&(&a0 + &a1 * u)));
+                black_box(wobble_model::eig::eigenvalues(&pencil.at(u)));
             }
         });
     });
@@ -38,34 +48,19 @@ fn sweep_1000(c: &mut Criterion) {
 
 fn two_parameter_fit(c: &mut Criterion) {
     let start = test_bicycle();
-    let keys = vec![
-        "steer_head.stiffness".to_string(),
-        "steer_head.damping".to_string(),
-    ];
-    let mut truth = start.clone();
-    truth.set_value(&keys[0], 3450.0, "truth").unwrap();
-    truth.set_value(&keys[1], 1.6, "truth").unwrap();
-    let speeds: Vec<f64> = (0..11).map(|i| 3.0 + 0.5 * f64::from(i)).collect();
-    let wobble = mode_at(&Model::from_set(&truth).unwrap(), Mode::Wobble, &speeds)
-        .unwrap()
-        .unwrap();
-    let obs: Vec<Observation> = speeds
-        .iter()
-        .zip(&wobble)
-        .map(|(&u, w)| Observation {
-            speed_mps: u,
-            freq_hz: w.im / std::f64::consts::TAU,
-            sigma_per_s: w.re,
-        })
-        .collect();
-    let weights = Weights {
-        freq_sd_hz: 0.03,
-        sigma_sd_per_s: 0.1,
-    };
+    let case = Synthetic::steering_head(&start).unwrap();
     let mut group = c.benchmark_group("fit");
     group.sample_size(10);
     group.bench_function("two parameters, 11 episodes", |b| {
-        b.iter(|| fit(&start, &keys, black_box(&obs), weights).unwrap());
+        b.iter(|| {
+            fit(
+                &start,
+                &case.keys,
+                black_box(&case.observations),
+                case.weights,
+            )
+            .unwrap()
+        });
     });
     group.finish();
 }

@@ -108,50 +108,90 @@ fn narrow(
     ((ua, a), (ub, b))
 }
 
+/// A sign change of one branch's real part between two speeds of a grid.
+#[derive(Clone, Copy, Debug)]
+struct Bracket {
+    branch: usize,
+    below: (f64, Complex<f64>),
+    above: (f64, Complex<f64>),
+}
+
+/// The sign changes of every branch, gathered one speed at a time (so that
+/// a sweep need not be held whole).
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Brackets {
+    /// Per branch, the last speed with a signed real part and the value there.
+    last: Vec<Option<(f64, Complex<f64>)>>,
+    found: Vec<Bracket>,
+}
+
+impl Brackets {
+    /// Adds the branches' `values` at the next speed `u`.
+    pub(crate) fn add(&mut self, u: f64, values: &[Complex<f64>]) {
+        if self.last.is_empty() {
+            self.last = vec![None; values.len()];
+        }
+        for (branch, (&v, last)) in values.iter().zip(self.last.iter_mut()).enumerate() {
+            if sign(v) == 0 {
+                continue;
+            }
+            let Some((uj, vj)) = last.replace((u, v)) else {
+                continue;
+            };
+            // The lower member of a pair repeats its partner's crossing.
+            if sign(vj) == sign(v) || (vj.im < -REAL_TOL && v.im < -REAL_TOL) {
+                continue;
+            }
+            self.found.push(Bracket {
+                branch,
+                below: (uj, vj),
+                above: (u, v),
+            });
+        }
+    }
+
+    /// Each bracketed sign change of a named branch (`modes[branch]`),
+    /// refined, in speed order.
+    pub(crate) fn refine(&self, model: &Model, modes: &[Mode]) -> Vec<CriticalSpeed> {
+        let mut out: Vec<CriticalSpeed> = self
+            .found
+            .iter()
+            .filter(|b| modes.get(b.branch).is_some_and(|&m| m != Mode::Other))
+            .filter_map(|b| refine(model, modes[b.branch], b))
+            .collect();
+        out.sort_by(|a, b| a.speed_mps.total_cmp(&b.speed_mps));
+        out
+    }
+}
+
+/// The bracketed sign change, narrowed and refined by Brent's method.
+fn refine(model: &Model, mode: Mode, bracket: &Bracket) -> Option<CriticalSpeed> {
+    let ((ua, a), (ub, b)) = narrow(model, bracket.below, bracket.above);
+    let at = |u: f64| nearest(model, u, a + (b - a) * ((u - ua) / (ub - ua)));
+    let mut conv = SimpleConvergency {
+        eps: SPEED_TOL_MPS,
+        max_iter: 200,
+    };
+    let u = find_root_brent(ua, ub, |u| at(u).re, &mut conv).ok()?;
+    let im = at(u).im.abs();
+    Some(CriticalSpeed {
+        mode,
+        speed_mps: u,
+        unstable_above: b.re > 0.0,
+        im_rad_per_s: if im > REAL_TOL { im } else { 0.0 },
+    })
+}
+
 /// Every sign change of the real part of a named mode within the sweep.
 #[must_use]
 pub fn critical_speeds(model: &Model, sweep: &Sweep) -> Vec<CriticalSpeed> {
-    let mut out = Vec::new();
-    for branch in &sweep.branches {
-        if branch.mode == Mode::Other {
-            continue;
-        }
-        let v = &branch.values;
-        // The last speed with a signed real part.
-        let mut last: Option<usize> = None;
-        for k in 0..v.len() {
-            if sign(v[k]) == 0 {
-                continue;
-            }
-            let Some(j) = last.replace(k) else { continue };
-            if sign(v[j]) == sign(v[k]) {
-                continue;
-            }
-            // The lower member of a pair repeats its partner's crossing.
-            if v[j].im < -REAL_TOL && v[k].im < -REAL_TOL {
-                continue;
-            }
-            let ((ua, a), (ub, b)) = narrow(
-                model,
-                (sweep.speeds_mps[j], v[j]),
-                (sweep.speeds_mps[k], v[k]),
-            );
-            let at = |u: f64| nearest(model, u, a + (b - a) * ((u - ua) / (ub - ua)));
-            let mut conv = SimpleConvergency {
-                eps: SPEED_TOL_MPS,
-                max_iter: 200,
-            };
-            if let Ok(u) = find_root_brent(ua, ub, |u| at(u).re, &mut conv) {
-                let im = at(u).im.abs();
-                out.push(CriticalSpeed {
-                    mode: branch.mode,
-                    speed_mps: u,
-                    unstable_above: b.re > 0.0,
-                    im_rad_per_s: if im > REAL_TOL { im } else { 0.0 },
-                });
-            }
-        }
+    let mut brackets = Brackets::default();
+    let mut values = Vec::with_capacity(sweep.branches.len());
+    for (k, &u) in sweep.speeds_mps.iter().enumerate() {
+        values.clear();
+        values.extend(sweep.branches.iter().map(|b| b.values[k]));
+        brackets.add(u, &values);
     }
-    out.sort_by(|a, b| a.speed_mps.total_cmp(&b.speed_mps));
-    out
+    let modes: Vec<Mode> = sweep.branches.iter().map(|b| b.mode).collect();
+    brackets.refine(model, &modes)
 }

@@ -25,6 +25,25 @@ pub enum StateRole {
     Rate,
 }
 
+/// A state matrix affine in the speed: `A(u) = A0 + u A1`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Pencil {
+    /// `A(0)`.
+    pub a0: DMatrix<f64>,
+    /// `dA/du`, per m/s.
+    pub a1: DMatrix<f64>,
+}
+
+impl Pencil {
+    /// `A(u)`.
+    #[must_use]
+    pub fn at(&self, speed_mps: f64) -> DMatrix<f64> {
+        let mut a = self.a0.clone();
+        a.zip_apply(&self.a1, |x, y| *x += speed_mps * y);
+        a
+    }
+}
+
 /// A linear model ready to evaluate at any speed.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Model {
@@ -94,13 +113,13 @@ impl Model {
     /// `u G`, `u / sigma` or `u` times a slip): one multiply-add per entry
     /// per speed instead of assembling the equations.
     #[must_use]
-    pub fn pencil(&self) -> Option<(DMatrix<f64>, DMatrix<f64>)> {
+    pub fn pencil(&self) -> Option<Pencil> {
         match self {
             Self::Whipple(_) | Self::NoSlip(_) => None,
             Self::Wobble(m) => {
                 let a0 = m.state_matrix(0.0);
                 let a1 = m.state_matrix(1.0) - &a0;
-                Some((a0, a1))
+                Some(Pencil { a0, a1 })
             }
         }
     }

@@ -123,55 +123,6 @@ fn find(parent: &mut [usize], i: usize) -> usize {
     r
 }
 
-/// Branches that are conjugates of each other over at least
-/// [`OSCILLATING_SHARE`] of the speeds, as groups.
-fn conjugate_groups(branches: &[Vec<Complex<f64>>]) -> Vec<Vec<usize>> {
-    let n = branches.len();
-    let mut parent: Vec<usize> = (0..n).collect();
-    let speeds = branches.first().map_or(0, Vec::len);
-    let mut count = vec![0_usize; n * n];
-    for (i, branch) in branches.iter().enumerate() {
-        for (k, &v) in branch.iter().enumerate() {
-            if v.im <= REAL_TOL {
-                continue;
-            }
-            let tol = 1e-9 * v.norm().max(1.0);
-            if let Some(j) = (0..n)
-                .filter(|&j| j != i)
-                .min_by(|&a, &b| {
-                    (branches[a][k] - v.conj())
-                        .norm()
-                        .total_cmp(&(branches[b][k] - v.conj()).norm())
-                })
-                .filter(|&j| (branches[j][k] - v.conj()).norm() <= tol)
-            {
-                count[i * n + j] += 1;
-            }
-        }
-    }
-    for i in 0..n {
-        for j in 0..n {
-            if count[i * n + j] as f64 >= OSCILLATING_SHARE * speeds as f64 {
-                let (a, b) = (find(&mut parent, i), find(&mut parent, j));
-                parent[a] = b;
-            }
-        }
-    }
-    let mut groups: Vec<Vec<usize>> = Vec::new();
-    let mut root_of: Vec<Option<usize>> = vec![None; n];
-    for i in 0..n {
-        let r = find(&mut parent, i);
-        match root_of[r] {
-            Some(g) => groups[g].push(i),
-            None => {
-                root_of[r] = Some(groups.len());
-                groups.push(vec![i]);
-            }
-        }
-    }
-    groups
-}
-
 /// The indices of up to [`SAMPLES`] speeds spread over `n`.
 fn sample_indices(n: usize) -> Vec<usize> {
     if n <= SAMPLES {
@@ -206,52 +157,160 @@ fn shares_of(vector: &nalgebra::DVector<Complex<f64>>, roles: &[StateRole]) -> S
     Shares(s)
 }
 
-/// The mode of each branch (`branches[b][k]` at `speeds[k]`).
-pub(crate) fn name(
-    branches: &[Vec<Complex<f64>>],
-    speeds: &[f64],
-    state_matrix: &dyn Fn(f64) -> DMatrix<f64>,
-    roles: &[StateRole],
-) -> Vec<Mode> {
-    let n = speeds.len();
-    let mut shares = vec![Shares::default(); branches.len()];
-    let samples = sample_indices(n);
-    for &k in &samples {
-        let a = state_matrix(speeds[k]);
-        for (b, s) in branches.iter().zip(shares.iter_mut()) {
-            let got = shares_of(&eigenvector(&a, b[k]), roles);
-            for (x, y) in s.0.iter_mut().zip(got.0) {
-                *x += y / samples.len() as f64;
-            }
+/// What naming needs of a sweep, gathered one speed at a time (so that a
+/// sweep need not be held whole): per branch its mean participation at the
+/// sample speeds and sums of its values, per pair of branches the speeds
+/// at which they are conjugates.
+pub(crate) struct Stats {
+    roles: Vec<StateRole>,
+    speeds: usize,
+    samples: Vec<usize>,
+    /// Speeds added so far.
+    k: usize,
+    branches: usize,
+    shares: Vec<Shares>,
+    /// `conjugate[i * branches + j]`: speeds at which `j` is `i`'s conjugate.
+    conjugate: Vec<usize>,
+    /// Per branch: speeds at which it is complex, and the sums of `|im|`
+    /// there, of `re` and of `|re|` over all speeds.
+    complex: Vec<usize>,
+    sum_abs_im: Vec<f64>,
+    sum_re: Vec<f64>,
+    sum_abs_re: Vec<f64>,
+}
+
+impl Stats {
+    /// Statistics of a sweep of `speeds` speeds, of a model with states of
+    /// `roles`.
+    pub(crate) fn new(speeds: usize, roles: &[StateRole]) -> Self {
+        Self {
+            roles: roles.to_vec(),
+            speeds,
+            samples: sample_indices(speeds),
+            k: 0,
+            branches: 0,
+            shares: Vec::new(),
+            conjugate: Vec::new(),
+            complex: Vec::new(),
+            sum_abs_im: Vec::new(),
+            sum_re: Vec::new(),
+            sum_abs_re: Vec::new(),
         }
     }
-    let groups: Vec<Group> = conjugate_groups(branches)
-        .into_iter()
-        .map(|members| {
-            let mut sh = [0.0; 5];
-            for &m in &members {
-                for (x, y) in sh.iter_mut().zip(shares[m].0) {
-                    *x += y / members.len() as f64;
+
+    /// Adds the branches' `values` at the next speed `u`; `state_matrix`
+    /// gives the matrix whose eigenvectors are taken at the sample speeds.
+    pub(crate) fn add(
+        &mut self,
+        u: f64,
+        values: &[Complex<f64>],
+        state_matrix: &dyn Fn(f64) -> DMatrix<f64>,
+    ) {
+        let n = values.len();
+        if self.k == 0 {
+            self.branches = n;
+            self.shares = vec![Shares::default(); n];
+            self.conjugate = vec![0; n * n];
+            self.complex = vec![0; n];
+            self.sum_abs_im = vec![0.0; n];
+            self.sum_re = vec![0.0; n];
+            self.sum_abs_re = vec![0.0; n];
+        }
+        if self.samples.binary_search(&self.k).is_ok() {
+            let a = state_matrix(u);
+            let weight = 1.0 / self.samples.len() as f64;
+            for (v, s) in values.iter().zip(self.shares.iter_mut()) {
+                let got = shares_of(&eigenvector(&a, *v), &self.roles);
+                for (x, y) in s.0.iter_mut().zip(got.0) {
+                    *x += y * weight;
                 }
             }
-            let values = || members.iter().flat_map(|&m| branches[m].iter());
-            let complex: Vec<f64> = values()
-                .filter(|v| v.im.abs() > REAL_TOL)
-                .map(|v| v.im.abs())
-                .collect();
-            let count = (members.len() * n) as f64;
-            Group {
-                shares: Shares(sh),
-                oscillates: complex.len() as f64 >= OSCILLATING_SHARE * count,
-                freq: complex.iter().sum::<f64>() / complex.len().max(1) as f64,
-                mean_re: values().map(|v| v.re).sum::<f64>() / count,
-                mean_abs_re: values().map(|v| v.re.abs()).sum::<f64>() / count,
-                members,
+        }
+        for (i, &v) in values.iter().enumerate() {
+            self.sum_re[i] += v.re;
+            self.sum_abs_re[i] += v.re.abs();
+            if v.im.abs() > REAL_TOL {
+                self.complex[i] += 1;
+                self.sum_abs_im[i] += v.im.abs();
             }
-        })
-        .collect();
+            if v.im <= REAL_TOL {
+                continue;
+            }
+            let tol = (1e-9 * v.norm().max(1.0)).powi(2);
+            let partner = (0..n)
+                .filter(|&j| j != i)
+                .map(|j| (j, (values[j] - v.conj()).norm_sqr()))
+                .min_by(|a, b| a.1.total_cmp(&b.1))
+                .filter(|&(_, d)| d <= tol);
+            if let Some((j, _)) = partner {
+                self.conjugate[i * n + j] += 1;
+            }
+        }
+        self.k += 1;
+    }
+
+    /// Branches that are conjugates of each other over at least
+    /// [`OSCILLATING_SHARE`] of the speeds, as groups.
+    fn conjugate_groups(&self) -> Vec<Vec<usize>> {
+        let n = self.branches;
+        let mut parent: Vec<usize> = (0..n).collect();
+        for i in 0..n {
+            for j in 0..n {
+                if self.conjugate[i * n + j] as f64 >= OSCILLATING_SHARE * self.speeds as f64 {
+                    let (a, b) = (find(&mut parent, i), find(&mut parent, j));
+                    parent[a] = b;
+                }
+            }
+        }
+        let mut groups: Vec<Vec<usize>> = Vec::new();
+        let mut root_of: Vec<Option<usize>> = vec![None; n];
+        for i in 0..n {
+            let r = find(&mut parent, i);
+            match root_of[r] {
+                Some(g) => groups[g].push(i),
+                None => {
+                    root_of[r] = Some(groups.len());
+                    groups.push(vec![i]);
+                }
+            }
+        }
+        groups
+    }
+
+    /// The mode of each branch.
+    pub(crate) fn modes(&self) -> Vec<Mode> {
+        let n = self.speeds;
+        let groups: Vec<Group> = self
+            .conjugate_groups()
+            .into_iter()
+            .map(|members| {
+                let mut sh = [0.0; 5];
+                for &m in &members {
+                    for (x, y) in sh.iter_mut().zip(self.shares[m].0) {
+                        *x += y / members.len() as f64;
+                    }
+                }
+                let sum = |v: &[f64]| members.iter().map(|&m| v[m]).sum::<f64>();
+                let complex: usize = members.iter().map(|&m| self.complex[m]).sum();
+                let count = (members.len() * n) as f64;
+                Group {
+                    shares: Shares(sh),
+                    oscillates: complex as f64 >= OSCILLATING_SHARE * count,
+                    freq: sum(&self.sum_abs_im) / complex.max(1) as f64,
+                    mean_re: sum(&self.sum_re) / count,
+                    mean_abs_re: sum(&self.sum_abs_re) / count,
+                    members,
+                }
+            })
+            .collect();
+        classify(&groups, self.branches)
+    }
+}
+
+/// The mode of each of `branches` branches, from their groups.
+fn classify(groups: &[Group], branches: usize) -> Vec<Mode> {
     let lean = pick(
-        &groups,
+        groups,
         |g| !g.tyre_only() && g.share(StateRole::Torso) >= LEAN_MIN_TORSO,
         |g| g.share(StateRole::Torso),
     );
@@ -259,18 +318,18 @@ pub(crate) fn name(
     let not_lean = |g: &Group| lean.is_none_or(|l| !std::ptr::eq(g, &groups[l]));
     // The weave rolls; a castering pair made complex by the tyre lags steers.
     let weave = pick(
-        &groups,
+        groups,
         |g| g.weave_like() && not_lean(g),
         |g| g.share(StateRole::Roll) / (g.share(StateRole::Roll) + g.share(StateRole::Steer)),
     );
-    let wobble = pick(&groups, |g| g.wobble_like() && not_lean(g), |g| -g.freq);
+    let wobble = pick(groups, |g| g.wobble_like() && not_lean(g), |g| -g.freq);
     let capsize = pick(
-        &groups,
+        groups,
         |g| g.planar() && !g.oscillates && g.largest_angle().0 == StateRole::Roll,
         |g| -g.mean_abs_re,
     );
     let castering = pick(
-        &groups,
+        groups,
         |g| {
             g.planar()
                 && g.largest_angle().0 == StateRole::Steer
@@ -279,7 +338,7 @@ pub(crate) fn name(
         },
         |g| -g.mean_re,
     );
-    let mut modes = vec![Mode::Other; branches.len()];
+    let mut modes = vec![Mode::Other; branches];
     for (i, g) in groups.iter().enumerate() {
         let mode = match g.largest_angle().0 {
             _ if g.tyre_only() => Mode::Other,

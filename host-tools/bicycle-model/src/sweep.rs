@@ -7,8 +7,11 @@ use std::fmt;
 
 use nalgebra::{Complex, DMatrix};
 
+use crate::critical::{Brackets, CriticalSpeed};
 use crate::eig::eigenvalues;
 use crate::model::{Model, StateRole};
+use crate::naming::Stats;
+use crate::track::Tracker;
 
 /// The name of a mode.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
@@ -93,10 +96,7 @@ impl Sweep {
         progress: impl FnMut(usize),
     ) -> Result<Self, SweepError> {
         let roles = model.state_roles();
-        match model.pencil() {
-            Some((a0, a1)) => Self::run_matrices(|u| &a0 + &a1 * u, &roles, speeds_mps, progress),
-            None => Self::run_matrices(|u| model.state_matrix(u), &roles, speeds_mps, progress),
-        }
+        Self::run_matrices(matrix_of(model), &roles, speeds_mps, progress)
     }
 
     /// [`Self::run`] on any state matrix function with states of `roles`
@@ -110,18 +110,25 @@ impl Sweep {
         speeds_mps: &[f64],
         mut progress: impl FnMut(usize),
     ) -> Result<Self, SweepError> {
-        if speeds_mps.is_empty() {
-            return Err(SweepError::NoSpeeds);
-        }
-        let values = crate::track::track(
-            &|u| eigenvalues(&state_matrix(u)),
-            speeds_mps,
-            &mut progress,
-        )?;
-        let modes = crate::naming::name(&values, speeds_mps, &state_matrix, roles);
+        let mut values: Vec<Vec<Complex<f64>>> = Vec::new();
+        let mut stats = Stats::new(speeds_mps.len(), roles);
+        each_speed(&state_matrix, speeds_mps, |k, u, v| {
+            if values.is_empty() {
+                values = v
+                    .iter()
+                    .map(|_| Vec::with_capacity(speeds_mps.len()))
+                    .collect();
+            }
+            for (b, x) in values.iter_mut().zip(v) {
+                b.push(*x);
+            }
+            stats.add(u, v, &state_matrix);
+            progress(k);
+        })?;
         Ok(Self {
             speeds_mps: speeds_mps.to_vec(),
-            branches: modes
+            branches: stats
+                .modes()
                 .into_iter()
                 .zip(values)
                 .map(|(mode, values)| Branch { mode, values })
@@ -142,6 +149,95 @@ impl Sweep {
             let sum = |br: &Branch| br.values.iter().map(|v| v.im).sum::<f64>();
             sum(a).total_cmp(&sum(b))
         })
+    }
+}
+
+/// Tracks the eigenvalues of `state_matrix` over `speeds_mps` (increasing),
+/// handing each speed's values (always in the same branch order) to `visit`.
+fn each_speed(
+    state_matrix: &dyn Fn(f64) -> DMatrix<f64>,
+    speeds_mps: &[f64],
+    mut visit: impl FnMut(usize, f64, &[Complex<f64>]),
+) -> Result<(), SweepError> {
+    if speeds_mps.is_empty() {
+        return Err(SweepError::NoSpeeds);
+    }
+    let eigen = |u: f64| eigenvalues(&state_matrix(u));
+    let mut tracker = Tracker::new(&eigen);
+    for (k, &u) in speeds_mps.iter().enumerate() {
+        visit(k, u, tracker.step(u)?);
+    }
+    Ok(())
+}
+
+/// A sweep's modes and critical speeds, found without holding its values
+/// (memory independent of the number of speeds); [`Survey::replay`] then
+/// gives the values speed by speed. This is [`Sweep::run`] and
+/// [`crate::critical_speeds`] for sweeps too long to hold: it evaluates
+/// every speed twice.
+#[derive(Clone, Debug)]
+pub struct Survey {
+    /// The mode of each branch, in the branch order of [`Survey::replay`].
+    pub modes: Vec<Mode>,
+    /// The critical speeds, as [`crate::critical_speeds`] gives them.
+    pub critical: Vec<CriticalSpeed>,
+}
+
+impl Survey {
+    /// Follows and names the eigenvalues of `model` over `speeds_mps`
+    /// (increasing) and finds its critical speeds, calling `progress` after
+    /// each speed.
+    ///
+    /// # Errors
+    /// As [`Sweep::run`].
+    pub fn run(
+        model: &Model,
+        speeds_mps: &[f64],
+        mut progress: impl FnMut(usize),
+    ) -> Result<Self, SweepError> {
+        let roles = model.state_roles();
+        let matrix = matrix_of(model);
+        let mut stats = Stats::new(speeds_mps.len(), &roles);
+        let mut brackets = Brackets::default();
+        each_speed(&matrix, speeds_mps, |k, u, v| {
+            stats.add(u, v, &matrix);
+            brackets.add(u, v);
+            progress(k);
+        })?;
+        let modes = stats.modes();
+        let critical = brackets.refine(model, &modes);
+        Ok(Self { modes, critical })
+    }
+
+    /// Follows the eigenvalues of `model` over `speeds_mps` again (the same
+    /// model and speeds as [`Survey::run`]) and hands each speed's values to
+    /// `visit`, branch `i` of mode `self.modes[i]`; stops at `visit`'s first
+    /// error.
+    ///
+    /// # Errors
+    /// `visit`'s error, or as [`Sweep::run`].
+    pub fn replay<E: From<SweepError>>(
+        &self,
+        model: &Model,
+        speeds_mps: &[f64],
+        mut visit: impl FnMut(f64, &[Complex<f64>]) -> Result<(), E>,
+    ) -> Result<(), E> {
+        let matrix = matrix_of(model);
+        let mut failed = None;
+        each_speed(&matrix, speeds_mps, |_, u, v| {
+            if failed.is_none() {
+                failed = visit(u, v).err();
+            }
+        })?;
+        failed.map_or(Ok(()), Err)
+    }
+}
+
+/// `model`'s state matrix as a function of speed (from its pencil if affine).
+fn matrix_of(model: &Model) -> Box<dyn Fn(f64) -> DMatrix<f64> + '_> {
+    match model.pencil() {
+        Some(pencil) => Box::new(move |u| pencil.at(u)),
+        None => Box::new(|u| model.state_matrix(u)),
     }
 }
 

@@ -28,99 +28,148 @@ struct State {
 }
 
 impl State {
-    fn predict(&self, u: f64) -> Vec<Complex<f64>> {
+    fn predict(&self, u: f64, out: &mut Vec<Complex<f64>>) {
         let (ul, vl) = &self.last;
+        out.clear();
         match &self.prev {
-            Some((up, vp)) if ul > up => vl
-                .iter()
-                .zip(vp)
-                .map(|(l, p)| l + (l - p) * ((u - ul) / (ul - up)))
-                .collect(),
-            _ => vl.clone(),
+            Some((up, vp)) if ul > up => out.extend(
+                vl.iter()
+                    .zip(vp)
+                    .map(|(l, p)| l + (l - p) * ((u - ul) / (ul - up))),
+            ),
+            _ => out.extend_from_slice(vl),
         }
     }
 
-    fn push(&mut self, u: f64, values: Vec<Complex<f64>>) {
-        let last = std::mem::replace(&mut self.last, (u, values));
-        self.prev = Some(last);
+    /// Makes `values` the last, handing the oldest buffer back in `values`.
+    fn push(&mut self, u: f64, values: &mut Vec<Complex<f64>>) {
+        let last = std::mem::replace(&mut self.last, (u, std::mem::take(values)));
+        if let Some((_, old)) = self.prev.replace(last) {
+            *values = old;
+        }
     }
 }
 
-/// The eigenvalues at each of `speeds` (increasing), as branches:
-/// `result[branch][speed]`. `eigenvalues(u)` gives the unordered eigenvalues
-/// at `u` (`None` if they cannot be computed); `progress` is called after each
-/// speed of the grid.
-pub(crate) fn track(
-    eigenvalues: &dyn Fn(f64) -> Option<Vec<Complex<f64>>>,
-    speeds: &[f64],
-    progress: &mut dyn FnMut(usize),
-) -> Result<Vec<Vec<Complex<f64>>>, SweepError> {
-    let at = |u: f64| eigenvalues(u).ok_or(SweepError::Eigen(u));
-    let Some(&first) = speeds.first() else {
-        return Err(SweepError::NoSpeeds);
-    };
-    let start = at(first)?;
-    let mut branches: Vec<Vec<Complex<f64>>> = start.iter().map(|&v| vec![v]).collect();
-    let mut state = State {
-        prev: None,
-        last: (first, start),
-    };
-    progress(0);
-    for (k, &u) in speeds.iter().enumerate().skip(1) {
-        let found = at(u)?;
-        advance(&mut state, u, found, MAX_HALVINGS, &at)?;
-        for (b, v) in branches.iter_mut().zip(&state.last.1) {
-            b.push(*v);
-        }
-        progress(k);
-    }
-    Ok(branches)
+/// Buffers reused from one speed to the next.
+#[derive(Default)]
+struct Scratch {
+    predicted: Vec<Complex<f64>>,
+    assigned: Vec<Complex<f64>>,
+    /// Squared distances, `predicted x found`.
+    dist: Vec<f64>,
+    choice: Vec<usize>,
+    taken: Vec<bool>,
 }
 
-/// Moves `state` to `u`, where the eigenvalues are `found`, halving the step
-/// while the assignment is in doubt.
-fn advance(
-    state: &mut State,
-    u: f64,
-    found: Vec<Complex<f64>>,
-    halvings: u32,
-    at: &dyn Fn(f64) -> Result<Vec<Complex<f64>>, SweepError>,
-) -> Result<(), SweepError> {
-    let predicted = state.predict(u);
-    let (assigned, doubtful) = assign(&predicted, &found);
-    if doubtful && halvings > 0 {
-        let mid = 0.5 * (state.last.0 + u);
-        advance(state, mid, at(mid)?, halvings - 1, at)?;
-        return advance(state, u, found, halvings - 1, at);
-    }
-    state.push(u, assigned);
-    Ok(())
+/// Eigenvalues followed from speed to speed: [`Tracker::step`] gives the
+/// branches' values at each next speed, always in the same branch order.
+pub(crate) struct Tracker<'a> {
+    eigenvalues: &'a dyn Fn(f64) -> Option<Vec<Complex<f64>>>,
+    state: Option<State>,
+    scratch: Scratch,
 }
 
-/// The eigenvalue of `found` for each prediction (greedy nearest pairs), and
-/// whether any assignment was in doubt.
-fn assign(predicted: &[Complex<f64>], found: &[Complex<f64>]) -> (Vec<Complex<f64>>, bool) {
-    let mut pairs: Vec<(f64, usize, usize)> = Vec::with_capacity(predicted.len() * found.len());
-    for (i, p) in predicted.iter().enumerate() {
-        for (j, f) in found.iter().enumerate() {
-            pairs.push(((f - p).norm(), i, j));
+impl<'a> Tracker<'a> {
+    /// A tracker of the eigenvalues `eigenvalues(u)` gives (unordered,
+    /// `None` where they cannot be computed).
+    pub(crate) fn new(eigenvalues: &'a dyn Fn(f64) -> Option<Vec<Complex<f64>>>) -> Self {
+        Self {
+            eigenvalues,
+            state: None,
+            scratch: Scratch::default(),
         }
     }
-    pairs.sort_by(|a, b| a.0.total_cmp(&b.0));
-    let mut taken = vec![false; found.len()];
-    let mut out: Vec<Option<usize>> = vec![None; predicted.len()];
-    for &(_, i, j) in &pairs {
-        if out[i].is_none() && !taken[j] {
-            out[i] = Some(j);
-            taken[j] = true;
-        }
+
+    fn at(&self, u: f64) -> Result<Vec<Complex<f64>>, SweepError> {
+        (self.eigenvalues)(u).ok_or(SweepError::Eigen(u))
     }
-    let scale = found.iter().fold(1.0_f64, |m, f| m.max(f.norm()));
+
+    /// The branches' values at `u`, above every speed stepped to before.
+    pub(crate) fn step(&mut self, u: f64) -> Result<&[Complex<f64>], SweepError> {
+        let found = self.at(u)?;
+        match self.state.take() {
+            None => {
+                self.state = Some(State {
+                    prev: None,
+                    last: (u, found),
+                });
+            }
+            Some(mut state) => {
+                let done = self.advance(&mut state, u, found, MAX_HALVINGS);
+                self.state = Some(state);
+                done?;
+            }
+        }
+        Ok(self.state.as_ref().map_or(&[], |s| &s.last.1))
+    }
+
+    /// Moves `state` to `u`, where the eigenvalues are `found`, halving the
+    /// step while the assignment is in doubt.
+    fn advance(
+        &mut self,
+        state: &mut State,
+        u: f64,
+        found: Vec<Complex<f64>>,
+        halvings: u32,
+    ) -> Result<(), SweepError> {
+        let mut predicted = std::mem::take(&mut self.scratch.predicted);
+        state.predict(u, &mut predicted);
+        let doubtful = assign(&predicted, &found, &mut self.scratch);
+        self.scratch.predicted = predicted;
+        if doubtful && halvings > 0 {
+            let mid = 0.5 * (state.last.0 + u);
+            let at_mid = self.at(mid)?;
+            self.advance(state, mid, at_mid, halvings - 1)?;
+            return self.advance(state, u, found, halvings - 1);
+        }
+        state.push(u, &mut self.scratch.assigned);
+        Ok(())
+    }
+}
+
+/// Puts the eigenvalue of `found` for each prediction (greedy nearest pairs)
+/// into `scratch.assigned`; returns whether any assignment was in doubt.
+fn assign(predicted: &[Complex<f64>], found: &[Complex<f64>], scratch: &mut Scratch) -> bool {
+    let (np, nf) = (predicted.len(), found.len());
+    let Scratch {
+        assigned,
+        dist,
+        choice,
+        taken,
+        ..
+    } = scratch;
+    dist.clear();
+    dist.extend(
+        predicted
+            .iter()
+            .flat_map(|p| found.iter().map(move |f| (f - p).norm_sqr())),
+    );
+    // Each prediction's nearest value; when these are all different, they
+    // are what the greedy pairing gives, without sorting every pair.
+    choice.clear();
+    choice.extend((0..np).map(|i| nearest(&dist[i * nf..(i + 1) * nf])));
+    taken.clear();
+    taken.resize(nf, false);
+    let mut distinct = true;
+    for &j in choice.iter() {
+        distinct &= !std::mem::replace(&mut taken[j], true);
+    }
+    if !distinct {
+        greedy(dist, np, nf, choice, taken);
+    }
+    let scale = found
+        .iter()
+        .fold(1.0_f64, |m, f| m.max(f.norm_sqr()))
+        .sqrt();
+    let (same, conj_tol) = ((1e-9 * scale).powi(2), (1e-12 * scale).powi(2));
     let mut doubtful = false;
     for (i, p) in predicted.iter().enumerate() {
-        let Some(j) = out[i] else { continue };
-        let d1 = (found[j] - p).norm();
-        if d1 <= 1e-9 * scale {
+        let j = choice[i];
+        if j == usize::MAX {
+            continue;
+        }
+        let d1 = dist[i * nf + j];
+        if d1 <= same {
             continue;
         }
         let rival = found
@@ -129,19 +178,48 @@ fn assign(predicted: &[Complex<f64>], found: &[Complex<f64>]) -> (Vec<Complex<f6
             .filter(|&(k, f)| {
                 // The conjugate a real prediction meets is no rival: either
                 // member continues the branch.
-                let conjugate = (f - found[j].conj()).norm() <= 1e-12 * scale && p.im.abs() < d1;
+                let conjugate = (f - found[j].conj()).norm_sqr() <= conj_tol && p.im * p.im < d1;
                 k != j && !conjugate
             })
-            .map(|(_, f)| (f - p).norm())
+            .map(|(k, _)| dist[i * nf + k])
             .fold(f64::INFINITY, f64::min);
-        if d1 > DOUBT * rival {
+        if d1 > DOUBT * DOUBT * rival {
             doubtful = true;
         }
     }
-    let values = out
-        .iter()
+    assigned.clear();
+    assigned.extend(choice.iter().enumerate().map(|(i, &j)| {
+        if j == usize::MAX {
+            predicted[i]
+        } else {
+            found[j]
+        }
+    }));
+    doubtful
+}
+
+/// The index of the smallest of `d` (`usize::MAX` if empty).
+fn nearest(d: &[f64]) -> usize {
+    d.iter()
         .enumerate()
-        .map(|(i, j)| j.map_or(predicted[i], |j| found[j]))
+        .min_by(|a, b| a.1.total_cmp(b.1))
+        .map_or(usize::MAX, |(j, _)| j)
+}
+
+/// Greedy nearest pairs over all of `dist` (`np x nf`), into `choice`
+/// (`usize::MAX` for a prediction left without a value).
+fn greedy(dist: &[f64], np: usize, nf: usize, choice: &mut [usize], taken: &mut Vec<bool>) {
+    let mut pairs: Vec<(f64, usize, usize)> = (0..np)
+        .flat_map(|i| (0..nf).map(move |j| (dist[i * nf + j], i, j)))
         .collect();
-    (values, doubtful)
+    pairs.sort_by(|a, b| a.0.total_cmp(&b.0));
+    taken.clear();
+    taken.resize(nf, false);
+    choice.fill(usize::MAX);
+    for &(_, i, j) in &pairs {
+        if choice[i] == usize::MAX && !taken[j] {
+            choice[i] = j;
+            taken[j] = true;
+        }
+    }
 }

@@ -167,3 +167,64 @@ fn twist_inertia_and_frequency_with_the_frame_locked() {
     let hz = (p.head_stiffness / mbb).sqrt() / std::f64::consts::TAU;
     assert!((hz - 17.3).abs() < 0.05, "{hz} Hz");
 }
+
+/// The twist's gravity stiffness, by hand, and the twist's natural frequency
+/// with the frame locked. A twist `beta` about `t` through `o` moves every
+/// point `a = p - o` of the fork and front wheel by `beta t x a` (sideways
+/// only: `t` and `a` lie in the symmetry plane) and, to second order, by
+/// `beta^2/2 (t (t.a) - a)`. The wheel's plane cambers by `beta cos lambda`,
+/// which lowers its contact below the centre by `R beta^2 cos^2 lambda / 2`;
+/// the whole bicycle pitches about the rear axle by `theta` (lowering a point
+/// at `x` by `theta x`, `z` down) to keep the front contact on the ground:
+/// `theta w = beta^2/2 (t_z (t.a_w) - a_wz - R cos^2 lambda)`. The potential
+/// `-g sum m dz` is then `K beta^2 / 2` with
+/// `K = -g [sum_sub m (t_z (t.a) - a_z) - M x_G (t_z (t.a_w) - a_wz - R cos^2 lambda) / w]`:
+/// the twisted parts' own drop and the forced pitch of the whole bicycle.
+#[test]
+fn twist_gravity_stiffness_through_the_forced_pitch() {
+    use nalgebra::Vector3;
+    use wobble_model::multibody::BETA;
+    let m = model();
+    let p = m.params;
+    let lam = p.steer_axis_tilt;
+    let t = Vector3::new(lam.cos(), 0.0, -lam.sin());
+    let o = Vector3::new(
+        p.wheelbase + p.trail + p.twist_z * lam.tan(),
+        0.0,
+        p.twist_z,
+    );
+    let fw = p.front_wheel;
+    let wheel = Vector3::new(p.wheelbase, 0.0, -fw.radius);
+    let fork = Vector3::new(p.fork.x, 0.0, p.fork.z);
+    // The second-order drop per beta^2/2 of a point of the fork or wheel.
+    let drop = |c: Vector3<f64>| {
+        let a = c - o;
+        t.z * t.dot(&a) - a.z
+    };
+    let own = p.fork.mass * drop(fork) + fw.mass * drop(wheel);
+    let pitch_per = (drop(wheel) - fw.radius * lam.cos().powi(2)) / p.wheelbase;
+    // Every body's weight moment about the rear axle (x = 0 there).
+    let moment = p.rear_frame.mass * p.rear_frame.x
+        + p.torso.mass * p.torso.x
+        + p.front_frame.mass * p.front_frame.x
+        + p.fork.mass * p.fork.x
+        + fw.mass * p.wheelbase;
+    let by_hand = -p.gravity * (own - moment * pitch_per);
+    let k = m.lin.k[(2 + BETA, BETA)];
+    assert!(
+        (k - by_hand).abs() < 1e-9 * by_hand.abs(),
+        "{k} against {by_hand} N m/rad"
+    );
+    // The forced pitch dominates, and lowers the bicycle: the weight eases
+    // the twist (by about 5 % of the head spring on the test bicycle).
+    assert!(
+        k < 0.0 && (p.gravity * own).abs() < 0.1 * k.abs(),
+        "{k}, own {}",
+        -p.gravity * own
+    );
+    // With the frame locked the twist mode's undamped frequency is
+    // sqrt((k_head + K) / I_t).
+    let inertia = m.lin.m[(2 + BETA, 2 + BETA)];
+    let hz = ((p.head_stiffness + k) / inertia).sqrt() / std::f64::consts::TAU;
+    println!("twist: K = {k:.1} N m/rad by gravity, {hz:.2} Hz with the frame locked");
+}

@@ -6,10 +6,11 @@ use std::io::{self, Read};
 use std::path::{Path, PathBuf};
 
 use wobble_core::config::Config;
-use wobble_core::detector::{AlertEvent, Detector, Kick};
-use wobble_core::format::{Event, FaultSource};
+use wobble_core::detector::{AlertEvent, Detector, Kick, MarginEvent, MarginWarning};
+use wobble_core::format::{Event, FaultSource, MarginRecord, MarginState};
 
 use crate::csv_input::{number_in, Cell, Step, TimeSteps};
+use crate::events::{LogEvent, Margin};
 use crate::reader::read_log;
 use crate::rows::{Row, RowAssembler};
 use crate::CliError;
@@ -33,11 +34,19 @@ the kick's; speed_mps is null when the speed is unknown),
   {\"t_s\": 12.4, \"event\": \"kick\", \"speed_mps\": 3.1, \"freq_hz\": 6.2, \"sigma_per_s\": -1.8, \"amp_deg\": 1.5, \"sigma_se_per_s\": 0.04}
   {\"t_s\": 17.12, \"event\": \"alert_on\", \"freq_hz\": 6.4, \"amp_deg\": 0.8}
   {\"t_s\": 18.9, \"event\": \"alert_off\"}
+and the on-board margin warning's records, the running estimate of the
+wobble speed from the kicks so far (after each kick that gives one) and the
+warning switching on and off (the speed within alert.margin_mps of the
+estimate's lower bound, and clear of it again),
+  {\"t_s\":40.2,\"event\":\"margin_estimate\",\"speed_mps\":3.2,\"wobble_speed_mps\":4.1,\"ci95_mps\":[3.8,4.5],\"kicks\":7}
+  {\"t_s\":52.6,\"event\":\"approaching\",\"speed_mps\":3.3,\"wobble_speed_mps\":4.1,\"ci95_mps\":[3.8,4.5],\"kicks\":8}
+  {\"t_s\":70.1,\"event\":\"approaching_off\", ...}
 and nothing else (sigma_per_s: growth rate of the ring, negative when it
-decays; sigma_se_per_s: its standard error from the fit). Without --json: a
-table with one line per change or kick (time in seconds, event, frequency in
-Hz and zero-to-peak steering amplitude in degrees, and for a kick its growth
-rate and speed), then one summary line.
+decays; sigma_se_per_s: its standard error from the fit; ci95_mps[1] null
+when open). Without --json: a table with one line per change, kick or
+margin record (time in seconds, event, frequency in Hz and zero-to-peak
+steering amplitude in degrees, for a kick its growth rate and speed, for a
+margin record the estimate in words), then one summary line.
 
 Exit codes: 0 ok (alerts or not), 1 unreadable or malformed input (the message
 names the file, the line and what is wrong), 2 usage error.";
@@ -81,6 +90,15 @@ pub struct KickAt {
     pub kick: Kick,
 }
 
+/// A margin record of a replay, as the board writes it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MarginAt {
+    /// Time of the sample that made it, seconds.
+    pub t_s: f64,
+    /// The record (speeds quantised as on the card).
+    pub record: MarginRecord,
+}
+
 /// What a replay saw besides the changes.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Replay {
@@ -88,6 +106,8 @@ pub struct Replay {
     pub changes: Vec<Change>,
     /// Measured kicks, in the order they were reported.
     pub kicks: Vec<KickAt>,
+    /// The margin warning's records, in time order.
+    pub margins: Vec<MarginAt>,
     /// Rows replayed.
     pub samples: u64,
     /// First and last `t_s`.
@@ -140,6 +160,7 @@ pub fn replay(path: &Path, input: impl Read, config: &Config) -> Result<Replay, 
         ));
     };
     let speed_col = column("speed_mps");
+    let mut margin = MarginWarning::new(config.alert.margin_mps);
     let mut out = Replay {
         has_speed: speed_col.is_some(),
         ..Replay::default()
@@ -188,7 +209,7 @@ pub fn replay(path: &Path, input: impl Read, config: &Config) -> Result<Replay, 
             cell.error(path, e)
         })?;
         let restart = matches!(step, Step::Gap(_)) && last.is_some();
-        out.push(&mut det, restart, line, t_s, steer, speed);
+        out.push(&mut det, &mut margin, restart, line, t_s, steer, speed);
         last = Some((t_s, line));
     }
     Ok(out)
@@ -197,10 +218,14 @@ pub fn replay(path: &Path, input: impl Read, config: &Config) -> Result<Replay, 
 impl Replay {
     /// Feeds one sample to `det`, restarting it first if `restart` (a gap
     /// before the sample at `place`, a line or frame number): an alert
-    /// still on is reported off at the previous sample.
+    /// still on is reported off at the previous sample. Its kicks go to
+    /// `margin`, which, as on the board, keeps the ride's kicks across
+    /// gaps (the board never restarts it).
+    #[allow(clippy::too_many_arguments)]
     fn push(
         &mut self,
         det: &mut Detector,
+        margin: &mut MarginWarning,
         restart: bool,
         place: u64,
         t_s: f64,
@@ -226,12 +251,31 @@ impl Replay {
         if let Some(event) = det.push(steer_deg as f32, speed_mps.map(|v| v as f32)) {
             self.changes.push(Change { t_s, event });
         }
+        // Times are checked against `T_S_RANGE`: whole µs fit a u64.
+        #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
+        let now_us = (t_s * 1e6).round() as u64;
+        #[allow(clippy::cast_possible_truncation)]
+        let speed = speed_mps.map(|v| v as f32);
+        let record = |state, estimate: Option<_>| MarginAt {
+            t_s,
+            record: MarginRecord::new(now_us, state, speed, estimate.as_ref()),
+        };
         if let Some(kick) = det.take_kick() {
             let ago_s = f64::from(kick.samples_ago) / f64::from(det.config().sample_rate_hz);
             self.kicks.push(KickAt {
                 t_s: t_s - ago_s,
                 kick,
             });
+            if let Some(e) = margin.add_kick(&kick) {
+                self.margins.push(record(MarginState::Estimate, Some(e)));
+            }
+        }
+        if let Some(ev) = margin.update(now_us, speed) {
+            let state = match ev {
+                MarginEvent::Approaching => MarginState::Approaching,
+                MarginEvent::Clear => MarginState::Clear,
+            };
+            self.margins.push(record(state, margin.estimate()));
         }
     }
 }
@@ -248,6 +292,7 @@ pub fn replay_log(path: &Path, config: &Config) -> Result<Replay, CliError> {
         .detector()
         .map_err(|e| CliError::Usage(format!("detector: {e}")))?;
     let period_s = 1.0 / f64::from(config.detector.sample_rate_hz).max(1.0);
+    let mut margin = MarginWarning::new(config.alert.margin_mps);
     let mut out = Replay {
         has_speed: true,
         ..Replay::default()
@@ -260,6 +305,7 @@ pub fn replay_log(path: &Path, config: &Config) -> Result<Replay, CliError> {
         let place = out.samples;
         out.push(
             &mut det,
+            &mut margin,
             restart,
             place,
             row.t_s,
@@ -364,14 +410,33 @@ pub fn kick_json_line(k: &KickAt) -> String {
     )
 }
 
-/// Alert changes and kicks, each with its time, in time order (a kick is
-/// reported after later samples, so the two lists interleave).
-fn in_time_order(r: &Replay) -> Vec<(f64, Result<&Change, &KickAt>)> {
+/// The JSON line of one margin record: the `wobblog events` object.
+#[must_use]
+pub fn margin_json_line(m: &MarginAt) -> Option<String> {
+    let event = LogEvent {
+        t_s: round(m.t_s, 3),
+        kind: Margin::event(&m.record)?,
+    };
+    serde_json::to_string(&event).ok()
+}
+
+/// One line of the report.
+enum Item<'a> {
+    Change(&'a Change),
+    Kick(&'a KickAt),
+    Margin(&'a MarginAt),
+}
+
+/// Alert changes, kicks and margin records, each with its time, in time
+/// order (a kick is reported after later samples, so the lists
+/// interleave).
+fn in_time_order(r: &Replay) -> Vec<(f64, Item<'_>)> {
     let mut all: Vec<_> = r
         .changes
         .iter()
-        .map(|c| (c.t_s, Ok(c)))
-        .chain(r.kicks.iter().map(|k| (k.t_s, Err(k))))
+        .map(|c| (c.t_s, Item::Change(c)))
+        .chain(r.kicks.iter().map(|k| (k.t_s, Item::Kick(k))))
+        .chain(r.margins.iter().map(|m| (m.t_s, Item::Margin(m))))
         .collect();
     all.sort_by(|a, b| a.0.total_cmp(&b.0));
     all
@@ -382,7 +447,7 @@ fn in_time_order(r: &Replay) -> Vec<(f64, Result<&Change, &KickAt>)> {
 pub fn table(r: &Replay) -> String {
     use std::fmt::Write as _;
     let mut s = String::new();
-    if !r.changes.is_empty() || !r.kicks.is_empty() {
+    if !r.changes.is_empty() || !r.kicks.is_empty() || !r.margins.is_empty() {
         let _ = writeln!(
             s,
             "{:>10}  {:<9}  {:>7}  {:>7}  {:>11}  {:>9}",
@@ -390,8 +455,20 @@ pub fn table(r: &Replay) -> String {
         );
         for (_, item) in in_time_order(r) {
             let c = match item {
-                Ok(c) => c,
-                Err(k) => {
+                Item::Change(c) => c,
+                Item::Margin(m) => {
+                    if let Some(kind) = Margin::event(&m.record) {
+                        let _ = writeln!(
+                            s,
+                            "{:>10.2}  {:<9}  {}",
+                            m.t_s,
+                            kind.name(),
+                            kind.describe()
+                        );
+                    }
+                    continue;
+                }
+                Item::Kick(k) => {
                     let m = &k.kick;
                     let speed = m.speed_mps.map_or("-".into(), |v| format!("{v:.2}"));
                     let _ = writeln!(
@@ -449,6 +526,18 @@ pub fn table(r: &Replay) -> String {
             crate::words::plural(r.kicks.len(), "kick")
         );
     }
+    let warnings = r
+        .margins
+        .iter()
+        .filter(|m| m.record.state == MarginState::Approaching)
+        .count();
+    if warnings > 0 {
+        let _ = write!(
+            s,
+            ", {} approaching the wobble speed",
+            crate::words::plural(warnings, "margin warning")
+        );
+    }
     if r.restart_count > 0 {
         let _ = write!(s, ", {} restarts at time gaps", r.restart_count);
     }
@@ -491,10 +580,15 @@ pub fn run(args: &Args) -> Result<(), CliError> {
     let text = if args.json {
         let mut s = String::new();
         for (_, item) in in_time_order(&r) {
-            s.push_str(&match item {
-                Ok(c) => json_line(c),
-                Err(k) => kick_json_line(k),
-            });
+            let line = match item {
+                Item::Change(c) => json_line(c),
+                Item::Kick(k) => kick_json_line(k),
+                Item::Margin(m) => match margin_json_line(m) {
+                    Some(line) => line,
+                    None => continue,
+                },
+            };
+            s.push_str(&line);
             s.push('\n');
         }
         s

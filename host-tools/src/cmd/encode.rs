@@ -15,10 +15,10 @@ use wobble_core::format::{
 };
 
 use crate::csv_input::{number_in, Cell, TimeSteps};
-use crate::export::CSV_COLUMNS;
+use crate::export::{CSV_COLUMNS, MISSING_NUMBER};
 use crate::output::Output;
 use crate::resample::{CsvRow, Resampler};
-use crate::time::parse_iso8601;
+use crate::time::parse_iso8601_us;
 use crate::CliError;
 
 /// Arguments of `wobblog encode`.
@@ -81,6 +81,10 @@ pub fn run(args: &Args) -> Result<(), CliError> {
 /// Index of each known column in the CSV, if present, and of `utc`.
 struct Columns([Option<usize>; CSV_COLUMNS.len()], Option<usize>);
 
+/// The indices in [`CSV_COLUMNS`] of the GPS numbers: latitude,
+/// longitude, ground speed.
+const GPS_NUMBERS: [usize; 3] = [9, 10, 11];
+
 /// The column `decode` writes UTC into.
 const UTC_COLUMN: &str = "utc";
 
@@ -118,18 +122,18 @@ fn refuse_unknown_columns(header: &csv::StringRecord, in_name: &Path) -> Result<
 
 /// The sync pairs that give every row its CSV UTC back: a pair at a row
 /// whenever the last pair does not already give that row's UTC, to the
-/// millisecond as `decode` prints it (so a log decoded and encoded again
-/// has pairs only where its clock and UTC drifted apart by a millisecond).
+/// microsecond as `decode` prints it (so a log decoded and encoded again
+/// has pairs only where its clock and UTC drifted apart).
 #[derive(Default)]
 struct SyncWriter {
     last: Option<UtcSync>,
 }
 
 impl SyncWriter {
-    /// The pair to write before the frame at `t_us` whose UTC is `utc_ms`
+    /// The pair to write before the frame at `t_us` whose UTC is `utc_us`
     /// (`None`: the row has no UTC), or why the row cannot be stored.
-    fn update(&mut self, t_us: u64, utc_ms: Option<i64>) -> Result<Option<UtcSync>, String> {
-        let Some(ms) = utc_ms else {
+    fn update(&mut self, t_us: u64, utc_us: Option<i64>) -> Result<Option<UtcSync>, String> {
+        let Some(us) = utc_us else {
             return match self.last {
                 Some(_) => Err("is empty after a row with a UTC: a log's UTC cannot stop".into()),
                 None => Ok(None),
@@ -137,15 +141,28 @@ impl SyncWriter {
         };
         let given = self.last.and_then(|s| {
             let since_us = i64::try_from(t_us.checked_sub(s.t_us)?).ok()?;
-            let us = i64::try_from(s.unix_ms).ok()?.checked_mul(1000)? + since_us;
-            Some(us.div_euclid(1000))
+            i64::try_from(s.unix_ms)
+                .ok()?
+                .checked_mul(1000)?
+                .checked_add(since_us)
         });
-        if given == Some(ms) {
+        if given == Some(us) {
             return Ok(None);
         }
-        let sync = UtcSync {
-            t_us,
-            unix_ms: u64::try_from(ms).unwrap_or(u64::MAX),
+        // A pair holds whole milliseconds: it sits the sub-millisecond part
+        // of the row's UTC before the row. In the first millisecond since
+        // boot there is no room before it, and the row's UTC is rounded to
+        // the millisecond.
+        let sub_ms = us.rem_euclid(1000).unsigned_abs();
+        let sync = match t_us.checked_sub(sub_ms) {
+            Some(at) => UtcSync {
+                t_us: at,
+                unix_ms: u64::try_from(us.div_euclid(1000)).unwrap_or(u64::MAX),
+            },
+            None => UtcSync {
+                t_us,
+                unix_ms: u64::try_from((us + 500).div_euclid(1000)).unwrap_or(u64::MAX),
+            },
         };
         if !sync.is_valid() {
             return Err("is outside the years a GPS states (2000 to 2099)".into());
@@ -344,7 +361,7 @@ impl<W: Write> LogWriter<'_, W> {
         // Before the frame, so the pair is in force for it.
         let sync = self
             .syncs
-            .update(row.frame.t_us, row.utc_ms)
+            .update(row.frame.t_us, row.utc_us)
             .map_err(|e| self.columns.utc_cell(self.line).error(self.in_name, e))?;
         if let Some(sync) = sync {
             self.push(&Record::UtcSync(sync))?;
@@ -399,10 +416,12 @@ fn parse_row(
         column: c + 1,
         name: CSV_COLUMNS[i],
     };
+    // `decode` writes a missing GPS number as NaN: for those columns it is
+    // no value (elsewhere NaN is refused as a value no log stores).
     let field = |i: usize| {
         columns.0[i]
             .and_then(|c| Some((c, record.get(c)?)))
-            .filter(|(_, f)| !f.is_empty())
+            .filter(|(_, f)| !(f.is_empty() || GPS_NUMBERS.contains(&i) && *f == MISSING_NUMBER))
     };
     // A missing column is zero (or no GPS); an empty cell of a column that
     // is there is refused (it would be stored as a zero nobody measured); a
@@ -497,16 +516,16 @@ fn parse_row(
             ));
         }
     };
-    let utc_ms = match columns.1.and_then(|c| record.get(c)) {
+    let utc_us = match columns.1.and_then(|c| record.get(c)) {
         Some("") | None => None,
-        Some(text) => Some(parse_iso8601(text).ok_or_else(|| {
+        Some(text) => Some(parse_iso8601_us(text).ok_or_else(|| {
             columns.utc_cell(line).error(
                 path,
                 format!("is not a UTC time like 2020-03-18T13:28:20.600Z: {text:?}"),
             )
         })?),
     };
-    Ok(CsvRow { frame, gps, utc_ms })
+    Ok(CsvRow { frame, gps, utc_us })
 }
 
 /// The GPS record to write at `t_us`, if any: when the fix changes, when it
@@ -530,23 +549,31 @@ fn gps_update(last: &Option<(u64, GpsFix)>, now: Option<GpsFix>, t_us: u64) -> O
 mod tests {
     use super::*;
 
-    /// 2020-03-18T10:00:01.000Z, ms since 1970.
-    const MS: i64 = 1_584_525_601_000;
+    /// 2020-03-18T10:00:01.000Z, µs since 1970.
+    const US: i64 = 1_584_525_601_000_000;
 
     #[test]
     fn a_pair_is_written_only_where_the_last_one_is_wrong() {
         let mut syncs = SyncWriter::default();
         assert_eq!(syncs.update(0, None), Ok(None));
-        let first = syncs.update(1_000_000, Some(MS)).unwrap().unwrap();
-        assert_eq!((first.t_us, first.unix_ms), (1_000_000, MS as u64));
+        let first = syncs.update(1_000_000, Some(US)).unwrap().unwrap();
+        assert_eq!((first.t_us, first.unix_ms), (1_000_000, (US / 1000) as u64));
         // 10 ms later the pair gives 10 ms more, to the microsecond.
-        assert_eq!(syncs.update(1_010_000, Some(MS + 10)), Ok(None));
-        // 9.999 ms later it gives 9 ms (decode rounds down).
-        assert_eq!(syncs.update(1_009_999, Some(MS + 9)), Ok(None));
-        // A clock 1 ms off: a new pair at this frame.
-        let next = syncs.update(1_020_000, Some(MS + 21)).unwrap().unwrap();
-        assert_eq!((next.t_us, next.unix_ms), (1_020_000, MS as u64 + 21));
-        assert_eq!(syncs.update(1_030_000, Some(MS + 31)), Ok(None));
+        assert_eq!(syncs.update(1_010_000, Some(US + 10_000)), Ok(None));
+        assert_eq!(syncs.update(1_009_999, Some(US + 9_999)), Ok(None));
+        // A clock 250 µs off: a new pair, 250 µs before this frame, holding
+        // the whole millisecond.
+        let next = syncs.update(1_020_000, Some(US + 20_250)).unwrap().unwrap();
+        assert_eq!(
+            (next.t_us, next.unix_ms),
+            (1_019_750, (US / 1000) as u64 + 20)
+        );
+        assert_eq!(syncs.update(1_030_000, Some(US + 30_250)), Ok(None));
+        // In the first millisecond since boot there is no room before the
+        // frame: the nearest millisecond.
+        let mut early = SyncWriter::default();
+        let pair = early.update(400, Some(US + 600)).unwrap().unwrap();
+        assert_eq!((pair.t_us, pair.unix_ms), (400, (US / 1000) as u64 + 1));
     }
 
     #[test]
@@ -556,8 +583,11 @@ mod tests {
             .update(0, Some(0))
             .unwrap_err()
             .contains("2000 to 2099"));
-        assert!(syncs.update(0, Some(4_102_444_800_000)).is_err());
-        assert!(syncs.update(0, Some(4_102_444_799_999)).unwrap().is_some());
+        assert!(syncs.update(0, Some(4_102_444_800_000_000)).is_err());
+        assert!(syncs
+            .update(0, Some(4_102_444_799_999_000))
+            .unwrap()
+            .is_some());
         assert!(syncs
             .update(10_000, None)
             .unwrap_err()

@@ -220,10 +220,9 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         report.model = Some(estimate(params, &keys, &used, report.kicks_rejected)?);
     }
     let text = if args.json {
-        let mut line = serde_json::to_string(&report)
+        let line = serde_json::to_string(&report)
             .map_err(|e| CliError::Failed(format!("cannot write the report: {e}")))?;
-        line.push('\n');
-        line
+        crate::text::json_terminal_safe(line) + "\n"
     } else {
         render_text(&report, logs.len())
     };
@@ -258,7 +257,10 @@ fn speed_text(v: Option<f64>, what: &str) -> String {
 }
 
 /// The table form: the answer in words, then every kick.
+/// Names and keys that come from files or the command line are shown with
+/// control and bidirectional characters escaped.
 fn render_text(r: &Report, logs: usize) -> String {
+    use crate::text::escape_controls;
     use std::fmt::Write;
     let mut o = String::new();
     let kicks = crate::words::plural(r.kicks.len(), "kick");
@@ -315,7 +317,7 @@ fn render_text(r: &Report, logs: usize) -> String {
         let _ = writeln!(
             o,
             "model ({}): wobble speed {}, 95 % interval {} to {}",
-            m.params_file,
+            escape_controls(&m.params_file),
             speed_text(
                 m.wobble_speed_mps,
                 "none (the fitted model's wobble never turns unstable)"
@@ -327,10 +329,13 @@ fn render_text(r: &Report, logs: usize) -> String {
             let _ = writeln!(
                 o,
                 "  {} = {:.4} +/- {:.4} {} (95 %)",
-                p.key, p.value, p.ci95, p.unit
+                escape_controls(&p.key),
+                p.value,
+                p.ci95,
+                escape_controls(&p.unit)
             );
         }
-        let _ = writeln!(o, "  method: {}", m.method);
+        let _ = writeln!(o, "  method: {}", escape_controls(&m.method));
     }
     if !r.kicks.is_empty() {
         let _ = writeln!(
@@ -350,7 +355,7 @@ fn render_text(r: &Report, logs: usize) -> String {
             k.kick.amp_deg,
             k.kick.source.as_str(),
             if k.used { "yes" } else { "no" },
-            crate::text::escape_controls(&k.log)
+            escape_controls(&k.log)
         );
     }
     o

@@ -22,7 +22,10 @@ pub enum SummaryFormat {
 /// Arguments of `wobblog summary`.
 #[derive(clap::Args)]
 pub struct Args {
-    /// Directory holding card logs (`*.WBL`, any case); not searched recursively.
+    /// A card (logs, `*.WBL` in any case, at its top) or a folder of cards
+    /// (one directory each, as `export` takes), not searched deeper; a
+    /// log of a folder of cards is named `CARD/RUNnnnnn.WBL` in the `log`
+    /// column.
     pub dir: PathBuf,
     /// Output format.
     #[arg(long, value_enum, default_value_t = SummaryFormat::Table)]
@@ -105,15 +108,18 @@ pub fn logs_in(dir: &Path) -> Result<Vec<PathBuf>, CliError> {
 
 /// Runs `wobblog summary`: rows for every readable log, even when some are not.
 pub fn run(args: &Args) -> Result<(), CliError> {
-    let logs = logs_in(&args.dir)?;
-    if logs.is_empty() {
-        return Err(CliError::file(&args.dir, "no *.WBL logs in this directory"));
-    }
+    let cards = crate::dataset::cards_in(&args.dir)?;
+    let logs: Vec<PathBuf> = cards.iter().flat_map(|(_, logs)| logs.clone()).collect();
     let mut rows = Vec::new();
     let result = for_each_log(&logs, "summarising", |log| {
         let ride = Ride::load(log)?;
         warn_losses(log, &ride.summary);
-        rows.push(RunRow::of(&ride));
+        let mut row = RunRow::of(&ride);
+        let card = cards.iter().find(|(_, logs)| logs.iter().any(|l| l == log));
+        if let Some((Some(card), _)) = card {
+            row.log = format!("{card}/{}", row.log);
+        }
+        rows.push(row);
         Ok(())
     });
     let format = if args.json {
@@ -129,9 +135,12 @@ fn opt(v: Option<f64>) -> String {
     v.map_or(String::new(), |v| format!("{v:.2}"))
 }
 
+/// A row's cells for the table and CSV forms, which are read on a
+/// terminal: the log's name with control and bidirectional characters
+/// escaped (the JSON lines keep the exact name, in JSON escapes).
 fn cells(r: &RunRow) -> [String; 11] {
     [
-        r.log.clone(),
+        crate::text::escape_controls(&r.log).into_owned(),
         format!("{:.2}", r.duration_s),
         format!("{:.1}", r.distance_m),
         format!("{:.2}", r.max_speed_mps),
@@ -166,7 +175,7 @@ pub fn render(rows: &[RunRow], format: SummaryFormat) -> String {
         SummaryFormat::Jsonl => rows
             .iter()
             .filter_map(|r| serde_json::to_string(r).ok())
-            .map(|line| line + "\n")
+            .map(|line| crate::text::json_terminal_safe(line) + "\n")
             .collect(),
         SummaryFormat::Csv => {
             let mut w = csv::Writer::from_writer(Vec::new());

@@ -3,35 +3,63 @@
 //! the board and the QEMU image share. A sensor that fails or freezes is
 //! set up again, at most once per [`RETRY`]: each attempt's start-up wait
 //! (45 ms) delays one sampler tick.
+//!
+//! With the sensor's data-ready line timed by the hardware
+//! ([`DataReadyPort::WIRED`], the board), every sample is read from the
+//! sensor's FIFO and placed on the MCU clock by [`SampleClock`]: each frame
+//! gets the sensor's output exactly [`crate::imu_clock::AGE_US`] before its
+//! tick, and samples that reach no frame are counted. Without it (the QEMU
+//! machine), the newest sample is read once per frame, 0-10 ms old.
 
 use embassy_time::{Duration, Instant};
 use embedded_hal_async::delay::DelayNs;
 use embedded_hal_async::spi::SpiDevice;
 
-use super::ports::{ImuPort, ImuSample, SensorError};
+use super::ports::{DataReadyPort, ImuPort, ImuSample, NoDataReady, SensorError};
 use crate::drivers::icm42688::{Error, Icm42688};
 use crate::imu::Imu;
+use crate::imu_clock::{ClockStats, SampleClock};
 
 /// Shortest time between two set-up attempts of a failed sensor.
 pub const RETRY: Duration = Duration::from_secs(1);
 
-/// Driver, channel and recovery state.
-pub struct Icm42688Port<SPI, D> {
+/// FIFO samples read per frame at most: a frame brings one, the catch-up
+/// after the longest stall seven; more wait in the FIFO (it holds 128)
+/// for the next frame.
+pub const MAX_FIFO_SAMPLES_PER_READ: u16 = 16;
+
+/// Driver, channel, data-ready line and recovery state.
+pub struct Icm42688Port<SPI, D, R = NoDataReady> {
     driver: Icm42688<SPI>,
     channel: Imu,
     delay: D,
+    data_ready: R,
+    clock: SampleClock,
+    /// Skipped samples not yet handed to a frame (a stale frame has none).
+    skipped: u32,
     ready: bool,
     next_attempt: Instant,
 }
 
 impl<SPI: SpiDevice, D: DelayNs> Icm42688Port<SPI, D> {
     /// Wraps a driver whose `init` has not run yet (the first read runs it);
-    /// `delay` times its waits.
+    /// `delay` times its waits. No data-ready line: one read per frame.
     pub fn new(driver: Icm42688<SPI>, channel: Imu, delay: D) -> Self {
+        Self::with_data_ready(driver, channel, delay, NoDataReady)
+    }
+}
+
+impl<SPI: SpiDevice, D: DelayNs, R: DataReadyPort> Icm42688Port<SPI, D, R> {
+    /// As [`Icm42688Port::new`], with the sensor's data-ready pulses timed
+    /// by `data_ready`.
+    pub fn with_data_ready(driver: Icm42688<SPI>, channel: Imu, delay: D, data_ready: R) -> Self {
         Self {
             driver,
             channel,
             delay,
+            data_ready,
+            clock: SampleClock::new(),
+            skipped: 0,
             ready: false,
             next_attempt: Instant::MIN,
         }
@@ -43,6 +71,11 @@ impl<SPI: SpiDevice, D: DelayNs> Icm42688Port<SPI, D> {
         let _ = self.ensure_ready().await;
     }
 
+    /// What the sample clock counted so far, and its period estimate.
+    pub fn clock(&self) -> (ClockStats, f32) {
+        (self.clock.stats(), self.clock.period_us())
+    }
+
     async fn ensure_ready(&mut self) -> Result<(), SensorError> {
         if self.ready {
             return Ok(());
@@ -52,10 +85,17 @@ impl<SPI: SpiDevice, D: DelayNs> Icm42688Port<SPI, D> {
             return Err(SensorError::NoResponse);
         }
         self.next_attempt = now + RETRY;
-        match self.driver.init(&mut self.delay).await {
+        let set_up = match self.driver.init(&mut self.delay).await {
+            // The start-up wait's samples have no timed pulses: gone.
+            Ok(()) if R::WIRED => self.driver.flush_fifo().await,
+            other => other,
+        };
+        match set_up {
             Ok(()) => {
                 #[cfg(feature = "defmt")]
                 defmt::info!("IMU ready");
+                self.data_ready.drain_pulses(&mut |_| {});
+                self.clock.restart();
                 self.ready = true;
                 Ok(())
             }
@@ -75,17 +115,56 @@ impl<SPI: SpiDevice, D: DelayNs> Icm42688Port<SPI, D> {
         self.ready = false;
         e.sensor_error()
     }
-}
 
-impl<SPI: SpiDevice, D: DelayNs> ImuPort for Icm42688Port<SPI, D> {
-    async fn read(&mut self) -> Result<ImuSample, SensorError> {
-        self.ensure_ready().await?;
+    /// The wired read: pulses first, then the FIFO (the order
+    /// [`SampleClock`] pairs them by), then the frame's value.
+    async fn read_timed(&mut self, scheduled_us: u64) -> Result<ImuSample, SensorError> {
+        let clock = &mut self.clock;
+        self.data_ready.drain_pulses(&mut |t| clock.data_ready(t));
+        let waiting = match self.driver.fifo_samples().await {
+            Ok(n) => n,
+            Err(e) => return Err(self.failed(&e)),
+        };
+        for _ in 0..waiting.min(MAX_FIFO_SAMPLES_PER_READ) {
+            match self.driver.fifo_sample().await {
+                Ok(raw) => {
+                    if let Some(raw) = raw {
+                        self.channel.watch(raw);
+                    }
+                    self.clock.sample(raw);
+                }
+                Err(e) => return Err(self.failed(&e)),
+            }
+        }
+        let value = self.clock.frame(scheduled_us, Instant::now().as_micros());
+        self.skipped = self.skipped.saturating_add(value.skipped);
+        let counts = value.counts.ok_or(SensorError::Stale)?;
+        let mut sample = self.channel.scale(counts);
+        let reported = self.skipped.min(u32::from(u16::MAX));
+        sample.skipped = reported as u16;
+        self.skipped -= reported;
+        Ok(sample)
+    }
+
+    /// The unwired read: the newest sample in the data registers.
+    async fn read_polled(&mut self) -> Result<ImuSample, SensorError> {
         let raw = match self.driver.read().await {
             Ok(raw) => raw,
             Err(e) => return Err(self.failed(&e)),
         };
         self.channel.push(raw);
-        let sample = self.channel.take().ok_or(SensorError::Stale)?;
+        self.channel.take().ok_or(SensorError::Stale)
+    }
+}
+
+impl<SPI: SpiDevice, D: DelayNs, R: DataReadyPort> ImuPort for Icm42688Port<SPI, D, R> {
+    async fn read(&mut self, scheduled_us: u64) -> Result<ImuSample, SensorError> {
+        self.ensure_ready().await?;
+        let sample = if R::WIRED {
+            self.read_timed(scheduled_us).await?
+        } else {
+            self.read_polled().await?
+        };
         if sample.stuck {
             // Frozen output: the frame flags it; reset the sensor on the
             // next attempt.

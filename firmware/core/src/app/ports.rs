@@ -30,12 +30,37 @@ pub enum SensorError {
 /// The 6-DOF IMU, read once per frame.
 #[allow(async_fn_in_trait)]
 pub trait ImuPort {
-    /// The frame's value from the samples since the previous read (the
-    /// [`crate::imu::Imu`] channel's `take`), `stuck` set when the sensor
-    /// repeats itself; [`SensorError::NoResponse`] when it did not answer,
-    /// [`SensorError::Stale`] when it answered without a new sample. Must
-    /// return within a few ms: the sampler's period is 10 ms.
-    async fn read(&mut self) -> Result<ImuSample, SensorError>;
+    /// The value of the frame due at `scheduled_us` (µs since boot):
+    /// with the sensor's data-ready times, its output at a fixed age
+    /// before that time ([`crate::imu_clock`]); without them, the samples
+    /// since the previous read (the [`crate::imu::Imu`] channel's `take`).
+    /// `stuck` is set when the sensor repeats itself, `skipped` counts its
+    /// samples that reach no frame; [`SensorError::NoResponse`] when it
+    /// did not answer, [`SensorError::Stale`] when no sample is there for
+    /// the frame. Must return within a few ms: the sampler's period is
+    /// 10 ms.
+    async fn read(&mut self, scheduled_us: u64) -> Result<ImuSample, SensorError>;
+}
+
+/// The IMU's data-ready line (INT1), its pulses timed by the hardware.
+pub trait DataReadyPort {
+    /// Whether the line is wired and timed: without it the IMU is read
+    /// once per frame, its newest sample 0-10 ms old.
+    const WIRED: bool;
+
+    /// Hands the time of every pulse since the last call to `pulse`,
+    /// oldest first, as µs since boot.
+    fn drain_pulses(&mut self, pulse: &mut dyn FnMut(u64));
+}
+
+/// No data-ready line (the QEMU machine's emulated sensor has none).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct NoDataReady;
+
+impl DataReadyPort for NoDataReady {
+    const WIRED: bool = false;
+
+    fn drain_pulses(&mut self, _pulse: &mut dyn FnMut(u64)) {}
 }
 
 /// The steering potentiometer, calibrated.

@@ -18,9 +18,10 @@ use super::ports::{
     SteeringPort, SteeringSample, WheelPort,
 };
 use crate::channels::{RecordQueue, SharedStatus};
-use crate::detector::{AlertEvent, AlertPattern, Detector, PatternConfig};
+use crate::config::AlertConfig;
+use crate::detector::{AlertEvent, AlertPattern, Detector, MarginEvent, MarginWarning};
 use crate::faults::FaultCounter;
-use crate::format::{FaultSource, FrameStatus, Marker, Record};
+use crate::format::{FaultSource, FrameStatus, MarginRecord, MarginState, Marker, Record};
 use crate::frame_assembly::{FrameAssembler, FrameConfig, TickInputs};
 use crate::wheel::WheelSpeed;
 
@@ -33,6 +34,10 @@ pub const FAULT_INTERVAL_US: u64 = 1_000_000;
 pub const FAULT_IMU_NO_RESPONSE: u8 = 1;
 /// IMU fault 2: the IMU answered with a stale, impossible or stuck sample.
 pub const FAULT_IMU_BAD_SAMPLE: u8 = 2;
+/// IMU fault 3: a sample the sensor made reached no frame (a gap in its
+/// data-ready times, a FIFO overflow or flush, an invalid FIFO packet:
+/// [`crate::imu_clock`]); one count per sample.
+pub const FAULT_IMU_SKIPPED: u8 = 3;
 /// Steering fault 1: the steering sensor could not be read.
 pub const FAULT_STEER_READ: u8 = 1;
 /// Steering fault 2: the steering ADC overran and was restarted.
@@ -75,8 +80,9 @@ pub struct Sampler {
     wheel: WheelSpeed,
     assembler: FrameAssembler,
     detector: Detector,
+    margin: MarginWarning,
     pattern: AlertPattern,
-    imu_faults: FaultCounter<2>,
+    imu_faults: FaultCounter<3>,
     steer_faults: FaultCounter<2>,
     marker_held: bool,
     markers: u16,
@@ -85,20 +91,21 @@ pub struct Sampler {
 }
 
 impl Sampler {
-    /// A sampler with the configured wheel estimator, frame assembly and
-    /// detector.
+    /// A sampler with the configured wheel estimator, frame assembly,
+    /// detector, margin warning and rider patterns.
     #[must_use]
     pub fn new(
         wheel: WheelSpeed,
         frame: FrameConfig,
         detector: Detector,
-        pattern: PatternConfig,
+        alert: AlertConfig,
     ) -> Self {
         Self {
             wheel,
             assembler: FrameAssembler::new(frame),
             detector,
-            pattern: AlertPattern::new(pattern),
+            margin: MarginWarning::new(alert.margin_mps),
+            pattern: AlertPattern::new(alert.pattern, alert.approach),
             imu_faults: FaultCounter::new(FaultSource::Imu, FAULT_INTERVAL_US),
             steer_faults: FaultCounter::new(FaultSource::Steering, FAULT_INTERVAL_US),
             marker_held: false,
@@ -146,6 +153,12 @@ impl Sampler {
         if let Some(code) = imu_fault {
             self.imu_faults.count(code, now_us, &mut emit_fault);
         }
+        if let Ok(sample) = inputs.imu {
+            for _ in 0..sample.skipped {
+                self.imu_faults
+                    .count(FAULT_IMU_SKIPPED, now_us, &mut emit_fault);
+            }
+        }
         if let Err(e) = inputs.steering {
             let code = if e == SensorError::Overrun {
                 FAULT_STEER_OVERRUN
@@ -177,9 +190,35 @@ impl Sampler {
             self.pattern
                 .set_alert(now_us, matches!(ev, AlertEvent::On { .. }));
         }
+        let speed = Some(frame.speed_mps());
         if let Some(kick) = self.detector.take_kick() {
             let rate_hz = self.detector.config().sample_rate_hz;
             out(Record::Kick(kick.to_record(now_us, rate_hz)));
+            if let Some(estimate) = self.margin.add_kick(&kick) {
+                let state = MarginState::Estimate;
+                out(Record::Margin(MarginRecord::new(
+                    now_us,
+                    state,
+                    speed,
+                    Some(&estimate),
+                )));
+            }
+        }
+        if let Some(ev) = self.margin.update(now_us, speed) {
+            let approaching = ev == MarginEvent::Approaching;
+            let state = if approaching {
+                MarginState::Approaching
+            } else {
+                MarginState::Clear
+            };
+            let estimate = self.margin.estimate();
+            out(Record::Margin(MarginRecord::new(
+                now_us,
+                state,
+                speed,
+                estimate.as_ref(),
+            )));
+            self.pattern.set_approaching(now_us, approaching);
         }
         self.pattern.update(now_us, alert_out);
         if self.detector.alert_active() {
@@ -245,7 +284,7 @@ pub async fn run<I, S, W, M, A, L>(
         let late_us = u32::try_from(now_us.saturating_sub(scheduled_us)).unwrap_or(u32::MAX);
         sampler.stats.max_lateness_us = sampler.stats.max_lateness_us.max(late_us);
         ports.wheel.drain_edges(&mut |t| sampler.wheel_edge(t));
-        let imu = ports.imu.read().await;
+        let imu = ports.imu.read(scheduled_us).await;
         // The IMU read may have taken a while (a re-initialisation): the
         // steering samples are owed up to the schedule, not up to now.
         let steer_late_us = Instant::now().as_micros().saturating_sub(scheduled_us);
@@ -255,11 +294,15 @@ pub async fn run<I, S, W, M, A, L>(
             marker: ports.marker.is_pressed(),
             last_gps_fix_us: shared.last_fix_us(),
         };
-        let event = sampler.step(now_us, &inputs, &mut ports.alert, &mut |rec| {
+        // Stamped on its own tick, also in a catch-up burst after a stall
+        // (the ticker then fires the missed ticks back to back): the frame
+        // holds the samples owed up to that tick, so the card's frames stay
+        // 10 ms apart instead of bunching microseconds apart.
+        let event = sampler.step(scheduled_us, &inputs, &mut ports.alert, &mut |rec| {
             queue.push(rec);
         });
         if let Some(ev) = event {
-            on_alert(now_us, ev);
+            on_alert(scheduled_us, ev);
         }
         let degraded = sampler.status.0 & DEGRADED != 0;
         ports.status_led.show(match (shared.card_ok(), degraded) {

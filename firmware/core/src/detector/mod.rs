@@ -31,6 +31,7 @@ mod filter;
 mod goertzel;
 mod harmonics;
 mod machine;
+pub mod margin;
 pub mod math;
 mod pattern;
 mod ringdown;
@@ -39,7 +40,8 @@ pub use filter::{Biquad, HighPass4};
 pub use goertzel::{goertzel_power, GoertzelBank, MAX_BINS};
 pub use harmonics::{sincos_turns, HarmonicCanceller};
 pub use machine::{AlertEvent, Detector, Estimate};
-pub use pattern::{AlertOutput, AlertPattern, PatternConfig};
+pub use margin::{MarginEvent, MarginWarning, WobbleSpeed};
+pub use pattern::{AlertOutput, AlertPattern, ApproachConfig, PatternConfig};
 pub use ringdown::Kick;
 
 /// Longest analysis window, samples (0.64 s at 100 Hz).

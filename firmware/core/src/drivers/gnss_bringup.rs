@@ -47,8 +47,10 @@ pub const MIN_VALID_SENTENCES: u32 = 2;
 /// a new baud rate or rate (u-blox: about 100 ms after CFG-PRT).
 pub const SETTLE_US: u64 = 150_000;
 
-/// GPS fault 6: no valid NMEA at any baud rate; logging at 9600 anyway.
-pub const FAULT_SETUP_SILENT: u8 = 6;
+/// GPS fault 10: no valid NMEA at any baud rate; logging at 9600 anyway.
+/// Earlier firmware recorded it as 6, the code of
+/// [`crate::gps::FAULT_OUT_OF_RANGE`] (FORMAT.md).
+pub const FAULT_SETUP_SILENT: u8 = 10;
 /// GPS fault 7: no command set was confirmed; logging at the receiver's
 /// own baud and rate.
 pub const FAULT_SETUP_UNCONFIRMED: u8 = 7;

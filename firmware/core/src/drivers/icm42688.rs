@@ -59,6 +59,31 @@ pub mod reg {
     pub const ACCEL_CONFIG1: u8 = 0x53;
     /// Bank 0: device identity.
     pub const WHO_AM_I: u8 = 0x75;
+    /// Bank 0: INT1/INT2 pin configuration (register map, INT_CONFIG): bit 2
+    /// INT1_MODE (0 pulsed), bit 1 INT1_DRIVE_CIRCUIT (1 push-pull), bit 0
+    /// INT1_POLARITY (1 active high).
+    pub const INT_CONFIG: u8 = 0x14;
+    /// Bank 0: FIFO mode, bits 7:6 (FIFO_MODE): 01 stream-to-FIFO.
+    pub const FIFO_CONFIG: u8 = 0x16;
+    /// Bank 0: FIFO byte count, high byte first (INTF_CONFIG0 at
+    /// reset: FIFO_COUNT_REC 0, a count of bytes; FIFO_COUNT_ENDIAN 1,
+    /// big-endian); reading the high byte
+    /// latches the low one.
+    pub const FIFO_COUNTH: u8 = 0x2E;
+    /// Bank 0: the FIFO's read port (FIFO_DATA): a burst read of it
+    /// pops bytes, the address does not advance.
+    pub const FIFO_DATA: u8 = 0x30;
+    /// Bank 0: FIFO contents (FIFO_CONFIG1): bit 2 FIFO_TEMP_EN, bit 1
+    /// FIFO_GYRO_EN, bit 0 FIFO_ACCEL_EN; with both sensors on, each
+    /// sample is one 16-byte packet 3 (section 6, FIFO packet structure).
+    pub const FIFO_CONFIG1: u8 = 0x5F;
+    /// Bank 0: bit 4 INT_ASYNC_RESET, 1 at reset; the register
+    /// description asks for 0 "for proper INT1 and INT2 pin operation".
+    pub const INT_CONFIG1: u8 = 0x64;
+    /// Bank 0: what drives INT1 (INT_SOURCE0): bit 3 UI_DRDY_INT1_EN.
+    pub const INT_SOURCE0: u8 = 0x65;
+    /// Bank 0: SIGNAL_PATH_RESET, bit 1 FIFO_FLUSH (self-clearing).
+    pub const SIGNAL_PATH_RESET: u8 = 0x4B;
 
     // User bank 1: gyro anti-alias filter.
     /// Bank 1: GYRO_AAF_DELT (5:0).
@@ -104,6 +129,29 @@ pub mod reg {
     pub const AAF_42HZ_BITSHIFT: u8 = 15;
     /// What a data register holds when no sample is available.
     pub const NO_DATA: i16 = i16::MIN;
+    /// `INT_CONFIG`: INT1 pulsed (a 100 µs pulse per sample:
+    /// INT_CONFIG1's INT_TPULSE_DURATION at its reset value 0), push-pull, active high.
+    pub const INT1_PULSED_PUSH_PULL_HIGH: u8 = 0b0000_0011;
+    /// `INT_CONFIG1`: the INT_ASYNC_RESET bit.
+    pub const INT_ASYNC_RESET: u8 = 0b0001_0000;
+    /// `INT_SOURCE0`: data ready on INT1 only.
+    pub const UI_DRDY_INT1_EN: u8 = 0b0000_1000;
+    /// `SIGNAL_PATH_RESET`: FIFO_FLUSH.
+    pub const FIFO_FLUSH: u8 = 0b0000_0010;
+    /// `FIFO_CONFIG`: stream-to-FIFO mode (the oldest data go when full).
+    pub const FIFO_STREAM: u8 = 0b0100_0000;
+    /// `FIFO_CONFIG1`: accelerometer, gyro and temperature: packet 3.
+    pub const FIFO_PACKET3: u8 = 0b0000_0111;
+    /// Bytes of one packet 3 (section 6): header, accel x/y/z and gyro
+    /// x/y/z as big-endian 16-bit words, temperature (1), timestamp (2).
+    pub const PACKET3_LEN: usize = 16;
+    /// Packet header bits (section 6, FIFO header): 7 HEADER_MSG (1: the FIFO is
+    /// empty, no data), 6 HEADER_ACCEL, 5 HEADER_GYRO.
+    pub const HEADER_MSG: u8 = 0x80;
+    /// Header: accelerometer data present.
+    pub const HEADER_ACCEL: u8 = 0x40;
+    /// Header: gyro data present.
+    pub const HEADER_GYRO: u8 = 0x20;
 }
 
 /// Wait after a soft reset before the next register access (datasheet: 1 ms).
@@ -219,7 +267,7 @@ enum Step {
 
 /// The datasheet's configuration sequence after the identity check, with
 /// `gyro_config0` (range and rate) for GYRO_CONFIG0.
-const fn configuration(gyro_config0: u8) -> [Step; 18] {
+const fn configuration(gyro_config0: u8) -> [Step; 23] {
     use reg::*;
     let [deltsqr_hi, deltsqr_lo] = AAF_42HZ_DELTSQR.to_be_bytes();
     let shift_and_hi = (AAF_42HZ_BITSHIFT << 4) | deltsqr_hi;
@@ -250,6 +298,13 @@ const fn configuration(gyro_config0: u8) -> [Step; 18] {
             GYRO_ACCEL_CONFIG0,
             (UI_FILT_BW_DIV10 << 4) | UI_FILT_BW_DIV10,
         ),
+        // Every sample into the FIFO, and a data-ready pulse on INT1 for
+        // each: the sampler times them on the MCU clock (`imu_clock`).
+        Step::Write(FIFO_CONFIG1, FIFO_PACKET3),
+        Step::Write(FIFO_CONFIG, FIFO_STREAM),
+        Step::Write(INT_CONFIG, INT1_PULSED_PUSH_PULL_HIGH),
+        Step::Modify(INT_CONFIG1, INT_ASYNC_RESET, 0),
+        Step::Write(INT_SOURCE0, UI_DRDY_INT1_EN),
         Step::Write(PWR_MGMT0, PWR_GYRO_ACCEL_LOW_NOISE),
         Step::WaitUs(STARTUP_WAIT_US),
     ]
@@ -327,20 +382,50 @@ impl<SPI: SpiDevice> Icm42688<SPI> {
         if raw.iter().all(|&b| b == 0xFF) || raw.iter().all(|&b| b == 0x00) {
             return Err(Error::NoResponse);
         }
-        let word = |i: usize| i16::from_be_bytes([raw[2 * i], raw[2 * i + 1]]);
-        let sample = RawImu {
-            accel: [word(0), word(1), word(2)],
-            gyro: [word(3), word(4), word(5)],
-        };
-        if sample
-            .accel
-            .iter()
-            .chain(&sample.gyro)
-            .all(|&w| w == reg::NO_DATA)
-        {
-            return Err(Error::NotReady);
+        words(&raw).ok_or(Error::NotReady)
+    }
+
+    /// Empties the FIFO (the samples of the start-up wait, whose data-ready
+    /// pulses nobody timed).
+    ///
+    /// # Errors
+    /// [`Error::Comm`] on a bus error.
+    pub async fn flush_fifo(&mut self) -> Result<(), Error<SPI::Error>> {
+        self.write(reg::SIGNAL_PATH_RESET, reg::FIFO_FLUSH).await
+    }
+
+    /// Whole samples waiting in the FIFO (FIFO_COUNTH/L over the packet
+    /// size).
+    ///
+    /// # Errors
+    /// [`Error::Comm`] on a bus error.
+    pub async fn fifo_samples(&mut self) -> Result<u16, Error<SPI::Error>> {
+        let mut count = [0u8; 2];
+        self.read_regs(reg::FIFO_COUNTH, &mut count).await?;
+        Ok(u16::from_be_bytes(count) / reg::PACKET3_LEN as u16)
+    }
+
+    /// Pops one sample from the FIFO; `Ok(None)` for a packet without both
+    /// sensors' data or holding the "no data" marker (the sensor's first
+    /// samples after power-up).
+    ///
+    /// # Errors
+    /// [`Error::Comm`] on a bus error, [`Error::NoResponse`] when the bus
+    /// reads as if nothing were on it.
+    pub async fn fifo_sample(&mut self) -> Result<Option<RawImu>, Error<SPI::Error>> {
+        use reg::*;
+        let mut packet = [0u8; PACKET3_LEN];
+        self.read_regs(FIFO_DATA, &mut packet).await?;
+        if packet.iter().all(|&b| b == 0xFF) || packet.iter().all(|&b| b == 0x00) {
+            return Err(Error::NoResponse);
         }
-        Ok(sample)
+        let header = packet[0];
+        if header & HEADER_MSG != 0
+            || header & (HEADER_ACCEL | HEADER_GYRO) != HEADER_ACCEL | HEADER_GYRO
+        {
+            return Ok(None);
+        }
+        Ok(words(&packet[1..1 + DATA_LEN]))
     }
 
     async fn write(&mut self, register: u8, value: u8) -> Result<(), Error<SPI::Error>> {
@@ -367,4 +452,17 @@ impl<SPI: SpiDevice> Icm42688<SPI> {
         let old = self.read_reg(register).await?;
         self.write(register, (old & !mask) | (bits & mask)).await
     }
+}
+
+/// Six big-endian words (accel x/y/z, gyro x/y/z) as a sample; `None`
+/// when one sensor's three words all hold the "no data" marker (it is off
+/// or still starting: the gyro's first samples after power-up).
+fn words(bytes: &[u8]) -> Option<RawImu> {
+    let word = |i: usize| i16::from_be_bytes([bytes[2 * i], bytes[2 * i + 1]]);
+    let sample = RawImu {
+        accel: [word(0), word(1), word(2)],
+        gyro: [word(3), word(4), word(5)],
+    };
+    let no_data = |axes: &[i16; 3]| axes.iter().all(|&w| w == reg::NO_DATA);
+    (!no_data(&sample.accel) && !no_data(&sample.gyro)).then_some(sample)
 }

@@ -26,7 +26,7 @@ pub const MAGIC: [u8; 4] = *b"WBLK";
 /// Format major version written and read by this code.
 pub const VERSION_MAJOR: u8 = 1;
 /// Format minor version written by this code.
-pub const VERSION_MINOR: u8 = 1;
+pub const VERSION_MINOR: u8 = 2;
 
 /// One block's bytes.
 pub type Block = [u8; BLOCK_LEN];
@@ -110,8 +110,17 @@ impl BlockHeader {
         if block[0..4] != MAGIC {
             return Err(BlockError::BadMagic);
         }
+        Self::parse_with_crc(block, crc32(&block[..BLOCK_LEN - CRC_LEN]))
+    }
+
+    /// [`Self::parse`] with the CRC of the block's first 508 bytes computed
+    /// by the caller (a rolling search computes it from a nearby window's).
+    pub fn parse_with_crc(block: &Block, crc: u32) -> Result<Self, BlockError> {
+        if block[0..4] != MAGIC {
+            return Err(BlockError::BadMagic);
+        }
         let stored = u32::from_le_bytes(le4(&block[BLOCK_LEN - CRC_LEN..]));
-        if crc32(&block[..BLOCK_LEN - CRC_LEN]) != stored {
+        if crc != stored {
             return Err(BlockError::BadCrc);
         }
         if block[4] != VERSION_MAJOR {

@@ -34,7 +34,10 @@ pub const TAG_CHANNEL: u8 = 0x81;
 pub const TAG_CONFIG: u8 = 0x82;
 /// Tag: a kick's measured ring-down (length-prefixed, format 1.1).
 pub const TAG_KICK: u8 = 0x83;
-/// `KickRingDown::speed_mm_s` on the card when the speed is unknown.
+/// Tag: the margin warning's estimate or switching (length-prefixed,
+/// format 1.2).
+pub const TAG_MARGIN: u8 = 0x84;
+/// A speed field on the card when the speed is unknown.
 const SPEED_UNKNOWN: u16 = u16::MAX;
 /// Nominal frame period: frame time deltas are stored relative to it.
 pub const FRAME_PERIOD_US: i64 = 10_000;
@@ -202,6 +205,19 @@ pub fn encode(
             body[8..10].copy_from_slice(&k.amp_cdeg.to_le_bytes());
             body[10] = k.segments;
             sized(&mut w, TAG_KICK, sdelta, &[&body])?
+        }
+        Record::Margin(m) => {
+            let mut body = [0u8; 10];
+            body[0] = m.state.code();
+            for (i, v) in [m.speed_mm_s, m.lower_mm_s, m.estimate_mm_s, m.upper_mm_s]
+                .into_iter()
+                .enumerate()
+            {
+                body[1 + 2 * i..3 + 2 * i]
+                    .copy_from_slice(&v.unwrap_or(SPEED_UNKNOWN).to_le_bytes());
+            }
+            body[9] = m.kicks;
+            sized(&mut w, TAG_MARGIN, sdelta, &[&body])?
         }
     };
     Ok(fits.map(|()| w.len))
@@ -533,7 +549,10 @@ impl<'a> Records<'a> {
 
     /// `Ok(None)` for a length-prefixed tag this reader does not know.
     fn sized_record(&self, tag: u8, r: &mut Reader<'a>) -> Result<Option<Record<'a>>, RecordError> {
-        let known = matches!(tag, TAG_LOG_INFO | TAG_CHANNEL | TAG_CONFIG | TAG_KICK);
+        let known = matches!(
+            tag,
+            TAG_LOG_INFO | TAG_CHANNEL | TAG_CONFIG | TAG_KICK | TAG_MARGIN
+        );
         if !known {
             return Ok(None);
         }
@@ -578,6 +597,19 @@ impl<'a> Records<'a> {
                 amp_cdeg: r.u16()?,
                 segments: r.u8()?,
             }),
+            TAG_MARGIN => {
+                let state = MarginState::from_code(r.u8()?);
+                let mut speed = || Ok(Some(r.u16()?).filter(|&v| v != SPEED_UNKNOWN));
+                Record::Margin(MarginRecord {
+                    t_us,
+                    state,
+                    speed_mm_s: speed()?,
+                    lower_mm_s: speed()?,
+                    estimate_mm_s: speed()?,
+                    upper_mm_s: speed()?,
+                    kicks: r.u8()?,
+                })
+            }
             _ => Record::Config(ConfigLine {
                 t_us,
                 text: Reader::str(r.rest(), tag)?,

@@ -18,6 +18,7 @@
 
 use super::block::{Block, BlockError, BlockHeader, BLOCK_LEN, MAGIC, PAYLOAD_LEN};
 use super::codec::{RecordError, Records};
+use super::crc_window::CrcWindow;
 use super::limits::DEFAULT_SAMPLE_RATE_HZ;
 use super::recent::{Recent, Seen};
 use super::record::Record;
@@ -316,9 +317,16 @@ impl Decoder {
         let mut skip: Option<(u64, SkipCause)> = self.open_skip.take();
         let base = self.offset;
         let at = |pos: usize| base + pos as u64;
+        // Candidates a few bytes apart get their CRCs rolled from the last.
+        let mut crc = CrcWindow::default();
         while chunk.len() - pos >= BLOCK_LEN {
             let block = as_block(&chunk[pos..]);
-            match BlockHeader::parse(block) {
+            let parsed = if block[..MAGIC.len()] == MAGIC {
+                BlockHeader::parse_with_crc(block, crc.crc_at(chunk, pos))
+            } else {
+                Err(BlockError::BadMagic)
+            };
+            match parsed {
                 Ok(header) => {
                     let seen = on_block(self, at(pos), &header, block);
                     if seen == Some(Seen::Repeat) {
@@ -609,20 +617,16 @@ fn cause_of(err: BlockError) -> SkipCause {
 /// CRC per marker.
 fn next_marker(chunk: &[u8], from: usize) -> usize {
     let limit = chunk.len().saturating_sub(BLOCK_LEN - 1);
-    let mut from = from;
-    while from < limit {
-        let window = &chunk[from..limit + MAGIC.len() - 1];
-        let Some(i) = memchr::memmem::find(window, &MAGIC) else {
-            return limit;
-        };
-        let at = from + i;
-        let len = u16::from_le_bytes([chunk[at + 6], chunk[at + 7]]);
-        if usize::from(len) <= PAYLOAD_LEN {
-            return at;
-        }
-        from = at + 1;
+    if from >= limit {
+        return limit.max(from.min(chunk.len()));
     }
-    limit.max(from.min(chunk.len()))
+    // One searcher for the whole stretch: a flood of markers costs one
+    // setup, not one per marker.
+    let window = &chunk[from..limit + MAGIC.len() - 1];
+    memchr::memmem::find_iter(window, &MAGIC)
+        .map(|i| from + i)
+        .find(|&at| usize::from(u16::from_le_bytes([chunk[at + 6], chunk[at + 7]])) <= PAYLOAD_LEN)
+        .unwrap_or(limit)
 }
 
 fn as_block(bytes: &[u8]) -> &Block {

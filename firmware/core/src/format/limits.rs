@@ -25,6 +25,8 @@ pub const SPEED_CM_S_MAX: u16 = 51_444;
 pub const ALT_CM_RANGE: (i32, i32) = (-50_000, 1_800_000);
 /// Most satellites an NMEA GGA sentence can state (two digits).
 pub const SATS_MAX: u8 = 99;
+/// Largest HDOP the record holds, tenths (0xFF is "unknown").
+pub const HDOP_D_MAX: u8 = 254;
 /// Sample rates the logger can be configured to, Hz.
 pub const SAMPLE_RATE_HZ_RANGE: (u16, u16) = (1, 1000);
 /// The documented frame rate, used when a log states an impossible one.

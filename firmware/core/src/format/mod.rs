@@ -3,6 +3,7 @@
 
 pub mod block;
 pub mod codec;
+mod crc_window;
 pub mod decoder;
 pub mod encoder;
 pub mod header;

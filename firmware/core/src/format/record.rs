@@ -505,6 +505,95 @@ impl KickRingDown {
     }
 }
 
+/// What a margin record says (format 1.2).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum MarginState {
+    /// A kick updated the running estimate of the wobble speed.
+    Estimate,
+    /// The speed came within `alert.margin_mps` of the estimate's lower
+    /// bound: the "approaching" pattern started.
+    Approaching,
+    /// The speed has stayed clear of it: the pattern stopped.
+    Clear,
+    /// A state of a later minor version.
+    Other(u8),
+}
+
+impl MarginState {
+    /// The code on the card.
+    #[must_use]
+    pub fn code(self) -> u8 {
+        match self {
+            Self::Estimate => 0,
+            Self::Approaching => 1,
+            Self::Clear => 2,
+            Self::Other(c) => c,
+        }
+    }
+
+    /// The state of a code on the card.
+    #[must_use]
+    pub fn from_code(code: u8) -> Self {
+        match code {
+            0 => Self::Estimate,
+            1 => Self::Approaching,
+            2 => Self::Clear,
+            c => Self::Other(c),
+        }
+    }
+}
+
+/// The on-board margin warning's state and estimate
+/// (`wobble_core::detector::MarginWarning`): the wobble speed the ride's
+/// kicks predict, with its 95 % interval, and the speed at the time.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct MarginRecord {
+    /// Local time, µs since boot.
+    pub t_us: u64,
+    /// What happened.
+    pub state: MarginState,
+    /// Wheel speed at the time, mm/s (`None`: unknown).
+    pub speed_mm_s: Option<u16>,
+    /// Lower end of the wobble speed's 95 % interval, mm/s (`None`: no
+    /// estimate).
+    pub lower_mm_s: Option<u16>,
+    /// The predicted wobble speed, mm/s (`None`: only a lower bound).
+    pub estimate_mm_s: Option<u16>,
+    /// Upper end of the interval, mm/s (`None`: open).
+    pub upper_mm_s: Option<u16>,
+    /// Kicks the estimate was made from.
+    pub kicks: u8,
+}
+
+/// A speed in mm/s below the "unknown" code 0xFFFF.
+fn speed_mm_s(v: f32) -> u16 {
+    quantise_u16(v, 1000.0).min(u16::MAX - 1)
+}
+
+impl MarginRecord {
+    /// The record of `state` at `now_us`, with the speed then and the
+    /// estimate in force (if any).
+    #[must_use]
+    pub fn new(
+        now_us: u64,
+        state: MarginState,
+        speed_mps: Option<f32>,
+        estimate: Option<&crate::detector::WobbleSpeed>,
+    ) -> Self {
+        Self {
+            t_us: now_us,
+            state,
+            speed_mm_s: speed_mps.map(speed_mm_s),
+            lower_mm_s: estimate.map(|e| speed_mm_s(e.lower_mps)),
+            estimate_mm_s: estimate.and_then(|e| e.estimate_mps).map(speed_mm_s),
+            upper_mm_s: estimate.and_then(|e| e.upper_mps).map(speed_mm_s),
+            kicks: estimate.map_or(0, |e| e.kicks),
+        }
+    }
+}
+
 /// Identity of the logger and firmware that wrote a log (file header).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -573,6 +662,8 @@ pub enum Record<'a> {
     Config(ConfigLine<'a>),
     /// A kick's measured ring-down (format 1.1).
     Kick(KickRingDown),
+    /// The margin warning's estimate or switching (format 1.2).
+    Margin(MarginRecord),
 }
 
 impl Record<'_> {
@@ -591,6 +682,7 @@ impl Record<'_> {
             Self::Channel(r) => r.t_us,
             Self::Config(r) => r.t_us,
             Self::Kick(r) => r.t_us,
+            Self::Margin(r) => r.t_us,
         }
     }
 }

@@ -248,16 +248,14 @@ impl EpochMerger {
                 let rolled = tod < last.ms_of_day.saturating_sub(DAY_MS / 2);
                 last.days_since_2000.checked_add(u16::from(rolled))
             });
-            // A leap second on a day that cannot end with one is a receiver
-            // error: the fix goes without its UTC, as the decoder would
-            // drop it (`format::limits`).
-            fix.utc = days
-                .map(|days_since_2000| UtcTime {
-                    days_since_2000,
-                    ms_of_day: tod,
-                })
-                .filter(|u| u.is_valid());
-            if fix.utc.is_some() {
+            // A leap second on a day that cannot end with one is passed on
+            // for the receiver to count and drop, but not taken as the
+            // date of later fixes.
+            fix.utc = days.map(|days_since_2000| UtcTime {
+                days_since_2000,
+                ms_of_day: tod,
+            });
+            if fix.utc.is_some_and(UtcTime::is_valid) {
                 self.last_utc = fix.utc;
             }
         }

@@ -50,7 +50,10 @@ pub const FAULT_UNPARSEABLE: u8 = 5;
 /// GPS fault 6: a sentence of such a type parsed, but a field is outside
 /// what a receiver can mean (position off the globe, minutes of 60 or more,
 /// speed over 514 m/s, altitude outside -500 m to 18 km, more than 99
-/// satellites): none of it is used.
+/// satellites): none of it is used. Also counted, with the rest of the fix
+/// kept: an HDOP the record cannot hold (over 25.4 or negative; left
+/// unknown, never clamped), and a leap second (23:59:60) on a day that
+/// cannot end with one (the fix goes without its UTC).
 pub const FAULT_OUT_OF_RANGE: u8 = 6;
 /// Number of GPS fault codes (`1..=FAULT_CODES`).
 pub const FAULT_CODES: usize = 6;
@@ -197,6 +200,9 @@ impl GpsReceiver {
                     Sentence::Unparseable(_) => fault(FAULT_UNPARSEABLE, t_us),
                     Sentence::OutOfRange(_) => fault(FAULT_OUT_OF_RANGE, t_us),
                     Sentence::Update(kind, update) => {
+                        if update.hdop_out_of_range {
+                            fault(FAULT_OUT_OF_RANGE, t_us);
+                        }
                         // One sentence ends at most two epochs: the previous
                         // one and, when it is the learned closer, its own.
                         epoch.push(kind, &update, t_us, &mut |f| {
@@ -257,7 +263,16 @@ impl GpsReceiver {
             .unwrap_or(0)
     }
 
-    fn emit_fix(&mut self, fix: GpsFix, out: &mut impl FnMut(GpsEvent)) {
+    fn emit_fix(&mut self, mut fix: GpsFix, out: &mut impl FnMut(GpsEvent)) {
+        if fix.utc.is_some_and(|u| !u.is_valid()) {
+            // A leap second on a day that cannot end with one: a receiver
+            // error, counted; the fix goes without its UTC, as the decoder
+            // would drop it (`format::limits`).
+            fix.utc = None;
+            self.faults.count(FAULT_OUT_OF_RANGE, fix.t_us, &mut |f| {
+                out(GpsEvent::Fault(f))
+            });
+        }
         self.stats.fixes = self.stats.fixes.saturating_add(1);
         out(GpsEvent::Fix(fix));
         let Some(utc) = fix.utc.filter(|_| fix.fix != FixMode::None) else {

@@ -92,6 +92,10 @@ pub struct Update {
     pub sats: Option<u8>,
     /// HDOP, tenths.
     pub hdop_d: Option<u8>,
+    /// The sentence stated an HDOP the record cannot hold (negative, not a
+    /// number, or over 25.4): `hdop_d` is left unknown, never clamped, and
+    /// the GPS path counts a fault.
+    pub hdop_out_of_range: bool,
     /// Validity of the fix this sentence reports.
     pub validity: Validity,
     /// The 2D/3D mode a GSA states.
@@ -288,7 +292,8 @@ fn from_gga(d: &GgaData) -> Option<Update> {
             }
         }),
         sats: d.fix_satellites.map(|n| n.min(u32::from(u8::MAX)) as u8),
-        hdop_d: d.hdop.map(hdop_d),
+        hdop_d: d.hdop.and_then(hdop_d),
+        hdop_out_of_range: d.hdop.is_some_and(|h| hdop_d(h).is_none()),
         validity,
         ..Update::default()
     })
@@ -319,7 +324,8 @@ fn from_vtg(d: &VtgData) -> Option<Update> {
 fn from_gsa(d: &GsaData) -> Option<Update> {
     use nmea::sentences::gsa::GsaMode2;
     Some(Update {
-        hdop_d: d.hdop.map(hdop_d),
+        hdop_d: d.hdop.and_then(hdop_d),
+        hdop_out_of_range: d.hdop.is_some_and(|h| hdop_d(h).is_none()),
         gsa_mode: Some(match d.mode2 {
             GsaMode2::NoFix => FixMode::None,
             GsaMode2::Fix2D => FixMode::Fix2d,
@@ -374,8 +380,15 @@ fn course_cdeg(deg: f32) -> Option<u16> {
         .then(|| (quantise_i32(cdeg, 1.0) % i32::from(limits::COURSE_CDEG_END)) as u16)
 }
 
-fn hdop_d(hdop: f32) -> u8 {
-    quantise_i32(f64::from(hdop), 10.0).clamp(0, i32::from(u8::MAX)) as u8
+/// HDOP in tenths, `None` when the record cannot hold it.
+fn hdop_d(hdop: f32) -> Option<u8> {
+    let hdop = f64::from(hdop);
+    if !hdop.is_finite() || hdop < 0.0 {
+        return None;
+    }
+    u8::try_from(quantise_i32(hdop, 10.0))
+        .ok()
+        .filter(|&d| d <= limits::HDOP_D_MAX)
 }
 
 #[cfg(test)]

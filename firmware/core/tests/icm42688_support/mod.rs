@@ -34,6 +34,7 @@ pub fn data_read(words: [i16; 6]) -> Vec<Transaction<u8>> {
 /// Reset values of the two filter-order registers (datasheet section 14).
 const GYRO_CONFIG1_RESET: u8 = 0x16;
 const ACCEL_CONFIG1_RESET: u8 = 0x0D;
+const INT_CONFIG1_RESET: u8 = 0x10;
 
 /// The bus traffic of `init`: identity check, reset, filters, ranges and
 /// rate (`gyro_config0`, `accel_config0`), power.
@@ -63,6 +64,15 @@ pub fn init_sequence(gyro_config0: u8, accel_config0: u8) -> Vec<Transaction<u8>
         write_reg(ACCEL_CONFIG1, 0x15),
         // Both UI bandwidths index 4: 400 Hz / 10.
         write_reg(GYRO_ACCEL_CONFIG0, 0x44),
+        // FIFO: accel, gyro and temperature (packet 3), stream mode.
+        write_reg(FIFO_CONFIG1, 0x07),
+        write_reg(FIFO_CONFIG, 0x40),
+        // INT1 pulsed, push-pull, active high, on data ready; the async
+        // reset bit (1 at reset) cleared, the rest kept.
+        write_reg(INT_CONFIG, 0x03),
+        read_regs(INT_CONFIG1, &[INT_CONFIG1_RESET]),
+        write_reg(INT_CONFIG1, 0x00),
+        write_reg(INT_SOURCE0, 0x08),
         write_reg(PWR_MGMT0, 0x0F),
     ]
     .concat()

@@ -450,3 +450,75 @@ impl Campaign {
         Ok(logs)
     }
 }
+
+/// A ride that speeds up towards the wobble speed, kicked as it goes: the
+/// margin warning's test (on the host and under QEMU).
+#[derive(Clone, Debug)]
+pub struct SpeedUp {
+    /// Speed at the start and at the end, fractions of the wobble speed
+    /// (the start never below the rider's slowest balanced speed).
+    pub fractions: (f64, f64),
+    /// Length, s (the speed rises linearly over it).
+    pub duration_s: f64,
+    /// Time between kicks, s (the first at 2 s).
+    pub kick_every_s: f64,
+}
+
+impl Default for SpeedUp {
+    /// From 0.5 to 0.95 of the wobble speed in 120 s, a knock every 5 s.
+    fn default() -> Self {
+        Self {
+            fractions: (0.5, 0.95),
+            duration_s: 120.0,
+            kick_every_s: 5.0,
+        }
+    }
+}
+
+/// A ride of `variant` from `seed` as `plan` says: its simulation (the
+/// CSV, the kicks' truth) and the nominal bicycle's wobble speed, m/s.
+///
+/// # Errors
+/// The bicycle does not load, its wobble is stable at every speed, or the
+/// ride cannot be simulated.
+pub fn speed_up_ride(
+    variant: &Variant,
+    plan: &SpeedUp,
+    seed: u64,
+) -> Result<(Simulation, f64), String> {
+    let set = variant.params()?;
+    let mut nominal = Bike::from_set(&set, 1.0 / FS_HZ)?;
+    let wobble_speed = wobble_speed_mps(&mut nominal)
+        .ok_or_else(|| format!("{}: no wobble speed below 12 m/s", variant.name))?;
+    let from = (plan.fractions.0 * wobble_speed).max(MIN_BALANCED_MPS + 0.1);
+    let to = plan.fractions.1 * wobble_speed;
+    let mut rng = Rng::new(seed);
+    let mut kicks = Vec::new();
+    let mut t = 2.0;
+    while t < plan.duration_s - 3.0 {
+        let size = rng.range(10.0, 20.0);
+        kicks.push((t + rng.range(0.0, 0.5), size * rng.sign()));
+        t += plan.kick_every_s;
+    }
+    let recipe = Recipe {
+        name: format!("{}_speedup_s{seed}", variant.name),
+        description: format!(
+            "speeding up from {from:.2} to {to:.2} m/s (wobble speed {wobble_speed:.2} m/s), \
+             kicked every {} s, {}",
+            plan.kick_every_s, variant.description
+        ),
+        bike: variant.file,
+        changes: variant.changes.clone(),
+        seed: rng.next_u64(),
+        duration_s: plan.duration_s,
+        road: RoadClass::B,
+        speed: vec![(0.0, from), (plan.duration_s, to)],
+        grip_at_deg: None,
+        rider_nm: (0.05, 0.1),
+        kicks,
+        kick_s: KICK_S,
+        ripple_deg: 0.03,
+        committed: false,
+    };
+    Ok((recipe.simulate()?, wobble_speed))
+}

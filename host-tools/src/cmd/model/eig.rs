@@ -7,9 +7,9 @@ use std::io::Write;
 use std::path::PathBuf;
 
 use serde::Serialize;
-use wobble_model::{critical_speeds, CriticalSpeed, Sweep};
+use wobble_model::{Complex, CriticalSpeed, Mode, SweepError};
 
-use super::{load_as, sweep, Speeds, Variant};
+use super::{load_as, survey, Speeds, Variant};
 use crate::output::Output;
 use crate::CliError;
 
@@ -67,8 +67,22 @@ struct Row<'a> {
     im_rad_per_s: f64,
 }
 
-/// Runs `wobblog model eig`. The rows are written as they are formatted
-/// (one speed at a time), never held as a whole text.
+/// Why writing the rows stopped.
+enum Failure {
+    Write(std::io::Error),
+    Sweep(SweepError),
+}
+
+impl From<SweepError> for Failure {
+    fn from(e: SweepError) -> Self {
+        Self::Sweep(e)
+    }
+}
+
+/// Runs `wobblog model eig`. The sweep is never held whole: a first pass
+/// names the modes and finds the critical speeds, a second writes the rows
+/// speed by speed as it evaluates them, so memory does not grow with the
+/// number of speeds.
 pub fn run(args: &Args) -> Result<(), CliError> {
     let variant = match (args.whipple, args.contacts) {
         (true, _) => Variant::Whipple,
@@ -77,36 +91,55 @@ pub fn run(args: &Args) -> Result<(), CliError> {
     };
     let (_, model) = load_as(&args.params, variant)?;
     let mut out = Output::create_or_stdout(args.output.as_deref(), &[&args.params])?;
-    let sweep = sweep(&model, &args.speeds.0, &args.params)?;
-    let critical = critical_speeds(&model, &sweep);
-    let written = match args.format {
-        Format::Csv => {
-            for c in &critical {
-                eprintln!("wobblog: {}", describe(c));
-            }
-            write_csv(&mut out, &sweep)
+    let speeds = &args.speeds.0;
+    let survey = survey(&model, speeds, &args.params)?;
+    let critical = &survey.critical;
+    if args.format == Format::Csv {
+        for c in critical {
+            eprintln!("wobblog: {}", describe(c));
         }
-        Format::Table => write_table(&mut out, &sweep, &critical),
-        Format::Jsonl => write_jsonl(&mut out, &sweep, &critical),
+    }
+    let header: &[u8] = match args.format {
+        Format::Csv => b"speed_mps,mode,re_per_s,im_rad_per_s\n",
+        Format::Table => b"speed_mps  mode          re_per_s  im_rad_per_s   freq_hz\n",
+        Format::Jsonl => b"",
     };
-    written.map_err(|e| out.error(e))?;
+    out.write_all(header).map_err(|e| out.error(e))?;
+    let mut at = Vec::with_capacity(survey.modes.len());
+    let written = survey.replay(&model, speeds, |u, values| {
+        rows_at(&mut at, &survey.modes, values);
+        for &(mode, v) in &at {
+            write_row(&mut out, args.format, &row(u, mode, v)).map_err(Failure::Write)?;
+        }
+        Ok(())
+    });
+    match written {
+        Ok(()) => {}
+        Err(Failure::Write(e)) => return Err(out.error(e)),
+        Err(Failure::Sweep(e)) => return Err(CliError::file(&args.params, e)),
+    }
+    let tail = match args.format {
+        Format::Csv => Ok(()),
+        Format::Table => write_table_tail(&mut out, critical),
+        Format::Jsonl => write_jsonl_tail(&mut out, critical),
+    };
+    tail.map_err(|e| out.error(e))?;
     out.commit()
 }
 
-/// The rows at the `k`-th speed, by mode, then imaginary part.
-fn rows_at(sweep: &Sweep, k: usize) -> impl Iterator<Item = Row<'static>> {
-    let u = sweep.speeds_mps[k];
-    let mut at: Vec<_> = sweep
-        .branches
-        .iter()
-        .map(|b| (b.mode, b.values[k]))
-        .collect();
+/// The values at one speed as `(mode, value)`, by mode, then imaginary part.
+fn rows_at(at: &mut Vec<(Mode, Complex<f64>)>, modes: &[Mode], values: &[Complex<f64>]) {
+    at.clear();
+    at.extend(modes.iter().copied().zip(values.iter().copied()));
     at.sort_by(|a, b| {
         a.0.cmp(&b.0)
             .then(a.1.im.total_cmp(&b.1.im))
             .then(a.1.re.total_cmp(&b.1.re))
     });
-    at.into_iter().map(move |(mode, v)| Row {
+}
+
+fn row(u: f64, mode: Mode, v: Complex<f64>) -> Row<'static> {
+    Row {
         speed_mps: u,
         mode: mode.name(),
         re_per_s: v.re,
@@ -116,34 +149,17 @@ fn rows_at(sweep: &Sweep, k: usize) -> impl Iterator<Item = Row<'static>> {
         } else {
             v.im
         },
-    })
+    }
 }
 
-/// Every row, in speed order.
-fn rows(sweep: &Sweep) -> impl Iterator<Item = Row<'static>> + '_ {
-    (0..sweep.speeds_mps.len()).flat_map(move |k| rows_at(sweep, k))
-}
-
-fn write_csv(o: &mut dyn Write, sweep: &Sweep) -> std::io::Result<()> {
-    o.write_all(b"speed_mps,mode,re_per_s,im_rad_per_s\n")?;
-    for r in rows(sweep) {
-        writeln!(
+fn write_row(o: &mut dyn Write, format: Format, r: &Row) -> std::io::Result<()> {
+    match format {
+        Format::Csv => writeln!(
             o,
             "{},{},{},{}",
             r.speed_mps, r.mode, r.re_per_s, r.im_rad_per_s
-        )?;
-    }
-    Ok(())
-}
-
-fn write_table(
-    o: &mut dyn Write,
-    sweep: &Sweep,
-    critical: &[CriticalSpeed],
-) -> std::io::Result<()> {
-    o.write_all(b"speed_mps  mode          re_per_s  im_rad_per_s   freq_hz\n")?;
-    for r in rows(sweep) {
-        writeln!(
+        ),
+        Format::Table => writeln!(
             o,
             "{:9.3}  {:<9}  {:11.5}  {:12.5}  {:8.4}",
             r.speed_mps,
@@ -151,8 +167,15 @@ fn write_table(
             r.re_per_s,
             r.im_rad_per_s,
             r.im_rad_per_s.abs() / std::f64::consts::TAU
-        )?;
+        ),
+        Format::Jsonl => {
+            serde_json::to_writer(&mut *o, r)?;
+            o.write_all(b"\n")
+        }
     }
+}
+
+fn write_table_tail(o: &mut dyn Write, critical: &[CriticalSpeed]) -> std::io::Result<()> {
     o.write_all(b"\ncritical speeds:\n")?;
     if critical.is_empty() {
         o.write_all(b"  none in this speed range\n")?;
@@ -163,15 +186,7 @@ fn write_table(
     Ok(())
 }
 
-fn write_jsonl(
-    o: &mut dyn Write,
-    sweep: &Sweep,
-    critical: &[CriticalSpeed],
-) -> std::io::Result<()> {
-    for r in rows(sweep) {
-        serde_json::to_writer(&mut *o, &r)?;
-        o.write_all(b"\n")?;
-    }
+fn write_jsonl_tail(o: &mut dyn Write, critical: &[CriticalSpeed]) -> std::io::Result<()> {
     for c in critical {
         let line = serde_json::json!({
             "critical_speed_mps": c.speed_mps,

@@ -86,6 +86,34 @@ fn runs(speeds: &[f64], values: impl Iterator<Item = Option<f64>>) -> Vec<Vec<(f
     out
 }
 
+/// Shortest segment of a wide line, pixels.
+const MIN_SEGMENT_PX: i32 = 16;
+
+/// The points of `run` at least [`MIN_SEGMENT_PX`] from the last one kept
+/// (the ends always kept). plotters fills a line wider than one pixel as a
+/// polygon on whole-pixel corners offset from each segment's direction, so a
+/// fine sweep's 1-3 px segments, whose directions the rounding scatters, give
+/// it a stair-stepped edge; the curves are smooth at this scale.
+fn spaced(run: Vec<(f64, f64)>, px: impl Fn(&(f64, f64)) -> (i32, i32)) -> Vec<(f64, f64)> {
+    let Some(&last) = run.last() else {
+        return run;
+    };
+    let mut out: Vec<(f64, f64)> = Vec::with_capacity(run.len());
+    for p in run {
+        let far = out.last().is_none_or(|q| {
+            let (a, b) = (px(q), px(&p));
+            (a.0 - b.0).abs().max((a.1 - b.1).abs()) >= MIN_SEGMENT_PX
+        });
+        if far {
+            out.push(p);
+        }
+    }
+    if out.last() != Some(&last) {
+        out.push(last);
+    }
+    out
+}
+
 impl EigenFigure {
     fn branches(&self) -> impl Iterator<Item = (&Layer, &wobble_model::Branch)> {
         self.layers.iter().flat_map(move |l| {
@@ -163,7 +191,10 @@ impl EigenFigure {
                 branch.values.iter().map(|v| pick(*v)),
             ) {
                 let series = match layer.line {
-                    Line::Thick => chart.draw_series(LineSeries::new(run, c.stroke_width(3))),
+                    Line::Thick => chart.draw_series(LineSeries::new(
+                        spaced(run, |p| chart.backend_coord(p)),
+                        c.stroke_width(3),
+                    )),
                     Line::Thin => chart.draw_series(LineSeries::new(run, c.stroke_width(1))),
                     Line::Dotted => {
                         chart.draw_series(DashedLineSeries::new(run, 2, 4, c.stroke_width(2)))
@@ -245,5 +276,29 @@ impl Figure for EigenFigure {
         let (top, bottom) = root.split_vertically(480);
         self.panel(&top, false)?;
         self.panel(&bottom, true)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A fine sweep's points 1 px apart become segments of at least 16 px
+    /// (the last one may be shorter), with both ends kept.
+    #[test]
+    fn wide_lines_get_segments_of_at_least_16_px() {
+        let run: Vec<(f64, f64)> = (0..=100)
+            .map(|i| (f64::from(i), (f64::from(i) * 0.1).sin()))
+            .collect();
+        let px = |p: &(f64, f64)| (p.0.round() as i32, (p.1 * 50.0).round() as i32);
+        let out = spaced(run.clone(), px);
+        assert_eq!(out.first(), run.first());
+        assert_eq!(out.last(), run.last());
+        assert!(out.len() < run.len() / 4, "{} points", out.len());
+        for w in out[..out.len() - 1].windows(2) {
+            let (a, b) = (px(&w[0]), px(&w[1]));
+            assert!((a.0 - b.0).abs().max((a.1 - b.1).abs()) >= MIN_SEGMENT_PX);
+        }
+        assert!(spaced(Vec::new(), px).is_empty());
     }
 }

@@ -13,7 +13,7 @@ use std::path::Path;
 use std::str::FromStr;
 
 use indicatif::{ProgressBar, ProgressStyle};
-use wobble_model::{Model, ParamError, ParamSet, Sweep};
+use wobble_model::{Model, ParamError, ParamSet, Survey, Sweep};
 
 use crate::CliError;
 
@@ -147,17 +147,34 @@ pub fn load_as(path: &Path, variant: Variant) -> Result<(ParamSet, Model), CliEr
 /// Eigenvalues of `model` at every speed, behind a progress bar on long
 /// sweeps (drawn only when stderr is a terminal).
 pub fn sweep(model: &Model, speeds: &[f64], file: &Path) -> Result<Sweep, CliError> {
-    let bar = if speeds.len() > PROGRESS_MIN_SPEEDS {
-        ProgressBar::new(speeds.len() as u64)
-    } else {
-        ProgressBar::hidden()
-    };
-    if let Ok(style) = ProgressStyle::with_template("eigenvalues {bar:40} {pos}/{len} speeds") {
-        bar.set_style(style.progress_chars("=> "));
-    }
+    let bar = progress_bar(speeds.len(), "eigenvalues");
     let sweep = Sweep::run(model, speeds, |_| bar.inc(1));
     bar.finish_and_clear();
     sweep.map_err(|e| CliError::file(file, e))
+}
+
+/// [`sweep`] without holding the values: the modes and critical speeds of
+/// `model` over `speeds`, for [`Survey::replay`] to give the values.
+pub fn survey(model: &Model, speeds: &[f64], file: &Path) -> Result<Survey, CliError> {
+    let bar = progress_bar(speeds.len(), "modes");
+    let survey = Survey::run(model, speeds, |_| bar.inc(1));
+    bar.finish_and_clear();
+    survey.map_err(|e| CliError::file(file, e))
+}
+
+/// A progress bar over `speeds` speeds, hidden on short sweeps.
+fn progress_bar(speeds: usize, what: &str) -> ProgressBar {
+    let bar = if speeds > PROGRESS_MIN_SPEEDS {
+        ProgressBar::new(speeds as u64)
+    } else {
+        ProgressBar::hidden()
+    };
+    if let Ok(style) =
+        ProgressStyle::with_template(&format!("{what} {{bar:40}} {{pos}}/{{len}} speeds"))
+    {
+        bar.set_style(style.progress_chars("=> "));
+    }
+    bar
 }
 
 #[cfg(test)]

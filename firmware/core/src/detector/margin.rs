@@ -1,0 +1,619 @@
+//! The margin warning: a running estimate of the wobble speed from the
+//! kicks of the current ride, and the warning that the speed is getting
+//! close to it.
+//!
+//! Each kick's ring-down ([`Kick`]) gives the wobble mode's growth rate
+//! sigma at its speed; sigma rises towards zero as the speed approaches the
+//! wobble speed. The estimate is the host's `wobblog margin` method
+//! (`host-tools/src/analysis/margin.rs`) in `f32` over the last
+//! [`MAX_KICKS`] kicks with a known speed:
+//!
+//! - a straight line `sigma = a + b u`, each kick weighted by `1 / sd^2`
+//!   (its standard error, floored at [`MIN_SD_PER_S`]) and made robust by
+//!   Tukey's bisquare (iteratively reweighted, scale from the median
+//!   absolute deviation and never below the kicks' own uncertainties), so
+//!   one bad kick cannot move it;
+//! - the wobble speed is the zero `-a / b`; its 95 % interval is Fieller's
+//!   (the speeds at which the line is not significantly different from
+//!   zero, t with `n - 2` degrees of freedom on the covariance scaled by the
+//!   residual scatter): the *lower bound* is what the warning uses;
+//! - no estimate from fewer than [`MIN_KICKS`] kicks carrying weight, a
+//!   speed range narrower than [`MIN_SPAN_MPS`], or a slope that is not
+//!   positive; the upper end is left open when the rise of sigma is not
+//!   significant or the zero lies further beyond the fastest kick than the
+//!   range measured.
+//!
+//! The warning ([`MarginWarning::update`]) switches on as soon as the speed
+//! comes within the configured margin of the lower bound (the threshold
+//! moves with every kick), and off once the speed has stayed
+//! [`HYSTERESIS_MPS`] below the threshold for [`CLEAR_HOLD_US`].
+//!
+//! Cost: nothing per sample but two compares; per kick with a known speed,
+//! at most [`ITERATIONS`] weighted fits and median sorts over
+//! [`MAX_KICKS`] points (a few thousand operations). Memory: about 320
+//! bytes.
+
+use super::math::sqrtf;
+use super::ringdown::Kick;
+
+/// Kicks the estimate is made from: the latest ones (a ride that speeds up
+/// puts its most telling kicks last).
+pub const MAX_KICKS: usize = 24;
+/// Fewest kicks (carrying weight) an estimate is made from.
+pub const MIN_KICKS: usize = 6;
+/// Narrowest range of the kicks' speeds an estimate is made from, m/s.
+pub const MIN_SPAN_MPS: f32 = 0.75;
+/// Floor of a kick's uncertainty, 1/s: no kick is weighted as exact.
+pub const MIN_SD_PER_S: f32 = 0.02;
+/// Tukey's bisquare constant (95 % efficiency for Gaussian scatter).
+const BISQUARE_C: f32 = 4.685;
+/// Most reweighting passes (it converges in a handful).
+pub const ITERATIONS: usize = 20;
+/// The warning ends only when the speed is this far below its threshold...
+pub const HYSTERESIS_MPS: f32 = 0.2;
+/// ...for this long, µs: a rider easing off for a moment is still warned.
+pub const CLEAR_HOLD_US: u64 = 2_000_000;
+
+/// The wobble speed as the kicks of the ride so far predict it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct WobbleSpeed {
+    /// The zero of the fitted line, m/s (`None` when the rise of sigma
+    /// with speed is not significant: only the lower bound is known).
+    pub estimate_mps: Option<f32>,
+    /// Lower end of its 95 % interval, m/s.
+    pub lower_mps: f32,
+    /// Upper end of its 95 % interval, m/s (`None`: open).
+    pub upper_mps: Option<f32>,
+    /// Kicks that carry weight in the fit.
+    pub kicks: u8,
+}
+
+/// The warning switching, as [`MarginWarning::update`] reports it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum MarginEvent {
+    /// The speed came within the margin of the wobble speed's lower bound.
+    Approaching,
+    /// The speed has stayed below the threshold (less the hysteresis)
+    /// long enough.
+    Clear,
+}
+
+/// One kick as the fit sees it.
+#[derive(Clone, Copy, Debug, Default)]
+struct Point {
+    speed_mps: f32,
+    sigma_per_s: f32,
+    /// Base weight, `1 / sd^2`.
+    weight: f32,
+}
+
+/// The running estimate and the warning.
+#[derive(Clone, Debug)]
+pub struct MarginWarning {
+    margin_mps: f32,
+    points: [Point; MAX_KICKS],
+    len: usize,
+    /// Where the next kick goes (the oldest once full).
+    next: usize,
+    estimate: Option<WobbleSpeed>,
+    approaching: bool,
+    /// Since when the speed has been clear of the threshold.
+    clear_since_us: Option<u64>,
+}
+
+impl MarginWarning {
+    /// A warning `margin_mps` below the lower bound of the wobble speed
+    /// (negative or non-finite values count as 0).
+    #[must_use]
+    pub fn new(margin_mps: f32) -> Self {
+        Self {
+            margin_mps: if margin_mps > 0.0 && margin_mps.is_finite() {
+                margin_mps
+            } else {
+                0.0
+            },
+            points: [Point::default(); MAX_KICKS],
+            len: 0,
+            next: 0,
+            estimate: None,
+            approaching: false,
+            clear_since_us: None,
+        }
+    }
+
+    /// The estimate from the kicks so far, if they give one.
+    #[must_use]
+    pub fn estimate(&self) -> Option<WobbleSpeed> {
+        self.estimate
+    }
+
+    /// Whether the warning is on.
+    #[must_use]
+    pub fn approaching(&self) -> bool {
+        self.approaching
+    }
+
+    /// The speed at which the warning switches on, m/s, if there is an
+    /// estimate.
+    #[must_use]
+    pub fn threshold_mps(&self) -> Option<f32> {
+        self.estimate.map(|e| e.lower_mps - self.margin_mps)
+    }
+
+    /// Takes a measured kick and re-estimates; returns the new estimate,
+    /// if the kicks give one. A kick without a speed, or with a non-finite
+    /// growth rate or uncertainty, is left out (returns `None`, the
+    /// estimate unchanged).
+    pub fn add_kick(&mut self, kick: &Kick) -> Option<WobbleSpeed> {
+        let speed = kick.speed_mps.filter(|v| v.is_finite() && *v > 0.0)?;
+        if !(kick.sigma_per_s.is_finite() && kick.sigma_se_per_s.is_finite()) {
+            return None;
+        }
+        let sd = kick.sigma_se_per_s.max(MIN_SD_PER_S);
+        self.points[self.next] = Point {
+            speed_mps: speed,
+            sigma_per_s: kick.sigma_per_s,
+            weight: 1.0 / (sd * sd),
+        };
+        self.next = (self.next + 1) % MAX_KICKS;
+        self.len = (self.len + 1).min(MAX_KICKS);
+        self.estimate = estimate(&self.points[..self.len]);
+        self.estimate
+    }
+
+    /// The warning at `now_us` for the current speed (`None`: unknown,
+    /// nothing changes); returns the switching, if any.
+    pub fn update(&mut self, now_us: u64, speed_mps: Option<f32>) -> Option<MarginEvent> {
+        let speed = speed_mps.filter(|v| v.is_finite())?;
+        let threshold = self.threshold_mps();
+        if !self.approaching {
+            if threshold.is_some_and(|t| speed >= t) {
+                self.approaching = true;
+                self.clear_since_us = None;
+                return Some(MarginEvent::Approaching);
+            }
+            return None;
+        }
+        if threshold.is_some_and(|t| speed >= t - HYSTERESIS_MPS) {
+            self.clear_since_us = None;
+            return None;
+        }
+        let since = *self.clear_since_us.get_or_insert(now_us);
+        if now_us.saturating_sub(since) >= CLEAR_HOLD_US {
+            self.approaching = false;
+            self.clear_since_us = None;
+            return Some(MarginEvent::Clear);
+        }
+        None
+    }
+}
+
+/// 97.5 % quantile of Student's t with `dof` degrees of freedom (the
+/// Cornish-Fisher expansion about the normal quantile; within 0.2 % of the
+/// tables from 3 degrees of freedom on).
+#[must_use]
+pub fn t_975(dof: usize) -> f32 {
+    let z: f32 = 1.959_964;
+    let n = dof.max(1) as f32;
+    let (z2, z3) = (z * z, z * z * z);
+    let (z5, z7) = (z3 * z2, z3 * z2 * z2);
+    z + (z3 + z) / (4.0 * n)
+        + (5.0 * z5 + 16.0 * z3 + 3.0 * z) / (96.0 * n * n)
+        + (3.0 * z7 + 19.0 * z5 + 17.0 * z3 - 15.0 * z) / (384.0 * n * n * n)
+}
+
+/// A weighted straight line `sigma = a + b (u - centre)`.
+#[derive(Clone, Copy, Debug)]
+struct Line {
+    centre: f32,
+    a: f32,
+    b: f32,
+    /// `(X^T W X)^-1`: `[Vaa, Vab, Vbb]`.
+    inv: [f32; 3],
+}
+
+impl Line {
+    fn residual(&self, p: &Point) -> f32 {
+        p.sigma_per_s - self.a - self.b * (p.speed_mps - self.centre)
+    }
+}
+
+/// Weighted least squares through `points` with weights `w`, about the
+/// weighted mean speed (which keeps `f32` well conditioned); `None`
+/// without a spread in speed.
+fn weighted_line(points: &[Point], w: &[f32]) -> Option<Line> {
+    let (mut s, mut su, mut sy) = (0.0_f32, 0.0_f32, 0.0_f32);
+    for (p, &w) in points.iter().zip(w) {
+        s += w;
+        su += w * p.speed_mps;
+        sy += w * p.sigma_per_s;
+    }
+    if s.is_nan() || s <= 0.0 {
+        return None;
+    }
+    let (centre, a) = (su / s, sy / s);
+    let (mut suu, mut suy) = (0.0_f32, 0.0_f32);
+    for (p, &w) in points.iter().zip(w) {
+        let du = p.speed_mps - centre;
+        suu += w * du * du;
+        suy += w * du * (p.sigma_per_s - a);
+    }
+    if suu.is_nan() || suu <= 1e-9 * s {
+        return None;
+    }
+    Some(Line {
+        centre,
+        a,
+        b: suy / suu,
+        inv: [1.0 / s, 0.0, 1.0 / suu],
+    })
+}
+
+/// Median of `v` (sorted in place). An insertion sort: the slices hold at
+/// most [`MAX_KICKS`] values, and it costs far less flash than `core`'s
+/// general sort.
+fn median(v: &mut [f32]) -> f32 {
+    for i in 1..v.len() {
+        let mut j = i;
+        while j > 0 && v[j - 1] > v[j] {
+            v.swap(j - 1, j);
+            j -= 1;
+        }
+    }
+    match v.len() {
+        0 => 0.0,
+        n if n % 2 == 1 => v[n / 2],
+        n => 0.5 * (v[n / 2 - 1] + v[n / 2]),
+    }
+}
+
+/// The robust line: Tukey's bisquare by iterative reweighting. Returns the
+/// line and the final weights.
+fn robust_line(points: &[Point]) -> Option<(Line, [f32; MAX_KICKS])> {
+    let n = points.len();
+    let mut base = [0.0_f32; MAX_KICKS];
+    for (b, p) in base.iter_mut().zip(points) {
+        *b = p.weight;
+    }
+    let mut w = base;
+    let mut line = weighted_line(points, &base[..n])?;
+    for _ in 0..ITERATIONS {
+        // Residuals in units of each kick's own uncertainty.
+        let mut z = [0.0_f32; MAX_KICKS];
+        let mut abs = [0.0_f32; MAX_KICKS];
+        for k in 0..n {
+            z[k] = line.residual(&points[k]) * sqrtf(base[k]);
+            abs[k] = z[k].abs();
+        }
+        let scale = (1.482_6 * median(&mut abs[..n])).max(1.0);
+        for k in 0..n {
+            let r = z[k] / (BISQUARE_C * scale);
+            w[k] = if r.abs() < 1.0 {
+                let q = 1.0 - r * r;
+                base[k] * q * q
+            } else {
+                0.0
+            };
+        }
+        let next = weighted_line(points, &w[..n])?;
+        let moved =
+            (next.a - line.a).abs() + (next.b - line.b).abs() + (next.centre - line.centre).abs();
+        line = next;
+        if moved < 1e-6 {
+            break;
+        }
+    }
+    Some((line, w))
+}
+
+/// Fieller's interval of the zero of `a + b x`: the `x` where
+/// `(a + b x)^2 <= t^2 (Vaa + 2 x Vab + x^2 Vbb)`, for a positive slope.
+/// `(lo, Some(hi))` when bounded; `(lo, None)` when open above (the slope
+/// is not significant); `None` when no speed is excluded below either.
+fn fieller(a: f32, b: f32, cov: [f32; 3], t: f32) -> Option<(f32, Option<f32>)> {
+    let [vaa, vab, vbb] = cov;
+    let t2 = t * t;
+    let qa = b * b - t2 * vbb;
+    let qb = 2.0 * (a * b - t2 * vab);
+    let qc = a * a - t2 * vaa;
+    let disc = qb * qb - 4.0 * qa * qc;
+    if disc < 0.0 || disc.is_nan() {
+        return None;
+    }
+    let r = sqrtf(disc);
+    let (x1, x2) = ((-qb - r) / (2.0 * qa), (-qb + r) / (2.0 * qa));
+    if qa > 0.0 {
+        Some((x1.min(x2), Some(x1.max(x2))))
+    } else if qa < 0.0 {
+        // The complement of (x1, x2) holds the zero: its upper part.
+        Some((x1.max(x2), None))
+    } else {
+        None
+    }
+}
+
+/// The estimate from `points` (see the module docs).
+fn estimate(points: &[Point]) -> Option<WobbleSpeed> {
+    if points.len() < MIN_KICKS {
+        return None;
+    }
+    let (line, w) = robust_line(points)?;
+    let (mut used, mut lo_u, mut hi_u, mut ssr) = (0usize, f32::INFINITY, 0.0_f32, 0.0_f32);
+    for (p, &w) in points.iter().zip(&w) {
+        if w > 0.0 {
+            used += 1;
+            lo_u = lo_u.min(p.speed_mps);
+            hi_u = hi_u.max(p.speed_mps);
+            let r = line.residual(p);
+            ssr += w * r * r;
+        }
+    }
+    let span = hi_u - lo_u;
+    if used < MIN_KICKS || span.is_nan() || span < MIN_SPAN_MPS || line.b.is_nan() || line.b <= 0.0
+    {
+        return None;
+    }
+    let dof = used - 2;
+    // Residual variance of unit weight, never below what the kicks' own
+    // uncertainties say.
+    let s2 = (ssr / dof as f32).max(1.0);
+    let cov = line.inv.map(|v| v * s2);
+    let (lo, hi) = fieller(line.a, line.b, cov, t_975(dof))?;
+    let zero = line.centre - line.a / line.b;
+    let open = zero - hi_u > span;
+    let lower_mps = line.centre + lo;
+    if !lower_mps.is_finite() {
+        return None;
+    }
+    Some(WobbleSpeed {
+        estimate_mps: hi.map(|_| zero),
+        lower_mps,
+        upper_mps: hi.filter(|_| !open).map(|h| line.centre + h),
+        kicks: used as u8,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    extern crate std;
+    use super::*;
+    use proptest::prelude::*;
+
+    fn kick(speed: f32, sigma: f32, se: f32) -> Kick {
+        Kick {
+            samples_ago: 100,
+            speed_mps: Some(speed),
+            freq_hz: 7.0,
+            sigma_per_s: sigma,
+            sigma_se_per_s: se,
+            amp_deg: 1.5,
+            segments: 8,
+        }
+    }
+
+    /// Kicks at `speeds` on the line `slope (u - zero)`, plus `scatter`.
+    fn warning_after(points: &[(f32, f32)], se: f32) -> MarginWarning {
+        let mut m = MarginWarning::new(0.5);
+        for &(u, s) in points {
+            m.add_kick(&kick(u, s, se));
+        }
+        m
+    }
+
+    /// Published reference: Student's t 97.5 % quantiles (Fisher and
+    /// Yates tables): 2.571 (5), 2.228 (10), 2.086 (20), 2.042 (30).
+    #[test]
+    fn t_quantile_matches_the_tables() {
+        for (dof, want) in [(5, 2.5706), (10, 2.2281), (20, 2.0860), (30, 2.0423)] {
+            assert!((t_975(dof) - want).abs() < 0.005, "{dof}: {}", t_975(dof));
+        }
+    }
+
+    /// Ten kicks exactly on sigma = 1.5 (u - 4.2): the zero is the
+    /// line's, the interval holds it and is narrow.
+    #[test]
+    fn an_exact_line_gives_its_zero() {
+        let pts: std::vec::Vec<(f32, f32)> = (0..10)
+            .map(|i| {
+                let u = 2.0 + 0.2 * i as f32;
+                (u, 1.5 * (u - 4.2))
+            })
+            .collect();
+        let e = warning_after(&pts, 0.05).estimate().unwrap();
+        let w = e.estimate_mps.unwrap();
+        assert!((w - 4.2).abs() < 1e-3, "{e:?}");
+        let hi = e.upper_mps.unwrap();
+        assert!(
+            e.lower_mps < 4.2 && hi > 4.2 && hi - e.lower_mps < 0.3,
+            "{e:?}"
+        );
+        assert_eq!(e.kicks, 10);
+    }
+
+    /// Hand check of Fieller's bounds: a line through (0, -1) of slope 1
+    /// with a diagonal covariance; the bounds solve
+    /// `(x - 1)^2 = t^2 (Vaa + x^2 Vbb)`.
+    #[test]
+    fn fieller_bounds_solve_the_test() {
+        let (t, vaa, vbb) = (2.0, 0.01, 0.0025);
+        let (lo, hi) = fieller(-1.0, 1.0, [vaa, 0.0, vbb], t).unwrap();
+        for x in [lo, hi.unwrap()] {
+            let lhs = (x - 1.0) * (x - 1.0);
+            let rhs = t * t * (vaa + x * x * vbb);
+            assert!((lhs - rhs).abs() < 1e-4, "{x}");
+        }
+        assert!(lo < 1.0 && hi.unwrap() > 1.0);
+        // A slope within its noise: a lower bound only.
+        let (lo, hi) = fieller(-1.0, 0.05, [vaa, 0.0, vbb], t).unwrap();
+        assert!(hi.is_none() && lo.is_finite(), "{lo}");
+    }
+
+    #[test]
+    fn too_few_kicks_or_too_narrow_a_range_give_no_estimate() {
+        let line = |u: f32| 1.5 * (u - 4.2);
+        // Five kicks over 2 m/s: too few.
+        let few: std::vec::Vec<_> = (0..5).map(|i| 2.0 + 0.5 * i as f32).collect();
+        let m = warning_after(
+            &few.iter()
+                .map(|&u| (u, line(u)))
+                .collect::<std::vec::Vec<_>>(),
+            0.05,
+        );
+        assert_eq!(m.estimate(), None);
+        // Twelve kicks within 0.6 m/s: too narrow.
+        let narrow: std::vec::Vec<_> = (0..12)
+            .map(|i| (3.0 + 0.05 * i as f32, line(3.0 + 0.05 * i as f32)))
+            .collect();
+        assert_eq!(warning_after(&narrow, 0.05).estimate(), None);
+        // A falling trend: no wobble speed ahead.
+        let falling: std::vec::Vec<_> = (0..8)
+            .map(|i| (2.0 + 0.2 * i as f32, -0.5 - 0.3 * i as f32))
+            .collect();
+        assert_eq!(warning_after(&falling, 0.05).estimate(), None);
+        // Kicks without a speed are left out.
+        let mut m = MarginWarning::new(0.5);
+        for i in 0..10 {
+            let mut k = kick(2.0 + 0.2 * i as f32, -1.0, 0.05);
+            k.speed_mps = None;
+            assert_eq!(m.add_kick(&k), None);
+        }
+        assert_eq!(m.len, 0);
+    }
+
+    #[test]
+    fn one_wild_kick_does_not_move_the_estimate() {
+        let mut pts: std::vec::Vec<(f32, f32)> = (0..10)
+            .map(|i| {
+                let u = 2.0 + 0.2 * i as f32;
+                (u, 1.5 * (u - 4.2) + if i % 2 == 0 { 0.05 } else { -0.05 })
+            })
+            .collect();
+        let clean = warning_after(&pts, 0.05).estimate().unwrap();
+        pts[4].1 = -8.0;
+        let wild = warning_after(&pts, 0.05).estimate().unwrap();
+        assert_eq!(wild.kicks, 9, "{wild:?}");
+        let (c, w) = (clean.estimate_mps.unwrap(), wild.estimate_mps.unwrap());
+        assert!((c - w).abs() < 0.02, "{clean:?} {wild:?}");
+    }
+
+    #[test]
+    fn the_latest_kicks_replace_the_oldest() {
+        // 24 kicks on one bicycle, then 24 on another: only the second
+        // counts.
+        let mut m = MarginWarning::new(0.5);
+        for i in 0..MAX_KICKS {
+            let u = 2.0 + 0.1 * i as f32;
+            m.add_kick(&kick(u, 1.5 * (u - 6.0), 0.05));
+        }
+        for i in 0..MAX_KICKS {
+            let u = 2.0 + 0.1 * i as f32;
+            m.add_kick(&kick(u, 1.5 * (u - 4.0), 0.05));
+        }
+        let w = m.estimate().unwrap().estimate_mps.unwrap();
+        assert!((w - 4.0).abs() < 1e-2, "{w}");
+    }
+
+    /// An estimate whose lower bound is 3.5 m/s (margin 0.5: threshold
+    /// 3.0 m/s).
+    fn armed() -> MarginWarning {
+        let mut m = MarginWarning::new(0.5);
+        m.estimate = Some(WobbleSpeed {
+            estimate_mps: Some(4.0),
+            lower_mps: 3.5,
+            upper_mps: Some(4.5),
+            kicks: 8,
+        });
+        m
+    }
+
+    #[test]
+    fn the_warning_switches_on_at_the_threshold_and_off_after_the_hold() {
+        let mut m = armed();
+        assert_eq!(m.threshold_mps(), Some(3.0));
+        assert_eq!(m.update(0, Some(2.99)), None);
+        assert_eq!(m.update(10_000, None), None);
+        assert_eq!(m.update(20_000, Some(3.0)), Some(MarginEvent::Approaching));
+        assert!(m.approaching());
+        assert_eq!(m.update(30_000, Some(3.5)), None);
+        // Inside the hysteresis: stays on however long.
+        assert_eq!(m.update(5_000_000, Some(2.81)), None);
+        // Below it: off once it stayed below for the hold.
+        assert_eq!(m.update(6_000_000, Some(2.79)), None);
+        assert_eq!(m.update(7_000_000, Some(2.0)), None);
+        // A moment back up restarts the hold.
+        assert_eq!(m.update(7_500_000, Some(2.9)), None);
+        assert_eq!(m.update(7_510_000, Some(2.0)), None);
+        assert_eq!(m.update(9_509_999, Some(2.0)), None);
+        assert_eq!(m.update(9_510_000, Some(2.0)), Some(MarginEvent::Clear));
+        assert!(!m.approaching());
+    }
+
+    #[test]
+    fn without_an_estimate_there_is_no_warning() {
+        let mut m = MarginWarning::new(0.5);
+        assert_eq!(m.update(0, Some(30.0)), None);
+        assert_eq!(MarginWarning::new(f32::NAN).margin_mps, 0.0);
+        assert_eq!(MarginWarning::new(-1.0).margin_mps, 0.0);
+    }
+
+    proptest! {
+        /// Kicks on a line through a known zero with scatter within their
+        /// stated uncertainty: the estimate is near the zero, and the
+        /// interval is ordered and holds the estimate.
+        #[test]
+        fn the_estimate_finds_the_zero_of_a_noisy_line(
+            zero in 3.0f32..7.0,
+            slope in 0.5f32..3.0,
+            n in MIN_KICKS..=MAX_KICKS,
+            noise in prop::collection::vec(-1.0f32..1.0, MAX_KICKS),
+        ) {
+            let se = 0.1;
+            let m = warning_after(
+                &(0..n)
+                    .map(|i| {
+                        let u = zero * (0.5 + 0.35 * i as f32 / (n - 1) as f32);
+                        (u, slope * (u - zero) + se * noise[i])
+                    })
+                    .collect::<std::vec::Vec<_>>(),
+                se,
+            );
+            let e = m.estimate().expect("an estimate");
+            prop_assert!(e.lower_mps <= e.estimate_mps.unwrap_or(f32::INFINITY));
+            if let Some(w) = e.estimate_mps {
+                prop_assert!((w - zero).abs() < 0.1 * zero, "{:?} for {}", e, zero);
+                if let Some(hi) = e.upper_mps {
+                    prop_assert!(hi >= w);
+                }
+            }
+            prop_assert!(e.lower_mps < zero + 0.1 * zero, "{:?} for {}", e, zero);
+        }
+
+        /// Whatever the kicks (non-finite values included), the estimator
+        /// never panics, and an estimate it gives is finite and ordered.
+        #[test]
+        fn any_kicks_are_taken_without_panic(
+            kicks in prop::collection::vec(
+                (prop::option::of(-10.0f32..40.0), -50.0f32..50.0, 0.0f32..10.0, any::<u8>()),
+                0..60,
+            ),
+        ) {
+            let mut m = MarginWarning::new(0.5);
+            for (speed, sigma, se, bits) in kicks {
+                let sigma = if bits == 0 { f32::NAN } else { sigma };
+                let se = if bits == 1 { f32::INFINITY } else { se };
+                let mut k = kick(1.0, sigma, se);
+                k.speed_mps = speed;
+                if let Some(e) = m.add_kick(&k) {
+                    prop_assert!(e.lower_mps.is_finite());
+                    prop_assert!(usize::from(e.kicks) >= MIN_KICKS);
+                    if let Some(w) = e.estimate_mps {
+                        prop_assert!(w.is_finite() && e.lower_mps <= w);
+                    }
+                }
+                let _ = m.update(0, speed);
+            }
+        }
+    }
+}
