@@ -60,25 +60,7 @@ fn run_number(path: &Path) -> Option<u32> {
 /// An unreadable directory, no logs, a log whose name carries no run
 /// number, or two logs of one card with the same run number.
 pub fn campaign_logs(dir: &Path) -> Result<Vec<LogEntry>, CliError> {
-    let mut cards: Vec<(Option<String>, Vec<PathBuf>)> = Vec::new();
-    let top = logs_in(dir)?;
-    if top.is_empty() {
-        let mut subdirs: Vec<PathBuf> = std::fs::read_dir(dir)
-            .map_err(|e| CliError::file(dir, e))?
-            .filter_map(|e| e.ok().map(|e| e.path()))
-            .filter(|p| p.is_dir())
-            .collect();
-        subdirs.sort();
-        for sub in subdirs {
-            let logs = logs_in(&sub)?;
-            if !logs.is_empty() {
-                let name = sub.file_name().map(|n| n.to_string_lossy().into_owned());
-                cards.push((name, logs));
-            }
-        }
-    } else {
-        cards.push((None, top));
-    }
+    let cards = cards_in(dir)?;
     let mut entries: Vec<LogEntry> = Vec::new();
     for (card, logs) in cards {
         for path in logs {
@@ -99,13 +81,45 @@ pub fn campaign_logs(dir: &Path) -> Result<Vec<LogEntry>, CliError> {
             entries.push(entry);
         }
     }
-    if entries.is_empty() {
+    Ok(entries)
+}
+
+/// A card's name (none for a card given itself) and its logs.
+pub type Card = (Option<String>, Vec<PathBuf>);
+
+/// The logs of a card (`*.WBL` at the top of `dir`: one card, no name) or
+/// of a folder of cards (none at the top: each subdirectory with logs is a
+/// card, named after it), cards and logs sorted by name.
+///
+/// # Errors
+/// An unreadable directory, or no log at either level.
+pub fn cards_in(dir: &Path) -> Result<Vec<Card>, CliError> {
+    let mut cards: Vec<Card> = Vec::new();
+    let top = logs_in(dir)?;
+    if top.is_empty() {
+        let mut subdirs: Vec<PathBuf> = std::fs::read_dir(dir)
+            .map_err(|e| CliError::file(dir, e))?
+            .filter_map(|e| e.ok().map(|e| e.path()))
+            .filter(|p| p.is_dir())
+            .collect();
+        subdirs.sort();
+        for sub in subdirs {
+            let logs = logs_in(&sub)?;
+            if !logs.is_empty() {
+                let name = sub.file_name().map(|n| n.to_string_lossy().into_owned());
+                cards.push((name, logs));
+            }
+        }
+    } else {
+        cards.push((None, top));
+    }
+    if cards.is_empty() {
         return Err(CliError::file(
             dir,
             "no *.WBL logs here or in its subdirectories",
         ));
     }
-    Ok(entries)
+    Ok(cards)
 }
 
 /// One run's row of `runs.parquet`.

@@ -23,8 +23,8 @@ pub struct CsvRow {
     pub frame: Frame,
     /// The GPS fix the row gives.
     pub gps: Option<GpsFix>,
-    /// UTC, ms since 1970.
-    pub utc_ms: Option<i64>,
+    /// UTC, µs since 1970.
+    pub utc_us: Option<i64>,
 }
 
 /// Resamples rows (time strictly increasing) onto a grid `period_us` apart.
@@ -93,7 +93,7 @@ fn between(a: &CsvRow, b: &CsvRow, t_us: u64) -> CsvRow {
     let lerp = |x: f64, y: f64| x + w * (y - x);
     // Between two stored counts, so the rounded value is one too.
     let i16_at = |x: i16, y: i16| lerp(f64::from(x), f64::from(y)).round() as i16;
-    let since_ms = (t_us - fa.t_us) as f64 / 1000.0;
+    let since_us = t_us - fa.t_us;
     CsvRow {
         frame: Frame {
             t_us,
@@ -104,7 +104,7 @@ fn between(a: &CsvRow, b: &CsvRow, t_us: u64) -> CsvRow {
             ..*fa
         },
         gps: a.gps,
-        utc_ms: a.utc_ms.map(|ms| ms + since_ms.round() as i64),
+        utc_us: a.utc_us.map(|us| us + since_us as i64),
     }
 }
 
@@ -130,7 +130,7 @@ mod tests {
                 lat_e7: Some(i32::from(v)),
                 ..GpsFix::default()
             }),
-            utc_ms: Some(1_600_000_000_000 + (t_us / 1000) as i64),
+            utc_us: Some(1_600_000_000_000_000 + t_us as i64),
         }
     }
 
@@ -158,7 +158,7 @@ mod tests {
         for f in &out {
             let ms = (f.frame.t_us / 1000) as i16;
             assert_eq!(f.frame, row(f.frame.t_us, ms).frame);
-            assert_eq!(f.utc_ms, Some(1_600_000_000_000 + i64::from(ms)));
+            assert_eq!(f.utc_us, Some(1_600_000_000_000_000 + f.frame.t_us as i64));
             // The fix of the row at or before the frame, never made up.
             assert_eq!(f.gps, rows[(f.frame.t_us / 25_000) as usize].gps);
         }

@@ -3,11 +3,11 @@
 use std::collections::BTreeMap;
 
 use serde::Serialize;
-use wobble_core::format::{DecodeStats, Event, Record};
+use wobble_core::format::{DecodeStats, Event, KickRingDown, Record};
 
 use crate::losses::Losses;
 use crate::rows::{Row, RowAssembler};
-use crate::time::iso8601_unix_ms;
+use crate::time::iso8601_unix_us;
 
 /// One wobble alert, from its switching on to its switching off.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
@@ -20,6 +20,36 @@ pub struct AlertSpan {
     pub freq_hz: f32,
     /// Steering amplitude when it switched on, degrees.
     pub amp_deg: f32,
+}
+
+/// How many records of one kind a log holds, and how often they came.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct RecordCount {
+    /// Records of the kind.
+    pub count: u64,
+    /// Records per second of the time the frames cover (`duration_s`);
+    /// absent when the frames cover no time.
+    pub rate_hz: Option<f64>,
+}
+
+/// The name `info` gives records of `record`'s kind.
+fn kind_name(record: &Record<'_>) -> &'static str {
+    match record {
+        Record::Frame(_) => "frame",
+        Record::Gps(g) if g.lat_e7.is_some() && g.lon_e7.is_some() => "gps_fix",
+        Record::Gps(_) => "gps_no_position",
+        Record::UtcSync(_) => "utc_sync",
+        Record::Alert(a) if a.on => "alert_on",
+        Record::Alert(_) => "alert_off",
+        Record::Marker(_) => "marker",
+        Record::Dropout(_) => "dropout",
+        Record::Fault(_) => "fault",
+        Record::Kick(_) => "kick",
+        Record::Margin(_) => "margin",
+        Record::LogInfo(_) => "log_info",
+        Record::Channel(_) => "channel",
+        Record::Config(_) => "config",
+    }
 }
 
 /// Summary of one log.
@@ -87,8 +117,17 @@ pub struct Summary {
     pub alerts: Vec<AlertSpan>,
     /// Rider markers, s.
     pub markers: Vec<f64>,
+    /// Kick ring-downs measured on board (kick records; `wobblog events`
+    /// lists them, `wobblog margin` uses them).
+    pub kicks: u64,
+    /// The kick records themselves, in file order.
+    #[serde(skip)]
+    pub kick_records: Vec<KickRingDown>,
     /// Fault records by source: number of faults counted.
     pub faults: BTreeMap<&'static str, u64>,
+    /// Records by kind (`frame`, `gps_fix`, `utc_sync`, ...): the log's
+    /// channels, as `ulog_info` lists a log's messages.
+    pub records: BTreeMap<&'static str, RecordCount>,
     /// Everything lost, in detail.
     pub losses: Losses,
     /// The GPS sync pairs (s since boot, UTC ms since 1970), in time order:
@@ -177,6 +216,7 @@ impl SummaryBuilder {
         let Event::Record(record) = event else { return };
         let s = &mut self.summary;
         let t_s = record.t_us() as f64 / 1e6;
+        s.records.entry(kind_name(record)).or_default().count += 1;
         match record {
             Record::Frame(f) => {
                 s.samples += 1;
@@ -220,8 +260,12 @@ impl SummaryBuilder {
                 s.run = Some(info.run);
                 s.sample_rate_hz = Some(info.sample_rate_hz);
             }
-            // `wobblog events` lists the kicks and the margin warning.
-            Record::Channel(_) | Record::Kick(_) | Record::Margin(_) => {}
+            Record::Kick(k) => {
+                s.kicks += 1;
+                s.kick_records.push(*k);
+            }
+            // `wobblog events` lists the margin warning.
+            Record::Channel(_) | Record::Margin(_) => {}
             Record::Config(line) => s.config.push(line.text.to_string()),
         }
         let stats = &mut self.row_stats;
@@ -263,11 +307,14 @@ impl SummaryBuilder {
         self.rows.finish(&mut |row: &Row| row_stats.take(row));
         self.close_segment();
         let mut s = self.summary;
-        let utc_text = |us: Option<i64>| us.and_then(|us| iso8601_unix_ms(us.div_euclid(1000)));
+        let utc_text = |us: Option<i64>| us.and_then(iso8601_unix_us);
         s.first_utc = utc_text(self.row_stats.first_utc_us);
         s.first_utc_us = self.row_stats.first_utc_us;
         s.last_utc = utc_text(self.row_stats.last_utc_us);
         s.duration_s = self.closed_us as f64 / 1e6;
+        for kind in s.records.values_mut() {
+            kind.rate_hz = (s.duration_s > 0.0).then(|| kind.count as f64 / s.duration_s);
+        }
         s.gps_coverage_pct = if s.samples == 0 {
             0.0
         } else {

@@ -10,9 +10,16 @@ use wobble_core::format::UtcTime;
 const UNIX_MS_AT_2000: i64 = 10_957 * 86_400_000;
 const MS_PER_DAY: i64 = 86_400_000;
 
-/// `2020-03-18T13:28:20.600Z`.
+/// `2020-03-18T13:28:20.600Z`: a GPS fix's own time, to the millisecond
+/// it has.
 #[must_use]
 pub fn iso8601(utc: UtcTime) -> String {
+    iso8601_frac(utc, 0, 3)
+}
+
+/// `utc` plus `extra_us` (under a millisecond) with `digits` (3 or 6)
+/// decimals of the second; a leap second stays 23:59:60.
+fn iso8601_frac(utc: UtcTime, extra_us: u32, digits: usize) -> String {
     let (year, month, day) = utc.date();
     let ms = utc.ms_of_day;
     let (h, m, s, milli) = if ms >= 86_400_000 {
@@ -21,26 +28,55 @@ pub fn iso8601(utc: UtcTime) -> String {
     } else {
         (ms / 3_600_000, ms / 60_000 % 60, ms / 1000 % 60, ms % 1000)
     };
-    format!("{year:04}-{month:02}-{day:02}T{h:02}:{m:02}:{s:02}.{milli:03}Z")
+    let date = format!("{year:04}-{month:02}-{day:02}T{h:02}:{m:02}:{s:02}");
+    if digits == 6 {
+        format!("{date}.{milli:03}{extra_us:03}Z")
+    } else {
+        format!("{date}.{milli:03}Z")
+    }
 }
 
 /// The time `unix_ms` (milliseconds since 1970) as [`iso8601`] writes it;
 /// `None` outside the card's dates (2000 to 2179).
 #[must_use]
 pub fn iso8601_unix_ms(unix_ms: i64) -> Option<String> {
+    Some(iso8601(utc_time(unix_ms)?))
+}
+
+/// The time `unix_us` (microseconds since 1970) to the microsecond,
+/// `2020-03-18T13:28:20.600250Z`: every UTC the log's clock places (the
+/// `utc` column of every export, `info`, `events`, `wobble`, `summary`);
+/// `None` outside the card's dates.
+#[must_use]
+pub fn iso8601_unix_us(unix_us: i64) -> Option<String> {
+    let utc = utc_time(unix_us.div_euclid(1000))?;
+    // A remainder of 0 to 999 µs.
+    Some(iso8601_frac(utc, unix_us.rem_euclid(1000) as u32, 6))
+}
+
+/// The card's calendar form of `unix_ms`.
+fn utc_time(unix_ms: i64) -> Option<UtcTime> {
     let since_2000 = unix_ms.checked_sub(UNIX_MS_AT_2000)?;
     let days = u16::try_from(since_2000.div_euclid(MS_PER_DAY)).ok()?;
     let ms_of_day = u32::try_from(since_2000.rem_euclid(MS_PER_DAY)).ok()?;
-    Some(iso8601(UtcTime {
+    Some(UtcTime {
         days_since_2000: days,
         ms_of_day,
-    }))
+    })
 }
 
-/// Parses `YYYY-MM-DDTHH:MM:SS[.fff][Z]` (a space for the `T` also works)
-/// as UTC; milliseconds since 1970.
+/// Parses `YYYY-MM-DDTHH:MM:SS[.fff][Z]` as [`parse_iso8601_us`] does;
+/// milliseconds since 1970 (a finer fraction rounded down).
 #[must_use]
 pub fn parse_iso8601(text: &str) -> Option<i64> {
+    parse_iso8601_us(text).map(|us| us.div_euclid(1000))
+}
+
+/// Parses `YYYY-MM-DDTHH:MM:SS[.ffffff][Z]` (a space for the `T` also
+/// works; up to six decimals count, further ones are cut) as UTC;
+/// microseconds since 1970.
+#[must_use]
+pub fn parse_iso8601_us(text: &str) -> Option<i64> {
     let text = text.strip_suffix('Z').unwrap_or(text);
     let (date, time) = text.split_once(['T', ' '])?;
     let mut d = date.splitn(3, '-').map(str::parse::<u32>);
@@ -51,7 +87,8 @@ pub fn parse_iso8601(text: &str) -> Option<i64> {
     if h > 23 || m > 59 || s > 60 || !frac.bytes().all(|b| b.is_ascii_digit()) {
         return None;
     }
-    let milli = format!("{frac:0<3}")[..3].parse::<u32>().ok()?;
+    let frac_us = format!("{frac:0<6}")[..6].parse::<u32>().ok()?;
+    let milli = frac_us / 1000;
     let days = UtcTime::days_from_date(i32::try_from(year).ok()?, month, day)?;
     // A leap second only where one can be: 23:59:60 at the end of a month
     // that can end with one (June or December, say), not on any day.
@@ -66,11 +103,10 @@ pub fn parse_iso8601(text: &str) -> Option<i64> {
     if s == 60 && !leap_ok {
         return None;
     }
-    Some(
-        UNIX_MS_AT_2000
-            + i64::from(days) * MS_PER_DAY
-            + i64::from(((h * 60 + m) * 60 + s) * 1000 + milli),
-    )
+    let unix_ms = UNIX_MS_AT_2000
+        + i64::from(days) * MS_PER_DAY
+        + i64::from(((h * 60 + m) * 60 + s) * 1000 + milli);
+    Some(unix_ms * 1000 + i64::from(frac_us % 1000))
 }
 
 /// One end of a time window: seconds since boot, or an absolute UTC time.
@@ -143,6 +179,15 @@ pub fn utc_ms_at(pairs: &[SyncPair], t_s: f64) -> Option<i64> {
     Some(pair_ms + ((t_s - pair_s) * 1e3).round() as i64)
 }
 
+/// [`utc_ms_at`] in µs since 1970, rounded to the microsecond (the
+/// precision of the log's clock).
+#[must_use]
+pub fn utc_us_at(pairs: &[SyncPair], t_s: f64) -> Option<i64> {
+    let at = pairs.partition_point(|p| p.0 <= t_s).saturating_sub(1);
+    let (pair_s, pair_ms) = *pairs.get(at)?;
+    Some(pair_ms * 1000 + ((t_s - pair_s) * 1e6).round() as i64)
+}
+
 /// Why a UTC bound cannot be placed in a log.
 const NO_UTC_FOR_WINDOW: &str =
     "the log has no UTC time (no GPS sync pair), so a UTC --from/--to cannot be placed";
@@ -153,7 +198,7 @@ const NO_UTC_FOR_WINDOW: &str =
 #[must_use]
 pub fn utc_text_at(pairs: &[SyncPair], t_s: f64) -> Option<String> {
     let earlier = pairs.partition_point(|p| p.0 <= t_s);
-    utc_ms_at(&pairs[..earlier], t_s).and_then(iso8601_unix_ms)
+    utc_us_at(&pairs[..earlier], t_s).and_then(iso8601_unix_us)
 }
 
 /// The `--from/--to` of a command.
@@ -372,12 +417,43 @@ mod tests {
         assert!(!w.contains(10.0, Some(1_000_501)));
     }
 
+    #[test]
+    fn microseconds_print_and_parse() {
+        // 2020-03-18T13:28:20.600Z is 1584538100600 ms since 1970.
+        let us = 1_584_538_100_600_250;
+        assert_eq!(
+            iso8601_unix_us(us).as_deref(),
+            Some("2020-03-18T13:28:20.600250Z")
+        );
+        assert_eq!(parse_iso8601_us("2020-03-18T13:28:20.600250Z"), Some(us));
+        assert_eq!(parse_iso8601_us("2020-03-18T13:28:20.6002509Z"), Some(us));
+        assert_eq!(
+            parse_iso8601("2020-03-18T13:28:20.600999Z"),
+            Some(us / 1000)
+        );
+        assert_eq!(
+            iso8601_unix_us(946_684_800_000_000).as_deref(),
+            Some("2000-01-01T00:00:00.000000Z")
+        );
+        assert_eq!(iso8601_unix_us(946_684_799_999_999), None);
+        // Times since boot round to the nearest microsecond.
+        assert_eq!(utc_us_at(&[(1.0, 1000)], 1.000_000_6), Some(1_000_001));
+        assert_eq!(utc_us_at(&[(1.0, 1000)], 1.000_000_4), Some(1_000_000));
+    }
+
     proptest! {
         /// Formatting and parsing are inverse over the card's dates.
         #[test]
         fn iso_round_trip(ms in 946_684_800_000i64..6_000_000_000_000) {
             let text = iso8601_unix_ms(ms).unwrap();
             prop_assert_eq!(parse_iso8601(&text), Some(ms));
+        }
+
+        /// The same to the microsecond.
+        #[test]
+        fn iso_us_round_trip(us in 946_684_800_000_000i64..6_000_000_000_000_000) {
+            let text = iso8601_unix_us(us).unwrap();
+            prop_assert_eq!(parse_iso8601_us(&text), Some(us));
         }
     }
 }

@@ -20,6 +20,67 @@ fn info_reports_samples_duration_and_gps() {
     assert_eq!(info["gps_coverage_pct"], 100.0);
 }
 
+/// Kick records (tag 0x83) are counted, in the text and in JSON.
+#[test]
+fn info_counts_kicks() {
+    use analysis_support::{stdout_of, write_log, Extras, Ride};
+    use wobble_core::format::{KickRingDown, Record};
+    let dir = tempfile::tempdir().unwrap();
+    let log = dir.path().join("RUN00001.WBL");
+    let kick = |t_s: f64| {
+        Record::Kick(KickRingDown {
+            t_us: (t_s * 1e6) as u64,
+            speed_mm_s: Some(3100),
+            freq_chz: 620,
+            sigma_milli_per_s: -1800,
+            sigma_se_milli_per_s: 40,
+            amp_cdeg: 150,
+            segments: 9,
+        })
+    };
+    let extras = Extras {
+        markers_s: vec![4.0],
+        records: vec![kick(2.0), kick(6.0), kick(8.5)],
+        ..Extras::default()
+    };
+    write_log(&log, &Ride::new(10.0, 3.0, 0.0, 0.0, 0.0), &extras);
+    let info = info_json(&log);
+    assert_eq!(info["kicks"], 3, "{info}");
+    assert_eq!(info["records"]["kick"]["count"], 3, "{info}");
+    let text = stdout_of(wobblog().arg("info").arg(&log));
+    assert!(text.contains("kicks:        3 "), "{text}");
+}
+
+#[test]
+fn info_lists_records_by_kind_with_their_rates() {
+    let dir = tempfile::tempdir().unwrap();
+    let log = dir.path().join("RUN00003.WBL");
+    // 30 s at 100 Hz; a fix every 5th frame, none with a position in
+    // 22-29 s (140 of the 600); a sync pair every 10 s; one alert; two
+    // markers.
+    analysis_support::standard_log(&log);
+    let info = info_json(&log);
+    let records = &info["records"];
+    let count = |kind: &str| records[kind]["count"].as_u64();
+    let rate = |kind: &str| records[kind]["rate_hz"].as_f64().unwrap();
+    assert_eq!(count("frame"), Some(3000));
+    assert_eq!(rate("frame"), 100.0);
+    assert_eq!(count("gps_fix"), Some(460));
+    assert_eq!(count("gps_no_position"), Some(140));
+    assert!((rate("gps_fix") - 460.0 / 30.0).abs() < 1e-9);
+    assert_eq!(count("utc_sync"), Some(3));
+    assert_eq!((count("alert_on"), count("alert_off")), (Some(1), Some(1)));
+    assert_eq!(count("marker"), Some(2));
+    assert_eq!(count("kick"), None);
+    let text = analysis_support::stdout_of(wobblog().arg("info").arg(&log));
+    let frame_line = text
+        .lines()
+        .find(|l| l.trim_start().starts_with("frame "))
+        .unwrap();
+    let cells: Vec<&str> = frame_line.split_whitespace().collect();
+    assert_eq!(cells, ["frame", "3000", "100.000"], "{text}");
+}
+
 #[test]
 fn damaged_block_is_reported_with_its_frames_and_time() {
     let dir = tempfile::tempdir().unwrap();

@@ -194,7 +194,7 @@ fn mcap_is_compressed_in_utc_with_every_frame_fix_and_event_on_its_channel() {
     let meta = mcap::read::metadata(&bytes, &summary.metadata_indexes[0]).unwrap();
     assert_eq!(meta.name, "wobblog");
     assert_eq!(meta.metadata["run"], "3");
-    assert_eq!(meta.metadata["first_utc"], "2020-03-18T10:00:01.000Z");
+    assert_eq!(meta.metadata["first_utc"], "2020-03-18T10:00:01.000000Z");
 }
 
 #[test]

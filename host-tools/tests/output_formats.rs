@@ -7,7 +7,6 @@ mod analysis_support;
 use std::path::Path;
 
 use analysis_support::{python, wobblog, write_log, Extras, Ride};
-use serde_json::json;
 
 /// A 20 s ride from 1 s since boot whose GPS has no fix before 5 s: 400
 /// rows with empty GPS cells first, as on every real ride.
@@ -42,18 +41,21 @@ for path in sys.argv[1:]:
     sep = "\t" if ".tsv" in path else ","
     if ".jsonl" in path:
         frame = pd.read_json(path, lines=True)
-        # Polars' default infers from the first 100 lines only, which have
-        # no fix: the whole file must be scanned for the types.
+        # JSON has no NaN: the first 100 lines, which Polars' default types
+        # from, hold only nulls in the GPS keys, so the whole file is
+        # scanned for the types.
         polars = pl.read_ndjson(path, infer_schema_length=None)
     else:
         frame = pd.read_csv(path, sep=sep)
-        polars = pl.read_csv(path, separator=sep, infer_schema_length=None)
+        polars = pl.read_csv(path, separator=sep)
     fixed = frame[frame["gps_lat_deg"].notna()]
+    polars_fixed = polars.fill_nan(None).drop_nulls("gps_lat_deg")
     out[path.rsplit("/", 1)[1]] = {
         "rows": len(frame),
         "pandas": {c: str(frame[c].dtype) for c in ["t_s", "steer_deg", "gps_lat_deg", "gps_lon_deg", "gps_speed_mps"]},
-        "polars": {c: str(polars.schema[c]) for c in ["t_s", "gps_lat_deg", "gps_lon_deg"]},
-        "polars_default_lat": str(pl.read_csv(path, separator=sep).schema["gps_lat_deg"]) if ".jsonl" not in path else None,
+        "polars": {c: str(polars.schema[c]) for c in polars.columns},
+        "polars_fixes": len(polars_fixed),
+        "utc": polars_fixed["utc"][0],
         "fixes": len(fixed),
         "first_fix": [float(fixed["t_s"].iloc[0]), float(fixed["gps_lat_deg"].iloc[0]), float(fixed["gps_lon_deg"].iloc[0])],
     }
@@ -101,10 +103,23 @@ fn text_outputs_read_back_numeric_in_pandas_and_polars() {
         ] {
             assert_eq!(file["pandas"][column], "float64", "{name} {column}");
         }
-        for column in ["t_s", "gps_lat_deg", "gps_lon_deg"] {
-            assert_eq!(file["polars"][column], "Float64", "{name} {column}");
+        // Polars, default options for CSV: every number a Float64, the
+        // names and times text.
+        for (column, dtype) in file["polars"].as_object().unwrap() {
+            let text = ["gps_fix", "utc"].contains(&column.as_str());
+            let expected = if text { "String" } else { "Float64" };
+            assert_eq!(dtype, expected, "{name} {column}");
         }
+        assert_eq!(file["polars"].as_object().unwrap().len(), 14, "{name}");
         assert_eq!(file["fixes"], 1600, "{name}");
+        assert_eq!(file["polars_fixes"], 1600, "{name}");
+        // UTC to the microsecond (the log's first sync pair is at 10:00:00 UTC at boot).
+        let utc = file["utc"].as_str().unwrap();
+        assert_eq!(
+            utc.len(),
+            "2020-03-18T10:00:06.000000Z".len(),
+            "{name} {utc}"
+        );
         // Latitude and longitude each their own value (the track runs north
         // from 52.2 N along 6.88 E).
         let first = &file["first_fix"];
@@ -118,9 +133,6 @@ fn text_outputs_read_back_numeric_in_pandas_and_polars() {
             "{name} {first}"
         );
     }
-    // Polars' default CSV reader types from the first 100 rows: with no fix
-    // there it reads the GPS columns as text (docs/analysis.md says so).
-    assert_eq!(seen["run.csv"]["polars_default_lat"], json!("String"));
 }
 
 #[test]
@@ -146,7 +158,7 @@ fn a_delimiter_is_honoured_and_unknown_names_are_refused() {
     assert_eq!(reader.headers().unwrap(), vec!["t_s", "gps_lat_deg", "utc"]);
     let rows: Vec<csv::StringRecord> = reader.records().map(Result::unwrap).collect();
     assert_eq!(rows.len(), 2000);
-    assert_eq!(&rows[0][1], "");
+    assert_eq!(&rows[0][1], "NaN");
     assert!(rows[1999][1].parse::<f64>().is_ok());
 
     for name in ["run.json", "run.txt", "run.gpx", "run.parquet.gz"] {

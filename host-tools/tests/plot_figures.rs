@@ -165,7 +165,8 @@ fn utc_axis_is_labelled_from_the_sync_pairs() {
     );
     let labels = texts(&svg);
     assert!(labels.contains(&"UTC (hh:mm:ss)"), "{labels:?}");
-    assert!(labels.contains(&"10:00:12.0"), "{labels:?}");
+    // Five seconds: a tick every whole second.
+    assert!(labels.contains(&"10:00:12"), "{labels:?}");
     assert!(
         labels.contains(
             &"RUN00003.WBL: 10.0 to 15.0 s (UTC 2020-03-18 10:00:10.000 to 10:00:15.000)"
@@ -182,7 +183,7 @@ fn utc_axis_is_labelled_from_the_sync_pairs() {
     let ticks: Vec<f64> = texts(&svg)
         .into_iter()
         .filter_map(|t| t.strip_prefix("10:00:"))
-        .filter(|t| t.len() == 5)
+        .filter(|t| t.contains('.'))
         .map(|t| t.parse().unwrap())
         .collect();
     // The same ticks on each of the four panels.

@@ -114,7 +114,8 @@ proptest! {
                     prop_assert!((num(11) - speed).abs() <= 0.0051);
                     prop_assert_eq!(&rec[12], fix);
                 }
-                None => prop_assert!(rec[9].is_empty() && rec[12].is_empty()),
+                // A missing number is NaN, a missing name empty.
+                None => prop_assert!(&rec[9] == "NaN" && &rec[11] == "NaN" && rec[12].is_empty()),
             }
         }
     }
@@ -132,8 +133,8 @@ proptest! {
             for (name, field) in header.iter().zip(rec.iter()) {
                 match obj.get(name) {
                     Some(serde_json::Value::String(s)) => prop_assert_eq!(s.as_str(), field),
-                    // An empty cell is a null: every key is on every line.
-                    Some(serde_json::Value::Null) => prop_assert!(field.is_empty(), "{} null", name),
+                    // An empty or NaN cell is a null: every key is on every line.
+                    Some(serde_json::Value::Null) => prop_assert!(field.is_empty() || field == "NaN", "{} null", name),
                     Some(v) => prop_assert_eq!(v.as_f64().unwrap(), field.parse::<f64>().unwrap()),
                     None => prop_assert!(false, "{} missing from JSON", name),
                 }
@@ -147,18 +148,24 @@ proptest! {
 fn missing_columns_are_zero() {
     let out = round_trip("t_s,steer_deg\n0.01,1.5\n0.02,-2.25\n", Format::Csv);
     let lines: Vec<&str> = out.lines().collect();
-    assert_eq!(lines[1], "0.01,0.0,0.0,0.0,0.0,0.0,0.0,1.5,0.0,,,,,");
-    assert_eq!(lines[2], "0.02,0.0,0.0,0.0,0.0,0.0,0.0,-2.25,0.0,,,,,");
+    assert_eq!(
+        lines[1],
+        "0.01,0.0,0.0,0.0,0.0,0.0,0.0,1.5,0.0,NaN,NaN,NaN,,"
+    );
+    assert_eq!(
+        lines[2],
+        "0.02,0.0,0.0,0.0,0.0,0.0,0.0,-2.25,0.0,NaN,NaN,NaN,,"
+    );
 }
 
-/// `csv` with a `utc` column appended: `utc_ms[i]` for data row `i`, empty
-/// where `None`.
-fn with_utc(csv: &str, utc_ms: &[Option<i64>]) -> String {
+/// `csv` with a `utc` column appended: `utc_us[i]` (µs since 1970) for
+/// data row `i`, empty where `None`.
+fn with_utc(csv: &str, utc_us: &[Option<i64>]) -> String {
     let mut lines = csv.lines();
     let mut out = format!("{},utc\n", lines.next().unwrap());
-    for (line, ms) in lines.zip(utc_ms) {
-        let utc = ms.map_or(String::new(), |ms| {
-            wobblog::time::iso8601_unix_ms(ms).unwrap()
+    for (line, us) in lines.zip(utc_us) {
+        let utc = us.map_or(String::new(), |us| {
+            wobblog::time::iso8601_unix_us(us).unwrap()
         });
         out.push_str(&format!("{line},{utc}\n"));
     }
@@ -187,17 +194,17 @@ proptest! {
     /// stands still against UTC), the log built from it decodes to the same
     /// UTC text on every row; rows before the first UTC stay without one.
     #[test]
-    fn utc_round_trips_to_the_millisecond(
+    fn utc_round_trips_to_the_microsecond(
         rows in rows(),
-        start_ms in 946_684_810_000i64..4_102_444_000_000,
-        steps_ms in vec(prop_oneof![8 => Just(10i64), 1 => 0..12i64, 1 => -3..1000i64], 600),
+        start_us in 946_684_810_000_000i64..4_102_444_000_000_000,
+        steps_us in vec(prop_oneof![6 => Just(10_000i64), 2 => 9_990..10_010i64, 1 => 0..12_000i64, 1 => -3000..1_000_000i64], 600),
         first in 0..50usize,
     ) {
-        let mut ms = start_ms;
+        let mut us = start_us;
         let utc: Vec<Option<i64>> = (0..rows.len())
             .map(|i| {
-                ms += steps_ms[i];
-                (i >= first).then_some(ms)
+                us += steps_us[i];
+                (i >= first).then_some(us)
             })
             .collect();
         let given = with_utc(&to_csv(&rows), &utc);
@@ -210,10 +217,11 @@ proptest! {
 fn a_decoded_log_encodes_to_the_same_utc() {
     let dir = tempfile::tempdir().unwrap();
     let csv = dir.path().join("ride.csv");
-    let first = wobblog::time::parse_iso8601("2020-03-18T10:00:01.000Z").unwrap();
-    // A GPS clock 0.4 ms off the logger's frames, as real pairs are.
+    let first = wobblog::time::parse_iso8601_us("2020-03-18T10:00:01.000Z").unwrap();
+    // A GPS clock 0.4 ms off the logger's frames on some rows, as real
+    // pairs are.
     let utc: Vec<Option<i64>> = (0..3000)
-        .map(|i| (i >= 100).then(|| first + (i - 100) * 10 + i64::from(i % 7 == 0)))
+        .map(|i| (i >= 100).then(|| first + (i - 100) * 10_000 + 400 * i64::from(i % 7 == 0)))
         .collect();
     let rows: Vec<CsvRow> = (0..3000)
         .map(|i| CsvRow {
@@ -228,8 +236,9 @@ fn a_decoded_log_encodes_to_the_same_utc() {
     assert_eq!(once, twice);
     let column = utc_column(&once);
     assert_eq!(column[99], "");
-    assert_eq!(column[100], "2020-03-18T10:00:01.000Z");
-    assert_eq!(column[2999], "2020-03-18T10:00:29.990Z");
+    assert_eq!(column[100], "2020-03-18T10:00:01.000000Z");
+    assert_eq!(column[105], "2020-03-18T10:00:01.050400Z");
+    assert_eq!(column[2999], "2020-03-18T10:00:29.990000Z");
 }
 
 #[test]

@@ -6,6 +6,25 @@ mod analysis_support;
 use analysis_support::{wobblog, Extras, Ride};
 use serde_json::Value;
 
+/// The JSON rows of `summary DIR`, which must exit 1 naming the unreadable
+/// log `bad` on stderr.
+fn rows_failing_on(dir: &std::path::Path, bad: &str) -> Vec<Value> {
+    let out = wobblog()
+        .arg("summary")
+        .arg(dir)
+        .arg("--json")
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains(bad), "{stderr}");
+    String::from_utf8(out.stdout)
+        .unwrap()
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect()
+}
+
 #[test]
 fn one_row_per_run_and_unreadable_logs_named() {
     let dir = tempfile::tempdir().unwrap();
@@ -16,20 +35,7 @@ fn one_row_per_run_and_unreadable_logs_named() {
     std::fs::write(dir.path().join("RUN00005.WBL"), b"not a log").unwrap();
     std::fs::write(dir.path().join("notes.txt"), b"ignored").unwrap();
 
-    let out = wobblog()
-        .arg("summary")
-        .arg(dir.path())
-        .args(["--format", "jsonl"])
-        .output()
-        .unwrap();
-    assert_eq!(out.status.code(), Some(1));
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(stderr.contains("RUN00005.WBL"), "{stderr}");
-    let rows: Vec<Value> = String::from_utf8(out.stdout)
-        .unwrap()
-        .lines()
-        .map(|l| serde_json::from_str(l).unwrap())
-        .collect();
+    let rows = rows_failing_on(dir.path(), "RUN00005.WBL");
     assert_eq!(rows.len(), 2);
 
     let wobbly = &rows[0];
@@ -79,6 +85,28 @@ fn empty_or_missing_directory_fails_cleanly() {
     assert_eq!(out.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&out.stderr).contains("no *.WBL"));
     assert_eq!(run(&dir.path().join("absent")).status.code(), Some(1));
+}
+
+#[test]
+fn a_folder_of_cards_gives_every_cards_runs() {
+    let dir = tempfile::tempdir().unwrap();
+    let (a, b) = (dir.path().join("card-a"), dir.path().join("card-b"));
+    std::fs::create_dir_all(&a).unwrap();
+    std::fs::create_dir_all(&b).unwrap();
+    std::fs::create_dir_all(dir.path().join("empty")).unwrap();
+    analysis_support::standard_log(&a.join("RUN00001.WBL"));
+    let mut calm = Ride::new(20.0, 3.0, 0.0, 0.0, 0.0);
+    calm.steer_deg.fill(0.0);
+    analysis_support::write_log(&b.join("RUN00001.WBL"), &calm, &Extras::default());
+    std::fs::write(b.join("RUN00002.WBL"), b"").unwrap();
+
+    // The empty log is named and left out; the other runs are there.
+    let rows = rows_failing_on(dir.path(), "RUN00002.WBL");
+    let logs: Vec<&str> = rows.iter().map(|r| r["log"].as_str().unwrap()).collect();
+    assert_eq!(logs, ["card-a/RUN00001.WBL", "card-b/RUN00001.WBL"]);
+    assert_eq!(rows[0]["unstable_episodes"], 1);
+    assert_eq!(rows[1]["episodes"], 0);
+    assert_eq!(rows[1]["duration_s"].as_f64(), Some(20.0));
 }
 
 #[test]

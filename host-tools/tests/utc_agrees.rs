@@ -84,10 +84,10 @@ fn info_decode_gpx_and_mcap_agree_on_utc() {
     let onset = episode["onset_s"].as_f64().unwrap();
     let onset_utc = episode["onset_utc"].as_str().unwrap();
     let frame = rows.iter().rev().find(|r| r.0 <= onset).unwrap();
-    let ms = |text: &str| wobblog::time::parse_iso8601(text).unwrap();
-    let expected = ms(&frame.1) + ((onset - frame.0) * 1000.0).round() as i64;
+    let us = |text: &str| wobblog::time::parse_iso8601_us(text).unwrap();
+    let expected = us(&frame.1) + ((onset - frame.0) * 1e6).round() as i64;
     assert!(
-        (ms(onset_utc) - expected).abs() <= 1,
+        (us(onset_utc) - expected).abs() <= 1,
         "{onset_utc} {frame:?}"
     );
 
@@ -101,8 +101,8 @@ fn info_decode_gpx_and_mcap_agree_on_utc() {
     let row: serde_json::Value = serde_json::from_str(summary.lines().next().unwrap()).unwrap();
     assert_eq!(row["first_utc"], info["first_utc"]);
 
-    // MCAP log times are the CSV's UTC, to the nanosecond the CSV's
-    // millisecond text allows.
+    // MCAP log times are the CSV's UTC, to the microsecond the CSV's text
+    // has.
     let mcap = dir.path().join("run.mcap");
     wobblog()
         .arg("decode")
@@ -120,8 +120,9 @@ fn info_decode_gpx_and_mcap_agree_on_utc() {
         .collect();
     assert_eq!(imu.len(), rows.len());
     for (ns, (_, utc)) in imu.iter().zip(&rows).filter(|(_, r)| !r.1.is_empty()) {
-        let ms = i64::try_from(ns / 1_000_000).unwrap();
-        assert_eq!(&wobblog::time::iso8601_unix_ms(ms).unwrap(), utc);
+        assert_eq!(ns % 1000, 0, "a whole microsecond");
+        let us = i64::try_from(ns / 1000).unwrap();
+        assert_eq!(&wobblog::time::iso8601_unix_us(us).unwrap(), utc);
     }
 
     let gpx = dir.path().join("run.gpx");
@@ -143,20 +144,23 @@ fn info_decode_gpx_and_mcap_agree_on_utc() {
     let Some(seen) = python(READ_BACK, &[gpx.as_os_str(), parquet.as_os_str()]) else {
         return;
     };
-    // Every GPX point's time is the UTC `decode` gives a row.
-    let utc_texts: std::collections::BTreeSet<&str> =
-        with_utc.iter().map(|r| r.1.as_str()).collect();
+    // Every GPX point's time (the fix's own, to its millisecond) is the UTC
+    // `decode` gives a row.
+    let utc_texts: std::collections::BTreeSet<String> = with_utc
+        .iter()
+        .map(|r| format!("{}Z", &r.1[..23]))
+        .collect();
     let gpx_times = seen["gpx"].as_array().unwrap();
     assert!(gpx_times.len() > 400);
     for time in gpx_times {
         assert!(utc_texts.contains(time.as_str().unwrap()), "{time}");
     }
-    // Parquet's microseconds begin with the CSV's milliseconds.
+    // Parquet's microseconds are the CSV's.
     let parquet_rows = seen["parquet"].as_array().unwrap();
     assert_eq!(parquet_rows.len(), with_utc.len());
     for (p, c) in parquet_rows.iter().zip(&with_utc) {
         assert_eq!(p[0].as_f64().unwrap(), c.0);
         let micro = p[1].as_str().unwrap();
-        assert_eq!(format!("{}Z", &micro[..23]), c.1, "{micro}");
+        assert_eq!(micro, c.1, "{micro}");
     }
 }

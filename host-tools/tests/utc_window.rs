@@ -6,7 +6,7 @@ mod analysis_support;
 use std::path::Path;
 
 use analysis_support::{stdout_of, wobblog, write_log, Extras, Ride, UTC_AT_BOOT_MS};
-use wobblog::time::iso8601_unix_ms;
+use wobblog::time::iso8601_unix_us;
 
 /// A 20 s ride from 1 s since boot whose GPS has no fix before 5 s.
 fn late_fix_log(path: &Path) {
@@ -27,7 +27,7 @@ fn csv_rows(text: &str) -> (Vec<String>, Vec<csv::StringRecord>) {
 
 /// The UTC the synthetic GPS gives at `t_s` since boot.
 fn utc_at(t_s: f64) -> String {
-    iso8601_unix_ms(UTC_AT_BOOT_MS + (t_s * 1000.0).round() as i64).unwrap()
+    iso8601_unix_us((UTC_AT_BOOT_MS + (t_s * 1000.0).round() as i64) * 1000).unwrap()
 }
 
 #[test]

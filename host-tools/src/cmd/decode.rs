@@ -24,11 +24,13 @@ Columns (units in the names):
                  angular rate, deg/s
   steer_deg      steering angle, deg
   speed_mps      wheel speed, m/s
-  gps_lat_deg    GPS latitude, deg (empty or null without a fix)
+  gps_lat_deg    GPS latitude, deg (without a fix: NaN in CSV, null in
+                 JSON lines and Parquet)
   gps_lon_deg    GPS longitude, deg
   gps_speed_mps  GPS ground speed, m/s
-  gps_fix        none, 2d or 3d
-  utc            UTC, ISO 8601 (through the GPS sync pairs; empty before the first)";
+  gps_fix        none, 2d or 3d (empty or null without a fix)
+  utc            UTC, ISO 8601 to the microsecond (through the GPS sync pairs;
+                 empty or null before the first)";
 
 /// Arguments of `wobblog decode`.
 #[derive(clap::Args)]

@@ -4,18 +4,21 @@ use std::fs::File;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
+use wobble_core::config::Config;
+use wobble_core::detector::Detector;
 use wobble_core::format::header::header_records;
 use wobble_core::format::limits::SPEED_CM_S_MAX;
 use wobble_core::format::{
-    quantise_i16, quantise_i32, quantise_u16, BlockEncoder, FixMode, Frame, GpsFix, LogInfo,
-    Record, UtcSync, ACCEL_COUNTS_PER_G, EDGE_AGE_NONE, GYRO_COUNTS_PER_DPS, STEER_COUNTS_PER_DEG,
+    quantise_i16, quantise_i32, quantise_u16, BlockEncoder, FixMode, Frame, FrameStatus, GpsFix,
+    LogInfo, Record, UtcSync, ACCEL_COUNTS_PER_G, EDGE_AGE_NONE, GYRO_COUNTS_PER_DPS,
+    STEER_COUNTS_PER_DEG,
 };
 
 use crate::csv_input::{number_in, Cell, TimeSteps};
-use crate::export::CSV_COLUMNS;
+use crate::export::{CSV_COLUMNS, MISSING_NUMBER};
 use crate::output::Output;
 use crate::resample::{CsvRow, Resampler};
-use crate::time::parse_iso8601;
+use crate::time::parse_iso8601_us;
 use crate::CliError;
 
 /// Arguments of `wobblog encode`.
@@ -36,6 +39,23 @@ pub struct Args {
     /// the row before each frame. Without this, such a CSV is an error.
     #[arg(long)]
     pub resample: bool,
+    /// Run the on-board detector over the frames as the board does, with
+    /// the default configuration, and store what it writes: its alert
+    /// records (and the frames' alert flag) and its kick ring-down records
+    /// (`wobblog events`, `wobblog margin`). The configuration goes into
+    /// the header, as the board's does. A gap restarts the detector.
+    #[arg(long)]
+    pub detect: bool,
+}
+
+/// How `encode` builds the log.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Options {
+    /// Interpolate a CSV at another rate (or an uneven one) onto the log's
+    /// frames.
+    pub resample: bool,
+    /// Run the on-board detector and store its alert and kick records.
+    pub detect: bool,
 }
 
 /// The frame rate of the logs `encode` writes, as the firmware's.
@@ -50,12 +70,20 @@ pub fn run(args: &Args) -> Result<(), CliError> {
     let mut output = Output::create(&args.output, &[&args.csv])?;
     let input = File::open(&args.csv).map_err(|e| CliError::file(&args.csv, e))?;
     let input = crate::csv_input::LineCap::new(input);
-    encode(input, &args.csv, &mut output, &args.output, args.resample)?;
+    let options = Options {
+        resample: args.resample,
+        detect: args.detect,
+    };
+    encode_with(input, &args.csv, &mut output, &args.output, options)?;
     output.commit()
 }
 
 /// Index of each known column in the CSV, if present, and of `utc`.
 struct Columns([Option<usize>; CSV_COLUMNS.len()], Option<usize>);
+
+/// The indices in [`CSV_COLUMNS`] of the GPS numbers: latitude,
+/// longitude, ground speed.
+const GPS_NUMBERS: [usize; 3] = [9, 10, 11];
 
 /// The column `decode` writes UTC into.
 const UTC_COLUMN: &str = "utc";
@@ -94,18 +122,18 @@ fn refuse_unknown_columns(header: &csv::StringRecord, in_name: &Path) -> Result<
 
 /// The sync pairs that give every row its CSV UTC back: a pair at a row
 /// whenever the last pair does not already give that row's UTC, to the
-/// millisecond as `decode` prints it (so a log decoded and encoded again
-/// has pairs only where its clock and UTC drifted apart by a millisecond).
+/// microsecond as `decode` prints it (so a log decoded and encoded again
+/// has pairs only where its clock and UTC drifted apart).
 #[derive(Default)]
 struct SyncWriter {
     last: Option<UtcSync>,
 }
 
 impl SyncWriter {
-    /// The pair to write before the frame at `t_us` whose UTC is `utc_ms`
+    /// The pair to write before the frame at `t_us` whose UTC is `utc_us`
     /// (`None`: the row has no UTC), or why the row cannot be stored.
-    fn update(&mut self, t_us: u64, utc_ms: Option<i64>) -> Result<Option<UtcSync>, String> {
-        let Some(ms) = utc_ms else {
+    fn update(&mut self, t_us: u64, utc_us: Option<i64>) -> Result<Option<UtcSync>, String> {
+        let Some(us) = utc_us else {
             return match self.last {
                 Some(_) => Err("is empty after a row with a UTC: a log's UTC cannot stop".into()),
                 None => Ok(None),
@@ -113,15 +141,28 @@ impl SyncWriter {
         };
         let given = self.last.and_then(|s| {
             let since_us = i64::try_from(t_us.checked_sub(s.t_us)?).ok()?;
-            let us = i64::try_from(s.unix_ms).ok()?.checked_mul(1000)? + since_us;
-            Some(us.div_euclid(1000))
+            i64::try_from(s.unix_ms)
+                .ok()?
+                .checked_mul(1000)?
+                .checked_add(since_us)
         });
-        if given == Some(ms) {
+        if given == Some(us) {
             return Ok(None);
         }
-        let sync = UtcSync {
-            t_us,
-            unix_ms: u64::try_from(ms).unwrap_or(u64::MAX),
+        // A pair holds whole milliseconds: it sits the sub-millisecond part
+        // of the row's UTC before the row. In the first millisecond since
+        // boot there is no room before it, and the row's UTC is rounded to
+        // the millisecond.
+        let sub_ms = us.rem_euclid(1000).unsigned_abs();
+        let sync = match t_us.checked_sub(sub_ms) {
+            Some(at) => UtcSync {
+                t_us: at,
+                unix_ms: u64::try_from(us.div_euclid(1000)).unwrap_or(u64::MAX),
+            },
+            None => UtcSync {
+                t_us,
+                unix_ms: u64::try_from((us + 500).div_euclid(1000)).unwrap_or(u64::MAX),
+            },
         };
         if !sync.is_valid() {
             return Err("is outside the years a GPS states (2000 to 2099)".into());
@@ -140,6 +181,22 @@ pub fn encode(
     out_name: &Path,
     resample: bool,
 ) -> Result<(), CliError> {
+    let options = Options {
+        resample,
+        detect: false,
+    };
+    encode_with(input, in_name, output, out_name, options)
+}
+
+/// [`encode`] with every option.
+pub fn encode_with(
+    input: impl std::io::Read,
+    in_name: &Path,
+    output: impl Write,
+    out_name: &Path,
+    options: Options,
+) -> Result<(), CliError> {
+    let resample = options.resample;
     let mut reader = csv::ReaderBuilder::new()
         .trim(csv::Trim::All)
         .from_reader(input);
@@ -165,6 +222,7 @@ pub fn encode(
         last_gps: None,
         frames: 0,
         line: 0,
+        detector: options.detect.then(OnBoard::new).transpose()?,
     };
     let mut record = csv::StringRecord::new();
     let mut steps = if resample {
@@ -211,6 +269,66 @@ struct LogWriter<'a, W> {
     frames: u64,
     /// The CSV line being read, for messages.
     line: u64,
+    /// The on-board detector, with `--detect`.
+    detector: Option<OnBoard>,
+}
+
+/// The on-board detector as the board's sampler runs it on the frames.
+struct OnBoard {
+    config: Config,
+    detector: Detector,
+    /// Time of the last frame it saw, µs.
+    last_us: Option<u64>,
+}
+
+impl OnBoard {
+    fn new() -> Result<Self, CliError> {
+        let config = Config::default();
+        let detector = config
+            .detector()
+            .map_err(|e| CliError::Failed(format!("the default detector: {e}")))?;
+        Ok(Self {
+            config,
+            detector,
+            last_us: None,
+        })
+    }
+
+    /// The configuration lines the board writes into the header.
+    fn header_lines(&self) -> Vec<String> {
+        let mut text = String::new();
+        // Writing into a String cannot fail.
+        let _ = self.config.write_lines(&mut text);
+        text.lines().map(String::from).collect()
+    }
+
+    /// Feeds `frame` (as the card stores it) and sets its alert flag; the
+    /// records the board would write before it (an alert switching, a
+    /// measured kick) go to `out`. A gap of more than 1.5 frame periods
+    /// restarts the detector, as `wobblog detect` does.
+    fn step(&mut self, frame: &mut Frame, out: &mut Vec<Record<'static>>) {
+        let period_us = 1_000_000 / u64::from(SAMPLE_RATE_HZ);
+        if self
+            .last_us
+            .is_some_and(|last| frame.t_us.saturating_sub(last) > period_us * 3 / 2)
+        {
+            self.detector.reset();
+        }
+        self.last_us = Some(frame.t_us);
+        if let Some(ev) = self
+            .detector
+            .push(frame.steer_deg(), Some(frame.speed_mps()))
+        {
+            out.push(Record::Alert(ev.to_record(frame.t_us)));
+        }
+        if let Some(kick) = self.detector.take_kick() {
+            let rate_hz = self.detector.config().sample_rate_hz;
+            out.push(Record::Kick(kick.to_record(frame.t_us, rate_hz)));
+        }
+        if self.detector.alert_active() {
+            frame.status.0 |= FrameStatus::ALERT;
+        }
+    }
 }
 
 impl<W: Write> LogWriter<'_, W> {
@@ -233,7 +351,9 @@ impl<W: Write> LogWriter<'_, W> {
                 sample_rate_hz: SAMPLE_RATE_HZ,
                 run: 0,
             };
-            for rec in header_records(info, []) {
+            let lines = self.detector.as_ref().map(OnBoard::header_lines);
+            let lines = lines.iter().flatten().map(String::as_str);
+            for rec in header_records(info, lines) {
                 self.push(&rec)?;
             }
         }
@@ -241,12 +361,20 @@ impl<W: Write> LogWriter<'_, W> {
         // Before the frame, so the pair is in force for it.
         let sync = self
             .syncs
-            .update(row.frame.t_us, row.utc_ms)
+            .update(row.frame.t_us, row.utc_us)
             .map_err(|e| self.columns.utc_cell(self.line).error(self.in_name, e))?;
         if let Some(sync) = sync {
             self.push(&Record::UtcSync(sync))?;
         }
-        self.push(&Record::Frame(row.frame))?;
+        let mut frame = row.frame;
+        if let Some(detector) = &mut self.detector {
+            let mut records = Vec::new();
+            detector.step(&mut frame, &mut records);
+            for record in &records {
+                self.push(record)?;
+            }
+        }
+        self.push(&Record::Frame(frame))?;
         if let Some(fix) = gps_update(&self.last_gps, row.gps, row.frame.t_us) {
             self.push(&Record::Gps(fix))?;
             self.last_gps = Some((row.frame.t_us, fix));
@@ -288,10 +416,12 @@ fn parse_row(
         column: c + 1,
         name: CSV_COLUMNS[i],
     };
+    // `decode` writes a missing GPS number as NaN: for those columns it is
+    // no value (elsewhere NaN is refused as a value no log stores).
     let field = |i: usize| {
         columns.0[i]
             .and_then(|c| Some((c, record.get(c)?)))
-            .filter(|(_, f)| !f.is_empty())
+            .filter(|(_, f)| !(f.is_empty() || GPS_NUMBERS.contains(&i) && *f == MISSING_NUMBER))
     };
     // A missing column is zero (or no GPS); an empty cell of a column that
     // is there is refused (it would be stored as a zero nobody measured); a
@@ -386,16 +516,16 @@ fn parse_row(
             ));
         }
     };
-    let utc_ms = match columns.1.and_then(|c| record.get(c)) {
+    let utc_us = match columns.1.and_then(|c| record.get(c)) {
         Some("") | None => None,
-        Some(text) => Some(parse_iso8601(text).ok_or_else(|| {
+        Some(text) => Some(parse_iso8601_us(text).ok_or_else(|| {
             columns.utc_cell(line).error(
                 path,
                 format!("is not a UTC time like 2020-03-18T13:28:20.600Z: {text:?}"),
             )
         })?),
     };
-    Ok(CsvRow { frame, gps, utc_ms })
+    Ok(CsvRow { frame, gps, utc_us })
 }
 
 /// The GPS record to write at `t_us`, if any: when the fix changes, when it
@@ -419,23 +549,31 @@ fn gps_update(last: &Option<(u64, GpsFix)>, now: Option<GpsFix>, t_us: u64) -> O
 mod tests {
     use super::*;
 
-    /// 2020-03-18T10:00:01.000Z, ms since 1970.
-    const MS: i64 = 1_584_525_601_000;
+    /// 2020-03-18T10:00:01.000Z, µs since 1970.
+    const US: i64 = 1_584_525_601_000_000;
 
     #[test]
     fn a_pair_is_written_only_where_the_last_one_is_wrong() {
         let mut syncs = SyncWriter::default();
         assert_eq!(syncs.update(0, None), Ok(None));
-        let first = syncs.update(1_000_000, Some(MS)).unwrap().unwrap();
-        assert_eq!((first.t_us, first.unix_ms), (1_000_000, MS as u64));
+        let first = syncs.update(1_000_000, Some(US)).unwrap().unwrap();
+        assert_eq!((first.t_us, first.unix_ms), (1_000_000, (US / 1000) as u64));
         // 10 ms later the pair gives 10 ms more, to the microsecond.
-        assert_eq!(syncs.update(1_010_000, Some(MS + 10)), Ok(None));
-        // 9.999 ms later it gives 9 ms (decode rounds down).
-        assert_eq!(syncs.update(1_009_999, Some(MS + 9)), Ok(None));
-        // A clock 1 ms off: a new pair at this frame.
-        let next = syncs.update(1_020_000, Some(MS + 21)).unwrap().unwrap();
-        assert_eq!((next.t_us, next.unix_ms), (1_020_000, MS as u64 + 21));
-        assert_eq!(syncs.update(1_030_000, Some(MS + 31)), Ok(None));
+        assert_eq!(syncs.update(1_010_000, Some(US + 10_000)), Ok(None));
+        assert_eq!(syncs.update(1_009_999, Some(US + 9_999)), Ok(None));
+        // A clock 250 µs off: a new pair, 250 µs before this frame, holding
+        // the whole millisecond.
+        let next = syncs.update(1_020_000, Some(US + 20_250)).unwrap().unwrap();
+        assert_eq!(
+            (next.t_us, next.unix_ms),
+            (1_019_750, (US / 1000) as u64 + 20)
+        );
+        assert_eq!(syncs.update(1_030_000, Some(US + 30_250)), Ok(None));
+        // In the first millisecond since boot there is no room before the
+        // frame: the nearest millisecond.
+        let mut early = SyncWriter::default();
+        let pair = early.update(400, Some(US + 600)).unwrap().unwrap();
+        assert_eq!((pair.t_us, pair.unix_ms), (400, (US / 1000) as u64 + 1));
     }
 
     #[test]
@@ -445,8 +583,11 @@ mod tests {
             .update(0, Some(0))
             .unwrap_err()
             .contains("2000 to 2099"));
-        assert!(syncs.update(0, Some(4_102_444_800_000)).is_err());
-        assert!(syncs.update(0, Some(4_102_444_799_999)).unwrap().is_some());
+        assert!(syncs.update(0, Some(4_102_444_800_000_000)).is_err());
+        assert!(syncs
+            .update(0, Some(4_102_444_799_999_000))
+            .unwrap()
+            .is_some());
         assert!(syncs
             .update(10_000, None)
             .unwrap_err()

@@ -109,6 +109,11 @@ fn render(path: &std::path::Path, s: &Summary) -> String {
         opt(&s.first_utc),
         opt(&s.last_utc)
     );
+    let _ = writeln!(o, "records:      kind              count    per s");
+    for (kind, n) in &s.records {
+        let rate = n.rate_hz.map_or("-".into(), |r| format!("{r:.3}"));
+        let _ = writeln!(o, "  {kind:<24}{:>11}  {rate:>7}", n.count);
+    }
     let _ = writeln!(o, "alerts:       {}", s.alerts.len());
     for a in &s.alerts {
         let off = a.off_s.map_or("end of log".into(), |t| format!("{t:.2} s"));
@@ -119,6 +124,7 @@ fn render(path: &std::path::Path, s: &Summary) -> String {
         );
     }
     let _ = writeln!(o, "markers:      {}", s.markers.len());
+    let _ = writeln!(o, "kicks:        {} ring-downs measured on board", s.kicks);
     let faults: Vec<String> = s.faults.iter().map(|(k, v)| format!("{k} {v}")).collect();
     let _ = writeln!(
         o,

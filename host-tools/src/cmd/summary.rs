@@ -22,7 +22,10 @@ pub enum SummaryFormat {
 /// Arguments of `wobblog summary`.
 #[derive(clap::Args)]
 pub struct Args {
-    /// Directory holding card logs (`*.WBL`, any case); not searched recursively.
+    /// A card (logs, `*.WBL` in any case, at its top) or a folder of cards
+    /// (one directory each, as `export` takes), not searched deeper; a
+    /// log of a folder of cards is named `CARD/RUNnnnnn.WBL` in the `log`
+    /// column.
     pub dir: PathBuf,
     /// Output format.
     #[arg(long, value_enum, default_value_t = SummaryFormat::Table)]
@@ -105,15 +108,18 @@ pub fn logs_in(dir: &Path) -> Result<Vec<PathBuf>, CliError> {
 
 /// Runs `wobblog summary`: rows for every readable log, even when some are not.
 pub fn run(args: &Args) -> Result<(), CliError> {
-    let logs = logs_in(&args.dir)?;
-    if logs.is_empty() {
-        return Err(CliError::file(&args.dir, "no *.WBL logs in this directory"));
-    }
+    let cards = crate::dataset::cards_in(&args.dir)?;
+    let logs: Vec<PathBuf> = cards.iter().flat_map(|(_, logs)| logs.clone()).collect();
     let mut rows = Vec::new();
     let result = for_each_log(&logs, "summarising", |log| {
         let ride = Ride::load(log)?;
         warn_losses(log, &ride.summary);
-        rows.push(RunRow::of(&ride));
+        let mut row = RunRow::of(&ride);
+        let card = cards.iter().find(|(_, logs)| logs.iter().any(|l| l == log));
+        if let Some((Some(card), _)) = card {
+            row.log = format!("{card}/{}", row.log);
+        }
+        rows.push(row);
         Ok(())
     });
     let format = if args.json {

@@ -33,7 +33,7 @@ impl LogMetadata {
             Event::Record(Record::UtcSync(sync)) if self.first_utc.is_none() => {
                 self.first_utc = i64::try_from(sync.unix_ms)
                     .ok()
-                    .and_then(crate::time::iso8601_unix_ms);
+                    .and_then(|ms| crate::time::iso8601_unix_us(ms.checked_mul(1000)?));
             }
             _ => {}
         }

@@ -7,6 +7,7 @@ pub mod mcap;
 pub mod metadata;
 pub mod parquet;
 mod text;
+pub use text::MISSING_NUMBER;
 
 use std::io::Write;
 use std::path::Path;

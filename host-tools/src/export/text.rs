@@ -57,8 +57,13 @@ fn csv_record<R>(line: &mut String, columns: &[Column<R>], row: &R, delimiter: u
             Value::Integer(Some(n)) => line.push_str(int.format(n)),
             Value::Text(Some(s)) => push_csv_text(line, &s, delimiter),
             Value::Bool(Some(b)) => line.push_str(if b { "true" } else { "false" }),
-            Value::Number(None)
-            | Value::Label(None)
+            // A missing number is `NaN`, never an empty cell: the GPS
+            // columns are empty in the first rows of every ride, and
+            // Polars' default CSV reader, typing from the first 100 rows,
+            // would read them as text. pandas and DuckDB read `NaN` as a
+            // missing number too.
+            Value::Number(None) => line.push_str(MISSING_NUMBER),
+            Value::Label(None)
             | Value::Utc(None)
             | Value::Integer(None)
             | Value::Text(None)
@@ -72,6 +77,9 @@ fn csv_record<R>(line: &mut String, columns: &[Column<R>], row: &R, delimiter: u
     }
     line.push('\n');
 }
+
+/// A number a row does not have, in CSV.
+pub const MISSING_NUMBER: &str = "NaN";
 
 /// `s` as a CSV cell: in quotes, with quotes doubled, if it holds the
 /// delimiter, a quote or a line break (the `csv` writer's "necessary" style).
@@ -130,11 +138,11 @@ pub fn json_line(line: &mut String, columns: &[Column], row: &Row) {
     line.push_str("}\n");
 }
 
-/// Length of `2020-03-18T13:28:20.600Z`.
-const UTC_LEN: usize = 24;
-/// UTC in ISO 8601 to the millisecond (rounded down), as
-/// [`crate::time::iso8601`] writes it, into `buf` without allocating;
-/// empty outside the card's dates.
+/// Length of `2020-03-18T13:28:20.600250Z`.
+const UTC_LEN: usize = 27;
+/// UTC in ISO 8601 to the microsecond, as [`crate::time::iso8601_unix_us`]
+/// writes it (Parquet's precision), into `buf` without allocating; empty
+/// outside the card's dates.
 fn utc_text(us: i64, buf: &mut [u8; UTC_LEN]) -> &str {
     const MS_PER_DAY: i64 = 86_400_000;
     const UNIX_MS_AT_2000: i64 = 10_957 * MS_PER_DAY;
@@ -162,6 +170,7 @@ fn utc_text(us: i64, buf: &mut [u8; UTC_LEN]) -> &str {
     put(14, ms / 60_000 % 60, 2);
     put(17, ms / 1000 % 60, 2);
     put(20, ms % 1000, 3);
+    put(23, us.rem_euclid(1000), 3);
     for (at, sep) in [
         (4, b'-'),
         (7, b'-'),
@@ -169,7 +178,7 @@ fn utc_text(us: i64, buf: &mut [u8; UTC_LEN]) -> &str {
         (13, b':'),
         (16, b':'),
         (19, b'.'),
-        (23, b'Z'),
+        (26, b'Z'),
     ] {
         buf[at] = sep;
     }
@@ -191,10 +200,13 @@ mod tests {
             1_584_575_999_999,
             4_102_444_800_123,
         ] {
-            assert_eq!(
-                utc_text(ms * 1000 + 999, &mut buf),
-                crate::time::iso8601_unix_ms(ms).unwrap()
-            );
+            for us in [0, 1, 250, 999] {
+                let at = ms * 1000 + us;
+                assert_eq!(
+                    utc_text(at, &mut buf),
+                    crate::time::iso8601_unix_us(at).unwrap()
+                );
+            }
         }
         assert_eq!(utc_text(0, &mut buf), "");
     }
@@ -205,7 +217,9 @@ mod tests {
         let mut time = [0u8; UTC_LEN];
         for column in columns {
             let cell = match (column.value)(row) {
-                Value::Number(v) => v.map(|v| zmij::Buffer::new().format(v).to_owned()),
+                Value::Number(v) => Some(v.map_or(MISSING_NUMBER.to_owned(), |v| {
+                    zmij::Buffer::new().format(v).to_owned()
+                })),
                 Value::Label(s) => s.map(str::to_owned),
                 Value::Utc(us) => us.map(|us| utc_text(us, &mut time).to_owned()),
                 Value::Integer(n) => n.map(|n| n.to_string()),

@@ -2,6 +2,7 @@
 //! stacked on one time axis, alert periods shaded, rider markers drawn, and
 //! where the data are missing (lost blocks, forward time jumps) shaded too.
 
+use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
@@ -252,15 +253,21 @@ impl TimePlot {
         })
     }
 
-    /// Decimals of the UTC tick labels: tenths or hundredths of a second
-    /// where the ticks are that close.
-    fn utc_decimals(&self) -> usize {
-        let span = self.x(self.window_s.end) - self.x(self.window_s.start);
-        match span {
-            s if s <= 1.5 => 2,
-            s if s <= 15.0 => 1,
-            _ => 0,
+    /// The time axis's ticks: on a UTC axis at round clock times (whole
+    /// minutes or hours on long windows, 1-2-5 steps of a second on short
+    /// ones, see [`clock_ticks`]), else where plotters puts them.
+    fn x_ticks(&self) -> Vec<f64> {
+        let (from, to) = (self.x(self.window_s.start), self.x(self.window_s.end));
+        match &self.utc {
+            Some(_) => clock_ticks(from, to, MAX_TIME_TICKS).0,
+            None => RangedCoordf64::from(from..to).key_points(MAX_TIME_TICKS),
         }
+    }
+
+    /// Decimals of the UTC tick labels: those of the tick step.
+    fn utc_decimals(&self) -> usize {
+        let (from, to) = (self.x(self.window_s.start), self.x(self.window_s.end));
+        clock_ticks(from, to, MAX_TIME_TICKS).1
     }
 
     /// Stretches lost from the file drawn, s.
@@ -327,7 +334,10 @@ impl Figure for TimePlot {
                 .x_label_area_size(x_label_px)
                 .y_label_area_size(Y_LABEL_AREA_PX)
                 .build_cartesian_2d(
-                    self.x(self.window_s.start)..self.x(self.window_s.end),
+                    TimeAxis {
+                        inner: (self.x(self.window_s.start)..self.x(self.window_s.end)).into(),
+                        ticks: self.x_ticks(),
+                    },
                     y.clone(),
                 )
                 .map_err(err)?;
@@ -421,6 +431,84 @@ impl Figure for TimePlot {
     }
 }
 
+/// A time axis with ticks of its own: plotters' f64 axis, whose ticks are
+/// decimal (round multiples of 100 or 500 s, not minutes), and whose
+/// `with_key_points` form cannot take a label formatter.
+struct TimeAxis {
+    inner: RangedCoordf64,
+    ticks: Vec<f64>,
+}
+
+impl Ranged for TimeAxis {
+    type FormatOption = plotters::coord::ranged1d::DefaultFormatting;
+    type ValueType = f64;
+
+    fn map(&self, value: &f64, limit: (i32, i32)) -> i32 {
+        self.inner.map(value, limit)
+    }
+
+    fn key_points<Hint: plotters::coord::ranged1d::KeyPointHint>(&self, hint: Hint) -> Vec<f64> {
+        // Light (minor) grid lines are not drawn.
+        if hint.weight().allow_light_points() {
+            Vec::new()
+        } else {
+            self.ticks.clone()
+        }
+    }
+
+    fn range(&self) -> std::ops::Range<f64> {
+        self.inner.range()
+    }
+}
+
+/// Most ticks on the time axis (plotters' default count).
+const MAX_TIME_TICKS: usize = 10;
+
+/// Tick steps of a clock axis, s, with the decimals their labels need: 1-2-5
+/// steps under a second, then the clock's own divisions (15 and 30 s,
+/// minutes, quarter hours, hours).
+const CLOCK_STEPS_S: [(f64, usize); 23] = [
+    (0.01, 2),
+    (0.02, 2),
+    (0.05, 2),
+    (0.1, 1),
+    (0.2, 1),
+    (0.5, 1),
+    (1.0, 0),
+    (2.0, 0),
+    (5.0, 0),
+    (10.0, 0),
+    (15.0, 0),
+    (30.0, 0),
+    (60.0, 0),
+    (120.0, 0),
+    (300.0, 0),
+    (600.0, 0),
+    (900.0, 0),
+    (1800.0, 0),
+    (3600.0, 0),
+    (7200.0, 0),
+    (10_800.0, 0),
+    (21_600.0, 0),
+    (43_200.0, 0),
+];
+
+/// Ticks at the multiples of the finest clock step that puts at most `max`
+/// of them in `from..=to` (seconds since a midnight), and their labels'
+/// decimals.
+fn clock_ticks(from: f64, to: f64, max: usize) -> (Vec<f64>, usize) {
+    let (step, decimals) = CLOCK_STEPS_S
+        .iter()
+        .copied()
+        .find(|&(step, _)| ((to / step).floor() - (from / step).ceil()) < max as f64)
+        .unwrap_or((86_400.0, 0));
+    let first = (from / step).ceil() as i64;
+    let last = (to / step).floor() as i64;
+    // Multiples of the step, not sums of it: no rounding creeps in.
+    let ticks = (first..=last).map(|k| k as f64 * step).collect();
+    (ticks, decimals)
+}
+
 /// Seconds since a midnight as `hh:mm:ss` with `decimals` of a second
 /// (rounded; past 24 h it goes on into the next day's hours).
 fn clock_text(s: f64, decimals: usize) -> String {
@@ -438,7 +526,35 @@ fn clock_text(s: f64, decimals: usize) -> String {
 
 #[cfg(test)]
 mod tests {
-    use super::clock_text;
+    use super::{clock_text, clock_ticks};
+
+    #[test]
+    fn clock_ticks_fall_on_round_clock_times() {
+        // 40 minutes from 10:03:17: every 5 minutes.
+        let (ticks, decimals) = clock_ticks(36_197.0, 38_597.0, 10);
+        assert_eq!(decimals, 0);
+        let labels: Vec<String> = ticks.iter().map(|&t| clock_text(t, 0)).collect();
+        assert_eq!(
+            labels,
+            [
+                "10:05:00", "10:10:00", "10:15:00", "10:20:00", "10:25:00", "10:30:00", "10:35:00",
+                "10:40:00"
+            ]
+        );
+        // 7 h: every hour.
+        let (ticks, _) = clock_ticks(30_000.0, 55_200.0, 10);
+        assert_eq!(ticks.first(), Some(&32_400.0));
+        assert!(ticks.iter().all(|t| t % 3600.0 == 0.0), "{ticks:?}");
+        // 1.5 s: every 0.2 s, to the tenth.
+        let (ticks, decimals) = clock_ticks(37_816.05, 37_817.55, 10);
+        assert_eq!(decimals, 1);
+        assert_eq!(clock_text(ticks[0], decimals), "10:30:16.2");
+        assert_eq!(ticks.len(), 7);
+        // 8 minutes: every minute (not every 50 s or 100 s).
+        let (ticks, _) = clock_ticks(36_000.0, 36_480.0, 10);
+        assert_eq!(ticks.len(), 9);
+        assert!(ticks.iter().all(|t| t % 60.0 == 0.0));
+    }
 
     #[test]
     fn clock_text_rounds_to_its_decimals() {
