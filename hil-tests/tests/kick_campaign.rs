@@ -7,6 +7,7 @@ use std::sync::OnceLock;
 
 use wobble_hil::corpus::signal::WHEEL_CIRCUMFERENCE_M;
 use wobble_hil::corpus::simulated::campaign::{self, Campaign, KickTruth, Plan};
+use wobblog::analysis::campaign_kicks::{campaign_kicks, Prefer, Source};
 use wobblog::analysis::margin::{predict, KickPoint};
 use wobblog::analysis::{find_kicks, Kick, Run};
 
@@ -134,13 +135,70 @@ fn kick_extractor_meets_its_accuracy() {
     );
     assert!(n >= 100, "{n} kicks");
     assert!(good * 10 >= n * 8, "{good} of {n}\n{table}");
+    // The stated SD is calibrated (`kicks::stated_sd`, on other seeds):
+    // about 95 % of the errors within two of it (92 % on 3600 kicks).
+    assert!(
+        within_2sd * 100 >= z.len() * 85,
+        "{within_2sd} of {}",
+        z.len()
+    );
 }
 
-/// Every kick the extractor finds in a campaign, as the regression takes it.
+/// The logs hold the kick records the board writes (`encode --detect`):
+/// `margin` takes them, re-measured by the host where it finds the kick
+/// too, and the host's re-measurement is nearer the truth than the card's
+/// record (median error, over the same kicks).
+#[test]
+fn card_records_are_used_and_refined_by_the_host() {
+    let (mut card_err, mut host_err, mut sources) = (Vec::new(), Vec::new(), Vec::new());
+    let (mut passes, mut with_records) = (0, 0);
+    for l in loaded() {
+        for (pass, run) in l.campaign.passes.iter().zip(&l.runs) {
+            passes += 1;
+            with_records += usize::from(!run.summary.kick_records.is_empty());
+            let log = format!("{}.wbl", pass.fixture.truth.name);
+            for k in campaign_kicks(run, WHEEL_CIRCUMFERENCE_M, Prefer::Best) {
+                sources.push(k.source);
+                let Some(truth) = l
+                    .campaign
+                    .kicks
+                    .iter()
+                    .find(|t| t.log == log && (t.t_s - k.t_s).abs() < 0.5)
+                else {
+                    continue;
+                };
+                if let (Some(c), Some(h)) = (&k.card, &k.host) {
+                    card_err.push((c.sigma_per_s - truth.sigma_per_s).abs());
+                    host_err.push((h.sigma_per_s - truth.sigma_per_s).abs());
+                }
+            }
+        }
+    }
+    // The board measures nearly every kick (844 of 864 on seeds 100-111).
+    assert!(
+        with_records * 10 >= passes * 9,
+        "{with_records} of {passes}"
+    );
+    let both = sources.iter().filter(|s| **s == Source::CardHost).count();
+    assert!(both * 10 >= sources.len() * 9, "{sources:?}");
+    let median = |mut v: Vec<f64>| {
+        v.sort_by(f64::total_cmp);
+        v[v.len() / 2]
+    };
+    let (c, h) = (median(card_err), median(host_err));
+    eprintln!(
+        "{both} of {} kicks card-host; median |sigma error| card {c:.3}, host {h:.3} 1/s",
+        sources.len()
+    );
+    assert!(h < c, "host {h} card {c}");
+}
+
+/// Every kick of a campaign as `margin` takes it (the card's records,
+/// re-measured by the host), as the regression takes it.
 fn points(l: &Loaded) -> Vec<KickPoint> {
     l.runs
         .iter()
-        .flat_map(|run| find_kicks(run, WHEEL_CIRCUMFERENCE_M))
+        .flat_map(|run| campaign_kicks(run, WHEEL_CIRCUMFERENCE_M, Prefer::Best))
         .map(|k| KickPoint {
             speed_mps: k.speed_mps,
             sigma_per_s: k.sigma_per_s,
@@ -179,11 +237,10 @@ fn margin_predicts_each_bicycle_within_5_percent() {
 /// Coverage of the 95 % interval and the prediction's error over more
 /// campaigns (3 seeds on each of the four bicycles, kicks measured from
 /// each pass's steering without the card round trip, to keep it short).
-/// The straight line's bias on bicycles whose sigma bends (it
-/// under-predicts by 2 % on average) keeps the coverage below its stated
-/// rate: over 48 campaigns (seeds 100-111) 28 covered the truth and 45
-/// were within 5 % (worst -6.2 %), see `host-tools/docs/kick-testing.md`.
-/// This test guards those figures: at least half covered, none off by
+/// Over 48 campaigns (seeds 100-111) the interval covered the truth in 44
+/// (92 ± 4 %), over 200 (seeds 200-249, not tuned on) in 188 (94 ± 2 %),
+/// see `host-tools/docs/kick-testing.md` (`examples/margin_coverage.rs`).
+/// This test guards them: at least 9 of these 12 covered (9 are), none off by
 /// more than 7 %.
 #[test]
 fn interval_coverage_and_error_over_seeds() {
@@ -232,7 +289,7 @@ fn interval_coverage_and_error_over_seeds() {
         "{table}covered {covered} of {n}; worst error {:.1} %",
         100.0 * worst
     );
-    assert!(2 * covered >= n, "{table}covered {covered} of {n}");
+    assert!(covered >= 9, "{table}covered {covered} of {n}");
     assert!(worst <= 0.07, "{table}worst {worst}");
 }
 

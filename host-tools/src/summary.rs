@@ -3,7 +3,7 @@
 use std::collections::BTreeMap;
 
 use serde::Serialize;
-use wobble_core::format::{DecodeStats, Event, Record};
+use wobble_core::format::{DecodeStats, Event, KickRingDown, Record};
 
 use crate::losses::Losses;
 use crate::rows::{Row, RowAssembler};
@@ -117,6 +117,12 @@ pub struct Summary {
     pub alerts: Vec<AlertSpan>,
     /// Rider markers, s.
     pub markers: Vec<f64>,
+    /// Kick ring-downs measured on board (kick records; `wobblog events`
+    /// lists them, `wobblog margin` uses them).
+    pub kicks: u64,
+    /// The kick records themselves, in file order.
+    #[serde(skip)]
+    pub kick_records: Vec<KickRingDown>,
     /// Fault records by source: number of faults counted.
     pub faults: BTreeMap<&'static str, u64>,
     /// Records by kind (`frame`, `gps_fix`, `utc_sync`, ...): the log's
@@ -254,8 +260,12 @@ impl SummaryBuilder {
                 s.run = Some(info.run);
                 s.sample_rate_hz = Some(info.sample_rate_hz);
             }
-            // `wobblog events` lists the kicks and the margin warning.
-            Record::Channel(_) | Record::Kick(_) | Record::Margin(_) => {}
+            Record::Kick(k) => {
+                s.kicks += 1;
+                s.kick_records.push(*k);
+            }
+            // `wobblog events` lists the margin warning.
+            Record::Channel(_) | Record::Margin(_) => {}
             Record::Config(line) => s.config.push(line.text.to_string()),
         }
         let stats = &mut self.row_stats;

@@ -20,6 +20,37 @@ fn info_reports_samples_duration_and_gps() {
     assert_eq!(info["gps_coverage_pct"], 100.0);
 }
 
+/// Kick records (tag 0x83) are counted, in the text and in JSON.
+#[test]
+fn info_counts_kicks() {
+    use analysis_support::{stdout_of, write_log, Extras, Ride};
+    use wobble_core::format::{KickRingDown, Record};
+    let dir = tempfile::tempdir().unwrap();
+    let log = dir.path().join("RUN00001.WBL");
+    let kick = |t_s: f64| {
+        Record::Kick(KickRingDown {
+            t_us: (t_s * 1e6) as u64,
+            speed_mm_s: Some(3100),
+            freq_chz: 620,
+            sigma_milli_per_s: -1800,
+            sigma_se_milli_per_s: 40,
+            amp_cdeg: 150,
+            segments: 9,
+        })
+    };
+    let extras = Extras {
+        markers_s: vec![4.0],
+        records: vec![kick(2.0), kick(6.0), kick(8.5)],
+        ..Extras::default()
+    };
+    write_log(&log, &Ride::new(10.0, 3.0, 0.0, 0.0, 0.0), &extras);
+    let info = info_json(&log);
+    assert_eq!(info["kicks"], 3, "{info}");
+    assert_eq!(info["records"]["kick"]["count"], 3, "{info}");
+    let text = stdout_of(wobblog().arg("info").arg(&log));
+    assert!(text.contains("kicks:        3 "), "{text}");
+}
+
 #[test]
 fn info_lists_records_by_kind_with_their_rates() {
     let dir = tempfile::tempdir().unwrap();

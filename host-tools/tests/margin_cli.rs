@@ -19,6 +19,11 @@ const FREQ_HZ: f64 = 6.5;
 /// then a ring of 1.5 degrees decaying at `0.5 (u - 4)`, plus a weave and
 /// small deterministic noise.
 fn pass(path: &Path, speed: f64, seed: u32) {
+    analysis_support::write_log(path, &pass_ride(speed, seed), &Extras::default());
+}
+
+/// The ride of [`pass`].
+fn pass_ride(speed: f64, seed: u32) -> Ride {
     let mut ride = Ride::new(10.0, speed, 0.0, 0.5, 0.0);
     let sigma = 0.5 * (speed - WOBBLE_MPS);
     let mut state = 0x9E37_79B9u32 ^ seed;
@@ -40,7 +45,7 @@ fn pass(path: &Path, speed: f64, seed: u32) {
         };
         *s += push + ring + noise;
     }
-    analysis_support::write_log(path, &ride, &Extras::default());
+    ride
 }
 
 /// `speeds.len()` passes in a new directory.
@@ -82,7 +87,7 @@ fn predicts_the_written_down_wobble_speed() {
     assert!(lo < WOBBLE_MPS && WOBBLE_MPS < hi && hi - lo < 0.6, "{v}");
     assert_eq!(v["kicks_used"], 12);
     assert_eq!(v["kicks_rejected"], 0);
-    assert!(v["method"].as_str().unwrap().contains("Fieller"));
+    assert!(v["method"].as_str().unwrap().contains("profile likelihood"));
     let kicks = v["kicks"].as_array().unwrap();
     assert_eq!(kicks.len(), 12);
     for k in kicks {
@@ -184,6 +189,76 @@ fn errors_name_the_input() {
     assert_eq!(code, Some(1));
     assert!(stderr.contains("RUN09999.WBL"), "{stderr}");
     assert_eq!(v["kicks_used"], 8, "{v}");
+}
+
+/// `encode --detect` runs the on-board detector over a CSV as the board
+/// does: the log holds its kick records (and the configuration in its
+/// header), `margin` takes them and says so per kick (`card-host`: the
+/// card's record, re-measured by the host), `--kicks card` uses the
+/// records alone, and a log encoded without `--detect` has none.
+#[test]
+fn card_kick_records_are_used_and_said_per_kick() {
+    let dir = tempfile::tempdir().unwrap();
+    for (i, u) in speeds(2.0, 3.4, 8).into_iter().enumerate() {
+        let ride = pass_ride(u, i as u32);
+        let mut csv = String::from("t_s,steer_deg,speed_mps\n");
+        for k in 0..ride.t_s.len() {
+            csv.push_str(&format!(
+                "{:.2},{:.3},{:.3}\n",
+                ride.t_s[k], ride.steer_deg[k], ride.speed_mps[k]
+            ));
+        }
+        let csv_path = dir.path().join(format!("pass{i}.csv"));
+        std::fs::write(&csv_path, csv).unwrap();
+        let status = wobblog()
+            .arg("encode")
+            .arg("--csv")
+            .arg(&csv_path)
+            .arg("-o")
+            .arg(dir.path().join(format!("RUN{i:05}.WBL")))
+            .arg("--detect")
+            .output()
+            .unwrap();
+        assert!(status.status.success());
+    }
+    let first = dir.path().join("RUN00000.WBL");
+    let info = analysis_support::info_json(&first);
+    assert_eq!(info["kicks"], 1, "{info}");
+    assert!(!info["config"].as_array().unwrap().is_empty(), "{info}");
+    let (code, v, stderr) = margin_json(&[dir.path().as_os_str()]);
+    assert_eq!(code, Some(0), "{stderr}");
+    let kicks = v["kicks"].as_array().unwrap();
+    assert_eq!(kicks.len(), 8, "{v}");
+    for k in kicks {
+        assert_eq!(k["source"], "card-host", "{k}");
+        assert!(k["card"]["sigma_per_s"].is_number(), "{k}");
+        assert_eq!(k["sigma_per_s"], k["host"]["sigma_per_s"], "{k}");
+    }
+    let w = v["wobble_speed_mps"].as_f64().unwrap();
+    assert!((w - WOBBLE_MPS).abs() < 0.15, "{v}");
+    // The card's records alone.
+    let (code, v, _) = margin_json(&[
+        dir.path().as_os_str(),
+        std::ffi::OsStr::new("--kicks"),
+        std::ffi::OsStr::new("card"),
+    ]);
+    assert_eq!(code, Some(0));
+    for k in v["kicks"].as_array().unwrap() {
+        assert_eq!(k["source"], "card", "{k}");
+        assert!(k["host"].is_null(), "{k}");
+    }
+    // Without --detect: no records.
+    let plain = dir.path().join("plain.wbl");
+    let status = wobblog()
+        .arg("encode")
+        .arg("--csv")
+        .arg(dir.path().join("pass0.csv"))
+        .arg("-o")
+        .arg(&plain)
+        .output()
+        .unwrap();
+    assert!(status.status.success());
+    assert_eq!(analysis_support::info_json(&plain)["kicks"], 0);
 }
 
 #[test]

@@ -1,6 +1,7 @@
 //! Offline analysis of a whole run: roll angle from the IMU, and wobble
 //! episodes measured as the seed paper does (frequency, growth rate, speed).
 
+pub mod campaign_kicks;
 pub mod censor;
 pub mod episodes;
 pub mod filter;

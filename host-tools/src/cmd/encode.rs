@@ -4,11 +4,14 @@ use std::fs::File;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
+use wobble_core::config::Config;
+use wobble_core::detector::Detector;
 use wobble_core::format::header::header_records;
 use wobble_core::format::limits::SPEED_CM_S_MAX;
 use wobble_core::format::{
-    quantise_i16, quantise_i32, quantise_u16, BlockEncoder, FixMode, Frame, GpsFix, LogInfo,
-    Record, UtcSync, ACCEL_COUNTS_PER_G, EDGE_AGE_NONE, GYRO_COUNTS_PER_DPS, STEER_COUNTS_PER_DEG,
+    quantise_i16, quantise_i32, quantise_u16, BlockEncoder, FixMode, Frame, FrameStatus, GpsFix,
+    LogInfo, Record, UtcSync, ACCEL_COUNTS_PER_G, EDGE_AGE_NONE, GYRO_COUNTS_PER_DPS,
+    STEER_COUNTS_PER_DEG,
 };
 
 use crate::csv_input::{number_in, Cell, TimeSteps};
@@ -36,6 +39,23 @@ pub struct Args {
     /// the row before each frame. Without this, such a CSV is an error.
     #[arg(long)]
     pub resample: bool,
+    /// Run the on-board detector over the frames as the board does, with
+    /// the default configuration, and store what it writes: its alert
+    /// records (and the frames' alert flag) and its kick ring-down records
+    /// (`wobblog events`, `wobblog margin`). The configuration goes into
+    /// the header, as the board's does. A gap restarts the detector.
+    #[arg(long)]
+    pub detect: bool,
+}
+
+/// How `encode` builds the log.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Options {
+    /// Interpolate a CSV at another rate (or an uneven one) onto the log's
+    /// frames.
+    pub resample: bool,
+    /// Run the on-board detector and store its alert and kick records.
+    pub detect: bool,
 }
 
 /// The frame rate of the logs `encode` writes, as the firmware's.
@@ -50,7 +70,11 @@ pub fn run(args: &Args) -> Result<(), CliError> {
     let mut output = Output::create(&args.output, &[&args.csv])?;
     let input = File::open(&args.csv).map_err(|e| CliError::file(&args.csv, e))?;
     let input = crate::csv_input::LineCap::new(input);
-    encode(input, &args.csv, &mut output, &args.output, args.resample)?;
+    let options = Options {
+        resample: args.resample,
+        detect: args.detect,
+    };
+    encode_with(input, &args.csv, &mut output, &args.output, options)?;
     output.commit()
 }
 
@@ -157,6 +181,22 @@ pub fn encode(
     out_name: &Path,
     resample: bool,
 ) -> Result<(), CliError> {
+    let options = Options {
+        resample,
+        detect: false,
+    };
+    encode_with(input, in_name, output, out_name, options)
+}
+
+/// [`encode`] with every option.
+pub fn encode_with(
+    input: impl std::io::Read,
+    in_name: &Path,
+    output: impl Write,
+    out_name: &Path,
+    options: Options,
+) -> Result<(), CliError> {
+    let resample = options.resample;
     let mut reader = csv::ReaderBuilder::new()
         .trim(csv::Trim::All)
         .from_reader(input);
@@ -182,6 +222,7 @@ pub fn encode(
         last_gps: None,
         frames: 0,
         line: 0,
+        detector: options.detect.then(OnBoard::new).transpose()?,
     };
     let mut record = csv::StringRecord::new();
     let mut steps = if resample {
@@ -228,6 +269,66 @@ struct LogWriter<'a, W> {
     frames: u64,
     /// The CSV line being read, for messages.
     line: u64,
+    /// The on-board detector, with `--detect`.
+    detector: Option<OnBoard>,
+}
+
+/// The on-board detector as the board's sampler runs it on the frames.
+struct OnBoard {
+    config: Config,
+    detector: Detector,
+    /// Time of the last frame it saw, µs.
+    last_us: Option<u64>,
+}
+
+impl OnBoard {
+    fn new() -> Result<Self, CliError> {
+        let config = Config::default();
+        let detector = config
+            .detector()
+            .map_err(|e| CliError::Failed(format!("the default detector: {e}")))?;
+        Ok(Self {
+            config,
+            detector,
+            last_us: None,
+        })
+    }
+
+    /// The configuration lines the board writes into the header.
+    fn header_lines(&self) -> Vec<String> {
+        let mut text = String::new();
+        // Writing into a String cannot fail.
+        let _ = self.config.write_lines(&mut text);
+        text.lines().map(String::from).collect()
+    }
+
+    /// Feeds `frame` (as the card stores it) and sets its alert flag; the
+    /// records the board would write before it (an alert switching, a
+    /// measured kick) go to `out`. A gap of more than 1.5 frame periods
+    /// restarts the detector, as `wobblog detect` does.
+    fn step(&mut self, frame: &mut Frame, out: &mut Vec<Record<'static>>) {
+        let period_us = 1_000_000 / u64::from(SAMPLE_RATE_HZ);
+        if self
+            .last_us
+            .is_some_and(|last| frame.t_us.saturating_sub(last) > period_us * 3 / 2)
+        {
+            self.detector.reset();
+        }
+        self.last_us = Some(frame.t_us);
+        if let Some(ev) = self
+            .detector
+            .push(frame.steer_deg(), Some(frame.speed_mps()))
+        {
+            out.push(Record::Alert(ev.to_record(frame.t_us)));
+        }
+        if let Some(kick) = self.detector.take_kick() {
+            let rate_hz = self.detector.config().sample_rate_hz;
+            out.push(Record::Kick(kick.to_record(frame.t_us, rate_hz)));
+        }
+        if self.detector.alert_active() {
+            frame.status.0 |= FrameStatus::ALERT;
+        }
+    }
 }
 
 impl<W: Write> LogWriter<'_, W> {
@@ -250,7 +351,9 @@ impl<W: Write> LogWriter<'_, W> {
                 sample_rate_hz: SAMPLE_RATE_HZ,
                 run: 0,
             };
-            for rec in header_records(info, []) {
+            let lines = self.detector.as_ref().map(OnBoard::header_lines);
+            let lines = lines.iter().flatten().map(String::as_str);
+            for rec in header_records(info, lines) {
                 self.push(&rec)?;
             }
         }
@@ -263,7 +366,15 @@ impl<W: Write> LogWriter<'_, W> {
         if let Some(sync) = sync {
             self.push(&Record::UtcSync(sync))?;
         }
-        self.push(&Record::Frame(row.frame))?;
+        let mut frame = row.frame;
+        if let Some(detector) = &mut self.detector {
+            let mut records = Vec::new();
+            detector.step(&mut frame, &mut records);
+            for record in &records {
+                self.push(record)?;
+            }
+        }
+        self.push(&Record::Frame(frame))?;
         if let Some(fix) = gps_update(&self.last_gps, row.gps, row.frame.t_us) {
             self.push(&Record::Gps(fix))?;
             self.last_gps = Some((row.frame.t_us, fix));

@@ -124,6 +124,7 @@ fn render(path: &std::path::Path, s: &Summary) -> String {
         );
     }
     let _ = writeln!(o, "markers:      {}", s.markers.len());
+    let _ = writeln!(o, "kicks:        {} ring-downs measured on board", s.kicks);
     let faults: Vec<String> = s.faults.iter().map(|(k, v)| format!("{k} {v}")).collect();
     let _ = writeln!(
         o,

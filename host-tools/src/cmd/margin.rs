@@ -7,8 +7,9 @@ use std::path::{Path, PathBuf};
 
 use serde::Serialize;
 
-use crate::analysis::margin::{predict, KickPoint, Margin};
-use crate::analysis::{find_kicks, Kick, Run};
+use crate::analysis::campaign_kicks::{campaign_kicks, CampaignKick, Prefer};
+use crate::analysis::margin::{predict_with, KickPoint, Margin, Trend};
+use crate::analysis::Run;
 use crate::cmd::detect::log_config;
 use crate::cmd::logs::{for_each_log, print_stdout, warn_losses};
 use crate::cmd::margin_model::{estimate, ModelEstimate, DEFAULT_PARAMS};
@@ -40,6 +41,17 @@ pub struct Args {
     /// head's stiffness and damping).
     #[arg(long = "param", value_name = "KEY", requires = "model")]
     pub params: Vec<String>,
+    /// Which kick measurements to use: `best` (the card's kick records,
+    /// re-measured by the host from the steering signal; the host's own
+    /// where the card has none, the card's where the host finds none),
+    /// `card` (only the card's records) or `host` (only the host's).
+    #[arg(long, value_enum, default_value_t = Prefer::Best)]
+    pub kicks: Prefer,
+    /// The trend of sigma against speed: `line` (a straight line whose
+    /// interval allows for sigma's bend beyond the kicks) or `quadratic`
+    /// (fitted to the kicks alone: worse on the simulated campaigns).
+    #[arg(long, value_enum, default_value_t = Trend::Line)]
+    pub trend: Trend,
 }
 
 /// One kick as reported.
@@ -47,11 +59,11 @@ pub struct Args {
 pub struct KickRow {
     /// The log it is in.
     pub log: String,
-    /// Where its measurement comes from: `host` (the steering signal).
-    pub source: &'static str,
-    /// The kick's ring-down.
+    /// The kick: where its values come from (`source`: `card`, `host` or
+    /// `card-host`), the values, and the host's fit and the card's record
+    /// behind them.
     #[serde(flatten)]
-    pub kick: Kick,
+    pub kick: CampaignKick,
     /// Whether the regression used it (an outlier gets no weight).
     pub used: bool,
 }
@@ -71,8 +83,15 @@ pub struct Report {
     pub method: String,
     /// Speeds of the kicks used, m/s.
     pub speed_range_mps: Option<[f64; 2]>,
-    /// The line `sigma = a + b u`: `[a (1/s), b (1/s per m/s)]`.
-    pub line: Option<[f64; 2]>,
+    /// The trend fitted (`quadratic` or `line`).
+    pub trend: Trend,
+    /// Its coefficients `[a, b, c]` of `sigma = a + b u + c u^2` (1/s,
+    /// speed in m/s; no `c` for a line).
+    pub coefficients: Option<Vec<f64>>,
+    /// The kicks' scatter about the trend over what their uncertainties
+    /// say (variance of unit weight; the interval is widened by it when
+    /// above 1).
+    pub unit_variance: Option<f64>,
     /// Why the answer is weaker than it looks.
     pub warnings: Vec<String>,
     /// Every kick, in the order of the logs.
@@ -100,24 +119,28 @@ fn expand(inputs: &[PathBuf]) -> Result<Vec<PathBuf>, CliError> {
     Ok(logs)
 }
 
-/// Every kick of `log`, measured from its steering signal with the wheel
-/// the log was recorded with.
-fn kicks_of(log: &Path) -> Result<Vec<Kick>, CliError> {
+/// Every kick of `log`: its kick records and what the host measures from
+/// its steering signal with the wheel the log was recorded with, taken as
+/// `prefer` says.
+fn kicks_of(log: &Path, prefer: Prefer) -> Result<Vec<CampaignKick>, CliError> {
     let run = Run::load(log)?;
     warn_losses(log, &run.summary);
     let config = log_config(&run.summary.config, &[])?;
-    Ok(find_kicks(&run, f64::from(config.wheel.circumference_m)))
+    Ok(campaign_kicks(
+        &run,
+        f64::from(config.wheel.circumference_m),
+        prefer,
+    ))
 }
 
 /// Gathers the kicks of `logs` behind a progress bar; a log that cannot be
 /// read is reported and the rest still count.
-fn gather(logs: &[PathBuf]) -> (Vec<KickRow>, Result<(), CliError>) {
+fn gather(logs: &[PathBuf], prefer: Prefer) -> (Vec<KickRow>, Result<(), CliError>) {
     let mut rows = Vec::new();
     let result = for_each_log(logs, "measuring kicks", |log| {
         let name = log.display().to_string();
-        rows.extend(kicks_of(log)?.into_iter().map(|kick| KickRow {
+        rows.extend(kicks_of(log, prefer)?.into_iter().map(|kick| KickRow {
             log: name.clone(),
-            source: "host",
             kick,
             used: false,
         }));
@@ -128,7 +151,7 @@ fn gather(logs: &[PathBuf]) -> (Vec<KickRow>, Result<(), CliError>) {
 
 /// The report of `rows` and the prediction made from them.
 #[must_use]
-pub fn report(mut rows: Vec<KickRow>) -> (Report, Margin) {
+pub fn report(mut rows: Vec<KickRow>, trend: Trend) -> (Report, Margin) {
     let points: Vec<KickPoint> = rows
         .iter()
         .map(|r| KickPoint {
@@ -138,7 +161,7 @@ pub fn report(mut rows: Vec<KickRow>) -> (Report, Margin) {
             freq_hz: r.kick.freq_hz,
         })
         .collect();
-    let margin = predict(&points);
+    let margin = predict_with(&points, trend);
     for (row, w) in rows.iter_mut().zip(&margin.weights) {
         row.used = *w > 0.0;
     }
@@ -149,7 +172,9 @@ pub fn report(mut rows: Vec<KickRow>) -> (Report, Margin) {
         kicks_rejected: margin.kicks_rejected,
         method: margin.method.clone(),
         speed_range_mps: margin.speed_range_mps,
-        line: margin.line,
+        trend: margin.trend,
+        coefficients: margin.coefficients.clone(),
+        unit_variance: margin.unit_variance,
         warnings: margin.warnings.clone(),
         kicks: rows,
         model: None,
@@ -172,11 +197,11 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         .as_deref()
         .map(|p| Output::create(p, &inputs))
         .transpose()?;
-    let (rows, result) = gather(&logs);
+    let (rows, result) = gather(&logs, args.kicks);
     if rows.is_empty() && result.is_err() {
         return result;
     }
-    let (mut report, margin) = report(rows);
+    let (mut report, margin) = report(rows, args.trend);
     if let Some(params) = &args.model {
         let keys: Vec<String> = if args.params.is_empty() {
             DEFAULT_PARAMS.iter().map(|k| (*k).to_owned()).collect()
@@ -268,8 +293,21 @@ fn render_text(r: &Report, logs: usize) -> String {
     if let Some([lo, hi]) = r.speed_range_mps {
         let _ = writeln!(o, "kicks used between {lo:.2} and {hi:.2} m/s");
     }
-    if let Some([a, b]) = r.line {
-        let _ = writeln!(o, "sigma = {a:.3} + {b:.3} * speed (1/s, speed in m/s)");
+    if let Some(c) = &r.coefficients {
+        let terms = ["", " * speed", " * speed^2"];
+        let sum: Vec<String> = c
+            .iter()
+            .zip(terms)
+            .map(|(c, t)| format!("{c:+.4}{t}"))
+            .collect();
+        let _ = writeln!(o, "sigma = {} (1/s, speed in m/s)", sum.join(" "));
+    }
+    if let Some(s2) = r.unit_variance {
+        let _ = writeln!(
+            o,
+            "scatter about the trend: {:.2} times the kicks' stated SD",
+            s2.sqrt()
+        );
     }
     for w in &r.warnings {
         let _ = writeln!(o, "warning: {w}");
@@ -302,19 +340,20 @@ fn render_text(r: &Report, logs: usize) -> String {
     if !r.kicks.is_empty() {
         let _ = writeln!(
             o,
-            "  t_s       speed_mps  freq_hz  sigma_per_s  sigma_sd_per_s  amp_deg  used  log"
+            "  t_s       speed_mps  freq_hz  sigma_per_s  sigma_sd_per_s  amp_deg  source     used  log"
         );
     }
     for k in &r.kicks {
         let _ = writeln!(
             o,
-            "  {:8.2}  {:9.2}  {:7.2}  {:11.3}  {:14.3}  {:7.2}  {:4}  {}",
+            "  {:8.2}  {:9.2}  {:7.2}  {:11.3}  {:14.3}  {:7.2}  {:9}  {:4}  {}",
             k.kick.t_s,
             k.kick.speed_mps,
             k.kick.freq_hz,
             k.kick.sigma_per_s,
             k.kick.sigma_sd_per_s,
             k.kick.amp_deg,
+            k.kick.source.as_str(),
             if k.used { "yes" } else { "no" },
             escape_controls(&k.log)
         );

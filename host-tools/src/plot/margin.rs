@@ -1,5 +1,5 @@
 //! The campaign's damping trend: every kick's sigma against its speed with
-//! its error bar (two standard uncertainties), the robust line and its
+//! its error bar (two standard uncertainties), the robust trend and its
 //! 95 % band carried forward to zero, the predicted wobble speed with its
 //! interval, and the model's curve when one was fitted: the seed paper's
 //! Figure 8 (left panel) extended forward.
@@ -9,7 +9,7 @@ use plotters::prelude::*;
 
 use super::modes::{DOT_PX, ZERO_LINE_COLOUR};
 use super::{padded_range, tick_label, Figure, FONT};
-use crate::analysis::margin::{t_975, Margin};
+use crate::analysis::margin::{Margin, Trend};
 
 /// One kick as drawn.
 #[derive(Clone, Debug, PartialEq)]
@@ -70,12 +70,7 @@ impl MarginPlot {
     }
 
     fn band(&self, u: f64) -> Option<(f64, f64, f64)> {
-        let [a, b] = self.margin.line?;
-        let [vaa, vab, vbb] = self.margin.covariance?;
-        let t = t_975(self.margin.dof);
-        let y = a + b * u;
-        let half = t * (vaa + 2.0 * u * vab + u * u * vbb).max(0.0).sqrt();
-        Some((y, y - half, y + half))
+        self.margin.band(u)
     }
 }
 
@@ -169,7 +164,10 @@ impl Figure for MarginPlot {
             chart
                 .draw_series(LineSeries::new(fit, FIT.stroke_width(2)))
                 .map_err(err)?
-                .label("robust straight line")
+                .label(match self.margin.trend {
+                    Trend::Line => "robust straight line",
+                    Trend::Quadratic => "robust quadratic",
+                })
                 .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], FIT.stroke_width(2)));
         }
         if let Some(w) = self.margin.wobble_speed_mps.filter(|w| x_range.contains(w)) {

@@ -407,7 +407,10 @@ pub fn simulate(variant: &Variant, plan: &Plan, seed: u64) -> Result<Campaign, S
 
 impl Campaign {
     /// Writes every pass as a card log `NAME.wbl` into `dir` (through the
-    /// encoder `wobblog encode` uses) and the answer as `truth.json`.
+    /// encoder `wobblog encode` uses, with the on-board detector run over
+    /// the frames as the board runs it, so each log holds the alert and
+    /// kick records the board would have written: `wobblog encode
+    /// --detect`) and the answer as `truth.json`.
     /// Returns the logs' paths.
     ///
     /// # Errors
@@ -418,12 +421,16 @@ impl Campaign {
         for pass in &self.passes {
             let log = dir.join(format!("{}.wbl", pass.fixture.truth.name));
             let mut out = Vec::new();
-            wobblog::cmd::encode::encode(
+            let options = wobblog::cmd::encode::Options {
+                resample: false,
+                detect: true,
+            };
+            wobblog::cmd::encode::encode_with(
                 pass.fixture.csv.as_bytes(),
                 Path::new(&pass.fixture.truth.file),
                 &mut out,
                 &log,
-                false,
+                options,
             )
             .map_err(|e| e.to_string())?;
             std::fs::write(&log, out).map_err(|e| format!("{}: {e}", log.display()))?;
