@@ -239,7 +239,7 @@ fn control_characters_from_the_log_are_shown_escaped() {
     let log = dir.path().join("esc.wbl");
     write_log(
         &log,
-        info("fw\u{1b}]0;owned\u{7}\u{1b}[2J", 100),
+        info("fw\u{1b}]0;owned\u{7}\u{1b}[2J\u{9b}2J\u{202e}", 100),
         &["alert.enabled=true\u{1b}[31m"],
         (0..100).map(|i| frame(i * 10_000)),
     );
@@ -250,7 +250,18 @@ fn control_characters_from_the_log_are_shown_escaped() {
             "{args:?}: raw control bytes reach the terminal"
         );
         let text = String::from_utf8_lossy(&out.stdout);
-        if args != ["info", "--json"] {
+        assert!(
+            !text.contains(['\u{9b}', '\u{202e}']),
+            "{args:?}: a C1 control or a bidi override reaches the terminal: {text}"
+        );
+        if args == ["info", "--json"] {
+            // The JSON value is still the log's exact string.
+            let json: serde_json::Value = serde_json::from_str(&text).unwrap();
+            assert_eq!(
+                json["firmware"], "fw\u{1b}]0;owned\u{7}\u{1b}[2J\u{9b}2J\u{202e}",
+                "{text}"
+            );
+        } else {
             assert!(text.contains("fw\\u{1b}]0;owned\\u{7}"), "{args:?}: {text}");
         }
     }

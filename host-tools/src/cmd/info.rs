@@ -24,7 +24,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
     let text = if args.output.is_json()? {
         let json =
             serde_json::to_string_pretty(&summary).map_err(|e| CliError::file(&args.log, e))?;
-        json + "\n"
+        crate::text::json_terminal_safe(json) + "\n"
     } else {
         render(&args.log, &summary)
     };
