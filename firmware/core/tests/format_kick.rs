@@ -2,27 +2,11 @@
 //! `firmware/FORMAT.md` lays them out, the round trip, a body longer than
 //! this reader knows (a later minor version), and a 1.0 card still decoding.
 
-use wobble_core::format::block::{BlockHeader, BLOCK_LEN, VERSION_MINOR};
+use wobble_core::format::block::VERSION_MINOR;
 use wobble_core::format::*;
 
 mod format_support;
-use format_support::{encode, frame};
-
-fn decode(file: &[u8]) -> (Vec<Record<'static>>, DecodeStats) {
-    let mut dec = Decoder::new();
-    let mut out = Vec::new();
-    dec.feed(file, true, &mut |e| {
-        if let Event::Record(r) = e {
-            // Frames and kicks own no borrowed text.
-            match r {
-                Record::Frame(f) => out.push(Record::Frame(f)),
-                Record::Kick(k) => out.push(Record::Kick(k)),
-                _ => {}
-            }
-        }
-    });
-    (out, *dec.stats())
-}
+use format_support::{decode, encode, frame, reseal};
 
 const KICK: KickRingDown = KickRingDown {
     t_us: 1_985_000,
@@ -80,15 +64,6 @@ fn kicks_round_trip_with_and_without_speed() {
     let (decoded, stats) = decode(&encode(&records));
     assert_eq!(decoded, records);
     assert_eq!(stats.unknown_records, 0);
-}
-
-/// Rewrites block 0 of `file`: `edit` gets its header and bytes (CRC
-/// checked first), then the block is resealed.
-fn reseal(file: &mut [u8], edit: impl FnOnce(&mut BlockHeader, &mut [u8])) {
-    let block: &mut Block = (&mut file[..BLOCK_LEN]).try_into().unwrap();
-    let mut header = BlockHeader::parse(block).unwrap();
-    edit(&mut header, block);
-    header.seal(block);
 }
 
 #[test]

@@ -4,28 +4,11 @@
 //! decoding.
 
 use wobble_core::detector::WobbleSpeed;
-use wobble_core::format::block::{BlockHeader, BLOCK_LEN, VERSION_MINOR};
+use wobble_core::format::block::VERSION_MINOR;
 use wobble_core::format::*;
 
 mod format_support;
-use format_support::{encode, frame};
-
-fn decode(file: &[u8]) -> (Vec<Record<'static>>, DecodeStats) {
-    let mut dec = Decoder::new();
-    let mut out = Vec::new();
-    dec.feed(file, true, &mut |e| {
-        if let Event::Record(r) = e {
-            // Frames, kicks and margin records own no borrowed text.
-            match r {
-                Record::Frame(f) => out.push(Record::Frame(f)),
-                Record::Kick(k) => out.push(Record::Kick(k)),
-                Record::Margin(m) => out.push(Record::Margin(m)),
-                _ => {}
-            }
-        }
-    });
-    (out, *dec.stats())
-}
+use format_support::{decode, encode, frame, reseal};
 
 const MARGIN: MarginRecord = MarginRecord {
     t_us: 2_003_000,
@@ -146,15 +129,6 @@ fn the_record_is_built_from_the_estimate_in_force() {
     let r = MarginRecord::new(5, MarginState::Clear, Some(1e9), None);
     assert_eq!(r.speed_mm_s, Some(0xFFFE));
     assert_eq!((r.lower_mm_s, r.kicks), (None, 0));
-}
-
-/// Rewrites block 0 of `file`: `edit` gets its header and bytes (CRC
-/// checked first), then the block is resealed.
-fn reseal(file: &mut [u8], edit: impl FnOnce(&mut BlockHeader, &mut [u8])) {
-    let block: &mut Block = (&mut file[..BLOCK_LEN]).try_into().unwrap();
-    let mut header = BlockHeader::parse(block).unwrap();
-    edit(&mut header, block);
-    header.seal(block);
 }
 
 #[test]

@@ -2,6 +2,7 @@
 //! decoder, for the format tests.
 #![allow(dead_code)] // Each test file uses the helpers it needs.
 
+use wobble_core::format::block::{BlockHeader, BLOCK_LEN};
 use wobble_core::format::*;
 
 /// A frame at `t_us` with every sensor field zero.
@@ -33,4 +34,31 @@ pub fn decode_events(file: &[u8]) -> (Vec<Event<'_>>, DecodeStats) {
     let mut events = Vec::new();
     dec.feed(file, true, &mut |e| events.push(e));
     (events, *dec.stats())
+}
+
+/// The frames, kicks and margin records the decoder reports for `file`
+/// (the records that own no borrowed text), and its statistics.
+pub fn decode(file: &[u8]) -> (Vec<Record<'static>>, DecodeStats) {
+    let mut dec = Decoder::new();
+    let mut out = Vec::new();
+    dec.feed(file, true, &mut |e| {
+        if let Event::Record(r) = e {
+            match r {
+                Record::Frame(f) => out.push(Record::Frame(f)),
+                Record::Kick(k) => out.push(Record::Kick(k)),
+                Record::Margin(m) => out.push(Record::Margin(m)),
+                _ => {}
+            }
+        }
+    });
+    (out, *dec.stats())
+}
+
+/// Rewrites block 0 of `file`: `edit` gets its header and bytes (CRC
+/// checked first), then the block is resealed.
+pub fn reseal(file: &mut [u8], edit: impl FnOnce(&mut BlockHeader, &mut [u8])) {
+    let block: &mut Block = (&mut file[..BLOCK_LEN]).try_into().unwrap();
+    let mut header = BlockHeader::parse(block).unwrap();
+    edit(&mut header, block);
+    header.seal(block);
 }
