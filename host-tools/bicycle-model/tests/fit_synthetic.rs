@@ -6,9 +6,8 @@ use std::path::Path;
 use proptest::prelude::RngExt;
 use proptest::test_runner::{RngAlgorithm, TestRng};
 use wobble_model::fit::{fit, Observation, Weights};
-use wobble_model::sweep::mode_at;
-use wobble_model::synthetic::Synthetic;
-use wobble_model::{Mode, Model, ParamSet};
+use wobble_model::synthetic::{self, Synthetic};
+use wobble_model::ParamSet;
 
 fn test_bicycle() -> ParamSet {
     ParamSet::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("params/test-bicycle.toml")).unwrap()
@@ -130,18 +129,7 @@ fn fit_from_far_with_a_tense_rider_finds_the_wobble() {
     let mut start = truth.clone();
     start.set_value(&key, 0.6 * k_true, "far start").unwrap();
     let speeds: Vec<f64> = (0..8).map(|i| 2.0 + f64::from(i)).collect();
-    let wobble = mode_at(&Model::from_set(&truth).unwrap(), Mode::Wobble, &speeds)
-        .unwrap()
-        .unwrap();
-    let obs: Vec<Observation> = speeds
-        .iter()
-        .zip(&wobble)
-        .map(|(&u, w)| Observation {
-            speed_mps: u,
-            freq_hz: w.im / std::f64::consts::TAU,
-            sigma_per_s: w.re,
-        })
-        .collect();
+    let obs = synthetic::observations(&truth, &speeds).unwrap();
     let weights = Weights {
         freq_sd_hz: 0.05,
         sigma_sd_per_s: 0.2,
