@@ -28,7 +28,7 @@ use std::path::Path;
 
 use nalgebra::DVector;
 use wobble_model::multibody::{N_COORDS, PHI, R, V};
-use wobble_model::wobble::WobbleModel;
+use wobble_model::wobble::{WobbleModel, WobbleParams};
 use wobble_model::ParamSet;
 
 fn model() -> WobbleModel {
@@ -109,6 +109,19 @@ fn a_lateral_velocity_is_a_slip_relaxed_over_sigma() {
     }
 }
 
+/// The twist axis of `p`: its direction `t = (cos lambda, 0, -sin lambda)`
+/// and its point `o` on the steer axis at the twist joint's height.
+fn twist_axis(p: &WobbleParams) -> (nalgebra::Vector3<f64>, nalgebra::Vector3<f64>) {
+    let lam = p.steer_axis_tilt;
+    let t = nalgebra::Vector3::new(lam.cos(), 0.0, -lam.sin());
+    let o = nalgebra::Vector3::new(
+        p.wheelbase + p.trail + p.twist_z * lam.tan(),
+        0.0,
+        p.twist_z,
+    );
+    (t, o)
+}
+
 /// The twist mode with the frame locked: the fork and front wheel turn about
 /// the twist axis `t = (cos lambda, 0, -sin lambda)` through the steer axis at
 /// height `steer_head.z`, on the head spring. By hand (parallel axes) its
@@ -123,13 +136,7 @@ fn twist_inertia_and_frequency_with_the_frame_locked() {
     use wobble_model::multibody::BETA;
     let m = model();
     let p = m.params;
-    let lam = p.steer_axis_tilt;
-    let t = Vector3::new(lam.cos(), 0.0, -lam.sin());
-    let o = Vector3::new(
-        p.wheelbase + p.trail + p.twist_z * lam.tan(),
-        0.0,
-        p.twist_z,
-    );
+    let (t, o) = twist_axis(&p);
     let fw = p.front_wheel;
     let bodies = [
         (
@@ -187,12 +194,7 @@ fn twist_gravity_stiffness_through_the_forced_pitch() {
     let m = model();
     let p = m.params;
     let lam = p.steer_axis_tilt;
-    let t = Vector3::new(lam.cos(), 0.0, -lam.sin());
-    let o = Vector3::new(
-        p.wheelbase + p.trail + p.twist_z * lam.tan(),
-        0.0,
-        p.twist_z,
-    );
+    let (t, o) = twist_axis(&p);
     let fw = p.front_wheel;
     let wheel = Vector3::new(p.wheelbase, 0.0, -fw.radius);
     let fork = Vector3::new(p.fork.x, 0.0, p.fork.z);
