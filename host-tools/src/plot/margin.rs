@@ -8,7 +8,7 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use super::modes::{DOT_PX, ZERO_LINE_COLOUR};
-use super::{padded_range, tick_label, Figure, FONT};
+use super::{numbers_chart, padded_range, titled_page, Figure, FONT};
 use crate::analysis::margin::{Margin, Trend};
 
 /// One kick as drawn.
@@ -81,10 +81,7 @@ impl Figure for MarginPlot {
 
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String> {
         let err = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
-        root.fill(&WHITE).map_err(err)?;
-        let root = root
-            .titled("Damping trend of the wobble mode", (FONT, 20))
-            .map_err(err)?;
+        let root = titled_page(root, "Damping trend of the wobble mode")?;
         let x_range = self.x_range();
         let us: Vec<f64> = (0..=STEPS)
             .map(|i| x_range.start + (x_range.end - x_range.start) * i as f64 / STEPS as f64)
@@ -107,22 +104,12 @@ impl Figure for MarginPlot {
         let model = curve.iter().map(|p| p.1);
         let line = band.iter().map(|b| b.1 .0);
         let y_range = padded_range(dots.chain(model).chain(line).chain([0.0]), 1.0);
-        let mut chart = ChartBuilder::on(&root)
-            .margin(16)
-            .x_label_area_size(44)
-            .y_label_area_size(64)
-            .build_cartesian_2d(x_range.clone(), y_range.clone())
-            .map_err(err)?;
-        chart
-            .configure_mesh()
-            .x_desc("speed (m/s)")
-            .y_desc("growth rate sigma (1/s)")
-            .x_label_formatter(&|v| tick_label(*v))
-            .y_label_formatter(&|v| tick_label(*v))
-            .label_style((FONT, 13))
-            .axis_desc_style((FONT, 15))
-            .draw()
-            .map_err(err)?;
+        let mut chart = numbers_chart(
+            &root,
+            16,
+            (x_range.clone(), y_range.clone()),
+            ("speed (m/s)", "growth rate sigma (1/s)"),
+        )?;
         let clip = |y: f64| y.clamp(y_range.start, y_range.end);
         // The 95 % band of the line, then the interval of the crossing.
         if !band.is_empty() {

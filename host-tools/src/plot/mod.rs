@@ -10,9 +10,11 @@ mod svg_font;
 pub mod timeplot;
 
 use std::io::Write;
+use std::ops::Range;
 use std::path::Path;
 use std::sync::Once;
 
+use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
@@ -201,6 +203,50 @@ impl Decimator {
         }
         lines
     }
+}
+
+/// `root` filled white under `title`: the page every figure is drawn on.
+///
+/// # Errors
+/// The backend's error, as text.
+pub fn titled_page<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    title: &str,
+) -> Result<DrawingArea<DB, Shift>, String> {
+    root.fill(&WHITE).map_err(|e| e.to_string())?;
+    root.titled(title, (FONT, 20)).map_err(|e| e.to_string())
+}
+
+/// A chart of `x_range` by `y_range` on `area`, `margin_px` from its edge,
+/// with its mesh drawn: `x_desc` and `y_desc` as the axes' names and
+/// [`tick_label`] ticks. The axes of the margin and mode figures.
+///
+/// # Errors
+/// The backend's error, as text.
+pub fn numbers_chart<'a, DB: DrawingBackend>(
+    area: &'a DrawingArea<DB, Shift>,
+    margin_px: u32,
+    (x_range, y_range): (Range<f64>, Range<f64>),
+    (x_desc, y_desc): (&str, &str),
+) -> Result<ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>, String> {
+    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
+    let mut chart = ChartBuilder::on(area)
+        .margin(margin_px)
+        .x_label_area_size(44)
+        .y_label_area_size(64)
+        .build_cartesian_2d(x_range, y_range)
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .x_desc(x_desc)
+        .y_desc(y_desc)
+        .x_label_formatter(&|v| tick_label(*v))
+        .y_label_formatter(&|v| tick_label(*v))
+        .label_style((FONT, 13))
+        .axis_desc_style((FONT, 15))
+        .draw()
+        .map_err(err)?;
+    Ok(chart)
 }
 
 /// An axis tick: the shortest of up to three decimals that shows the

@@ -7,7 +7,7 @@
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::{padded_range, tick_label, Figure, FONT};
+use super::{numbers_chart, padded_range, titled_page, Figure, FONT};
 use crate::analysis::{Episode, Stability};
 
 /// Axis labels.
@@ -158,22 +158,7 @@ impl ModePlot {
             SigmaAxis::None => 1.0,
         };
         let y_range = padded_range(ys, y_span);
-        let mut chart = ChartBuilder::on(area)
-            .margin(12)
-            .x_label_area_size(44)
-            .y_label_area_size(64)
-            .build_cartesian_2d(x_range.clone(), y_range.clone())
-            .map_err(err)?;
-        chart
-            .configure_mesh()
-            .x_desc(labels.0)
-            .y_desc(labels.1)
-            .x_label_formatter(&|v| tick_label(*v))
-            .y_label_formatter(&|v| tick_label(*v))
-            .label_style((FONT, 13))
-            .axis_desc_style((FONT, 15))
-            .draw()
-            .map_err(err)?;
+        let mut chart = numbers_chart(area, 12, (x_range.clone(), y_range.clone()), labels)?;
         let zero_line = match sigma_on {
             SigmaAxis::X => Some(vec![(0.0, y_range.start), (0.0, y_range.end)]),
             SigmaAxis::Y => Some(vec![(x_range.start, 0.0), (x_range.end, 0.0)]),
@@ -231,9 +216,7 @@ impl Figure for ModePlot {
     }
 
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String> {
-        let err = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
-        root.fill(&WHITE).map_err(err)?;
-        let root = root.titled("Wobble modes", (FONT, 20)).map_err(err)?;
+        let root = titled_page(root, "Wobble modes")?;
         let (plots, key) = root.split_horizontally(SIZE_PX.0 - KEY_PX);
         let (plane, by_speed) = plots.split_horizontally((SIZE_PX.0 - KEY_PX) * 11 / 20);
         let (sigma, freq) = by_speed.split_vertically((SIZE_PX.1 - 30) / 2);

@@ -6,7 +6,7 @@ use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::{padded_range, tick_label, Decimator, Figure, FONT};
+use super::{padded_range, tick_label, titled_page, Decimator, Figure, FONT};
 use crate::analysis::filter::follows;
 use crate::analysis::roll::RollStream;
 use crate::analysis::Run;
@@ -318,8 +318,7 @@ impl Figure for TimePlot {
 
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String> {
         let err = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
-        root.fill(&WHITE).map_err(err)?;
-        let root = root.titled(&self.title, (FONT, 20)).map_err(err)?;
+        let root = titled_page(root, &self.title)?;
         let panels = root.split_evenly((PANELS.len(), 1));
         let last = PANELS.len() - 1;
         for (k, ((area, label), series)) in panels.iter().zip(PANELS).zip(&self.series).enumerate()
