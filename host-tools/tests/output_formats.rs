@@ -4,32 +4,7 @@
 
 mod analysis_support;
 
-use std::path::Path;
-
-use analysis_support::{python, wobblog, write_log, Extras, Ride};
-
-/// A 20 s ride from 1 s since boot whose GPS has no fix before 5 s: 400
-/// rows with empty GPS cells first, as on every real ride.
-fn late_fix_log(path: &Path) {
-    let ride = Ride::new(20.0, 5.0, 0.0, 0.0, 0.0);
-    let extras = Extras {
-        gps: true,
-        gps_outages_s: vec![(0.0, 5.0)],
-        ..Extras::default()
-    };
-    write_log(path, &ride, &extras);
-}
-
-fn decode(log: &Path, out: &Path, extra: &[&str]) -> std::process::Output {
-    wobblog()
-        .arg("decode")
-        .arg(log)
-        .arg("-o")
-        .arg(out)
-        .args(extra)
-        .output()
-        .unwrap()
-}
+use analysis_support::{decode_to, late_fix_log, python};
 
 /// Reads each file given with pandas and Polars, default options (the
 /// separator named for a `.tsv`), and reports column types and values.
@@ -75,7 +50,7 @@ fn text_outputs_read_back_numeric_in_pandas_and_polars() {
         "run.jsonl.gz",
     ];
     for name in names {
-        let out = decode(&log, &dir.path().join(name), &[]);
+        let out = decode_to(&log, &dir.path().join(name), &[]);
         assert!(
             out.status.success(),
             "{name}: {}",
@@ -141,7 +116,7 @@ fn a_delimiter_is_honoured_and_unknown_names_are_refused() {
     let log = dir.path().join("RUN00003.WBL");
     late_fix_log(&log);
     let semi = dir.path().join("run.csv");
-    let out = decode(
+    let out = decode_to(
         &log,
         &semi,
         &["--delimiter", ";", "--columns", "t_s,gps_lat_deg,utc"],
@@ -163,7 +138,7 @@ fn a_delimiter_is_honoured_and_unknown_names_are_refused() {
 
     for name in ["run.json", "run.txt", "run.gpx", "run.parquet.gz"] {
         let target = dir.path().join(name);
-        let out = decode(&log, &target, &[]);
+        let out = decode_to(&log, &target, &[]);
         assert_eq!(out.status.code(), Some(2), "{name}");
         let stderr = String::from_utf8_lossy(&out.stderr);
         assert!(
@@ -174,11 +149,11 @@ fn a_delimiter_is_honoured_and_unknown_names_are_refused() {
     }
     // An explicit --format is honoured whatever the name.
     let txt = dir.path().join("run.txt");
-    let out = decode(&log, &txt, &["--format", "jsonl"]);
+    let out = decode_to(&log, &txt, &["--format", "jsonl"]);
     assert!(out.status.success());
     assert!(std::fs::read_to_string(&txt)
         .unwrap()
         .starts_with("{\"t_s\":1.0,"));
-    let out = decode(&log, &dir.path().join("x.parquet"), &["--delimiter", ";"]);
+    let out = decode_to(&log, &dir.path().join("x.parquet"), &["--delimiter", ";"]);
     assert_eq!(out.status.code(), Some(2));
 }

@@ -3,21 +3,8 @@
 
 mod analysis_support;
 
-use std::path::Path;
-
-use analysis_support::{stdout_of, wobblog, write_log, Extras, Ride, UTC_AT_BOOT_MS};
+use analysis_support::{late_fix_log, stdout_of, wobblog, UTC_AT_BOOT_MS};
 use wobblog::time::iso8601_unix_us;
-
-/// A 20 s ride from 1 s since boot whose GPS has no fix before 5 s.
-fn late_fix_log(path: &Path) {
-    let ride = Ride::new(20.0, 5.0, 0.0, 0.0, 0.0);
-    let extras = Extras {
-        gps: true,
-        gps_outages_s: vec![(0.0, 5.0)],
-        ..Extras::default()
-    };
-    write_log(path, &ride, &extras);
-}
 
 fn csv_rows(text: &str) -> (Vec<String>, Vec<csv::StringRecord>) {
     let mut reader = csv::Reader::from_reader(text.as_bytes());

@@ -397,6 +397,30 @@ pub fn standard_log(path: &Path) -> (Ride, Extras) {
     (ride, extras)
 }
 
+/// A 20 s ride from 1 s since boot whose GPS has no fix before 5 s: 400
+/// rows with empty GPS cells first, as on every real ride.
+pub fn late_fix_log(path: &Path) {
+    let ride = Ride::new(20.0, 5.0, 0.0, 0.0, 0.0);
+    let extras = Extras {
+        gps: true,
+        gps_outages_s: vec![(0.0, 5.0)],
+        ..Extras::default()
+    };
+    write_log(path, &ride, &extras);
+}
+
+/// `wobblog decode LOG -o OUT EXTRA...`, run to its end, whatever its exit.
+pub fn decode_to(log: &Path, out: &Path, extra: &[&str]) -> std::process::Output {
+    wobblog()
+        .arg("decode")
+        .arg(log)
+        .arg("-o")
+        .arg(out)
+        .args(extra)
+        .output()
+        .unwrap()
+}
+
 /// `a` and `b` measure the same episode: every value to 1e-9, the same
 /// stability and cuts.
 pub fn assert_same_episode(a: &Episode, b: &Episode) {
