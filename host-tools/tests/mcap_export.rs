@@ -1,7 +1,7 @@
 //! `wobblog decode --format mcap`, read back with the `mcap` crate as
-//! Foxglove reads it: zstd chunks, a CDR channel per sensor group with its
-//! ROS 2 message definition, the GPS as `foxglove.LocationFix`, the events as
-//! `foxglove.Log`, log times in UTC nanoseconds, the metadata.
+//! Foxglove reads it: zstd chunks, one CDR message per frame on `/sensors`
+//! with its ROS 2 message definition, the GPS as `foxglove.LocationFix`, the
+//! events as `foxglove.Log`, log times in UTC nanoseconds, the metadata.
 
 mod analysis_support;
 
@@ -68,14 +68,7 @@ fn read_back(bytes: &[u8]) -> BTreeMap<String, Vec<Message>> {
 }
 
 fn decode(log: &std::path::Path, out: &std::path::Path, extra: &[&str]) -> Vec<u8> {
-    let result = wobblog()
-        .arg("decode")
-        .arg(log)
-        .arg("-o")
-        .arg(out)
-        .args(extra)
-        .output()
-        .unwrap();
+    let result = analysis_support::decode_to(log, out, extra);
     assert!(
         result.status.success(),
         "{}",
@@ -103,24 +96,24 @@ fn mcap_is_compressed_in_utc_with_every_frame_fix_and_event_on_its_channel() {
         assert_eq!(chunk.compression, "zstd");
         assert!(chunk.compressed_size < chunk.uncompressed_size / 2);
     }
-    assert_eq!(summary.channels.len(), 5);
+    assert_eq!(summary.channels.len(), 3);
 
     let frames = ride.t_s.len();
-    let imu = &by_topic["/imu"];
-    assert_eq!(imu.len(), frames);
-    assert_eq!(by_topic["/steering"].len(), frames);
-    assert_eq!(by_topic["/wheel"].len(), frames);
-    assert!(imu[0]
-        .schema
-        .starts_with("ros2msg wobblog_msgs/msg/Imu: float64 ax_g\nfloat64 ay_g\nfloat64 az_g\n"));
+    let sensors = &by_topic["/sensors"];
+    assert_eq!(sensors.len(), frames);
+    assert_eq!(
+        sensors[0].schema,
+        "ros2msg wobblog_msgs/msg/Sensors: float64 ax_g\nfloat64 ay_g\nfloat64 az_g\n\
+         float64 gx_dps\nfloat64 gy_dps\nfloat64 gz_dps\nfloat64 steer_deg\nfloat64 speed_mps\n"
+    );
     // Every frame in UTC, to the nanosecond, with its time since boot as
     // the publish time; the values are the frame's.
-    for (i, message) in imu.iter().enumerate() {
+    for (i, message) in sensors.iter().enumerate() {
         let t = ride.t_s[i];
         assert_eq!(message.log_time, utc_ns(t), "frame {i}");
         assert_eq!(message.publish_time, (t * 1e9).round() as u64);
         let values = message.cdr_f64();
-        assert_eq!(values.len(), 6);
+        assert_eq!(values.len(), 8);
         for axis in 0..3 {
             assert!(
                 (values[axis] - ride.accel_g[i][axis]).abs() < 1e-3,
@@ -131,10 +124,14 @@ fn mcap_is_compressed_in_utc_with_every_frame_fix_and_event_on_its_channel() {
                 "frame {i}"
             );
         }
+        assert!(
+            (values[6] - ride.steer_deg[i]).abs() < 0.01,
+            "frame {i}: {} against {}",
+            values[6],
+            ride.steer_deg[i]
+        );
+        assert_eq!(values[7], 5.0, "frame {i}");
     }
-    assert_eq!(by_topic["/wheel"][0].cdr_f64(), [5.0]);
-    let steer = by_topic["/steering"][100].cdr_f64()[0];
-    assert!((steer - ride.steer_deg[100]).abs() < 0.01);
 
     let fixes: Vec<_> = (0..frames)
         .filter_map(|i| gps_fix(&ride, i, &extras))
@@ -204,7 +201,7 @@ fn a_log_without_utc_keeps_the_loggers_clock() {
     let ride = Ride::new(5.0, 5.0, 0.0, 0.0, 0.0);
     write_log(&log, &ride, &Extras::default());
     let by_topic = read_back(&decode(&log, &dir.path().join("run.mcap"), &[]));
-    for (message, t) in by_topic["/imu"].iter().zip(&ride.t_s) {
+    for (message, t) in by_topic["/sensors"].iter().zip(&ride.t_s) {
         assert_eq!(message.log_time, (t * 1e9).round() as u64);
         assert_eq!(message.publish_time, message.log_time);
     }
@@ -244,23 +241,24 @@ fn columns_choose_the_fields_and_channels_and_say_where_the_rest_go() {
     let bytes = std::fs::read(&out).unwrap();
     let by_topic = read_back(&bytes);
     let topics: Vec<&str> = by_topic.keys().map(String::as_str).collect();
-    assert_eq!(topics, ["/events", "/gps", "/imu", "/steering"]);
+    assert_eq!(topics, ["/events", "/gps", "/sensors"]);
     // Only the chosen fields, in schema and message, in the order chosen.
-    let imu = &by_topic["/imu"];
+    let sensors = &by_topic["/sensors"];
     assert!(
-        imu[0]
+        sensors[0]
             .schema
-            .ends_with(": float64 gz_dps\nfloat64 gx_dps\n"),
+            .ends_with(": float64 steer_deg\nfloat64 gz_dps\nfloat64 gx_dps\n"),
         "{}",
-        imu[0].schema
+        sensors[0].schema
     );
-    assert_eq!(imu.len(), ride.t_s.len());
-    let values = imu[10].cdr_f64();
-    assert!((values[0] - ride.gyro_dps[10][2]).abs() < 0.05);
-    assert!((values[1] - ride.gyro_dps[10][0]).abs() < 0.05);
-    assert_eq!(by_topic["/steering"][0].cdr_f64().len(), 1);
+    assert_eq!(sensors.len(), ride.t_s.len());
+    let values = sensors[10].cdr_f64();
+    assert_eq!(values.len(), 3);
+    assert!((values[0] - ride.steer_deg[10]).abs() < 0.01);
+    assert!((values[1] - ride.gyro_dps[10][2]).abs() < 0.05);
+    assert!((values[2] - ride.gyro_dps[10][0]).abs() < 0.05);
     let summary = mcap::Summary::read(&bytes).unwrap().unwrap();
-    assert_eq!(summary.channels.len(), 4);
+    assert_eq!(summary.channels.len(), 3);
     let meta = mcap::read::metadata(&bytes, &summary.metadata_indexes[0]).unwrap();
     assert_eq!(meta.metadata["unit.gz_dps"], "deg/s");
     assert!(!meta.metadata.contains_key("unit.ax_g"));
@@ -272,6 +270,6 @@ fn columns_choose_the_fields_and_channels_and_say_where_the_rest_go() {
         &["--columns", "speed_mps"],
     ));
     let topics: Vec<&str> = by_topic.keys().map(String::as_str).collect();
-    assert_eq!(topics, ["/events", "/wheel"]);
-    assert_eq!(by_topic["/wheel"][0].cdr_f64(), [5.0]);
+    assert_eq!(topics, ["/events", "/sensors"]);
+    assert_eq!(by_topic["/sensors"][0].cdr_f64(), [5.0]);
 }

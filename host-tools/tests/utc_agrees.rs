@@ -112,14 +112,14 @@ fn info_decode_gpx_and_mcap_agree_on_utc() {
         .assert()
         .success();
     let bytes = std::fs::read(&mcap).unwrap();
-    let imu: Vec<u64> = mcap::MessageStream::new(&bytes)
+    let sensors: Vec<u64> = mcap::MessageStream::new(&bytes)
         .unwrap()
         .map(Result::unwrap)
-        .filter(|m| m.channel.topic == "/imu")
+        .filter(|m| m.channel.topic == "/sensors")
         .map(|m| m.log_time)
         .collect();
-    assert_eq!(imu.len(), rows.len());
-    for (ns, (_, utc)) in imu.iter().zip(&rows).filter(|(_, r)| !r.1.is_empty()) {
+    assert_eq!(sensors.len(), rows.len());
+    for (ns, (_, utc)) in sensors.iter().zip(&rows).filter(|(_, r)| !r.1.is_empty()) {
         assert_eq!(ns % 1000, 0, "a whole microsecond");
         let us = i64::try_from(ns / 1000).unwrap();
         assert_eq!(&wobblog::time::iso8601_unix_us(us).unwrap(), utc);

@@ -53,9 +53,9 @@ pub struct Args {
     #[arg(short, long)]
     pub output: Option<PathBuf>,
     /// Only these columns, in this order (comma-separated names, e.g.
-    /// `t_s,steer_deg,speed_mps,utc`). In MCAP, the sensor channels carry
-    /// only these fields, a channel with none of them is left out, and
-    /// `/gps` is written when a GPS column is named.
+    /// `t_s,steer_deg,speed_mps,utc`). In MCAP, `/sensors` carries only
+    /// these fields and is left out when none is named, and `/gps` is
+    /// written when a GPS column is named.
     #[arg(long, value_name = "NAMES")]
     pub columns: Option<String>,
     /// The time window (`--from`, `--to`).
@@ -140,7 +140,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
 fn say_mcap_homes(columns: &[Column]) {
     for column in columns {
         match crate::export::mcap::home_of(column.name) {
-            Some("its sensor channel") => {}
+            Some(crate::export::mcap::SENSORS_TOPIC) => {}
             Some(home) => eprintln!("wobblog: --columns {}: in MCAP it is {home}", column.name),
             None => eprintln!(
                 "wobblog: warning: --columns {}: MCAP has no field for it; left out",

@@ -1,9 +1,10 @@
 //! Rows, GPS fixes and events as an MCAP file for Foxglove and other
-//! robotics viewers: zstd-compressed chunks; one channel per sensor group in
-//! ROS 2 message definitions and CDR (binary: a 64 MiB log encodes in a
-//! fraction of the JSON time); the GPS as `foxglove.LocationFix` (the map
-//! panel) and the events as `foxglove.Log` (the Log panel), both JSON; the
-//! log's metadata as an MCAP metadata record.
+//! robotics viewers: zstd-compressed chunks; the sensors of a frame as one
+//! message on `/sensors`, a ROS 2 message definition in CDR (binary, and one
+//! message per frame rather than one per sensor group: a 64 MiB log is 2.6 M
+//! messages, and the writer's cost is per message); the GPS as
+//! `foxglove.LocationFix` (the map panel) and the events as `foxglove.Log`
+//! (the Log panel), both JSON; the log's metadata as an MCAP metadata record.
 //!
 //! Message log times are UTC, nanoseconds since 1970, when the log has a
 //! GPS sync pair (frames before the first pair are placed through it), so
@@ -13,13 +14,11 @@
 use std::collections::BTreeMap;
 use std::io::Write;
 
-use mcap::records::{MessageHeader, Metadata};
-use mcap::write::{NoSeek, WriteOptions, Writer};
-use mcap::{Compression, McapError};
 use serde::Serialize;
 use wobble_core::format::GpsFix;
 
 use super::columns::{Column, Value};
+use super::mcap_file::McapFile;
 use super::LogMetadata;
 use crate::events::{EventKind, LogEvent};
 use crate::rows::{GpsColumns, Row};
@@ -42,52 +41,52 @@ const LOCATION_FIX_SCHEMA: &str = r#"{"title":"foxglove.LocationFix","type":"obj
 /// Foxglove's `foxglove.Log`, as its JSON Schema.
 const LOG_SCHEMA: &str = r#"{"title":"foxglove.Log","type":"object","properties":{"timestamp":{"type":"object","properties":{"sec":{"type":"integer"},"nsec":{"type":"integer"}}},"level":{"type":"integer","description":"1 debug, 2 info, 3 warning, 4 error, 5 fatal"},"message":{"type":"string"},"name":{"type":"string"},"file":{"type":"string"},"line":{"type":"integer"}}}"#;
 
-/// Topics, one per sensor group.
-pub const IMU_TOPIC: &str = "/imu";
-/// Steering angle.
-pub const STEERING_TOPIC: &str = "/steering";
-/// Wheel speed.
-pub const WHEEL_TOPIC: &str = "/wheel";
+/// Every sensor field of a frame, one message per frame.
+pub const SENSORS_TOPIC: &str = "/sensors";
 /// GPS fixes with a position.
 pub const GPS_TOPIC: &str = "/gps";
 /// Alerts, markers, faults, dropouts and damage.
 pub const EVENTS_TOPIC: &str = "/events";
 
-/// The sensor groups of a row: topic, schema name and the columns a
-/// message may carry.
-const SENSOR_GROUPS: [(&str, &str, &[&str]); 3] = [
-    (
-        IMU_TOPIC,
-        "wobblog_msgs/msg/Imu",
-        &["ax_g", "ay_g", "az_g", "gx_dps", "gy_dps", "gz_dps"],
-    ),
-    (STEERING_TOPIC, "wobblog_msgs/msg/Steering", &["steer_deg"]),
-    (WHEEL_TOPIC, "wobblog_msgs/msg/Wheel", &["speed_mps"]),
+/// The ROS 2 type of a `/sensors` message.
+const SENSORS_SCHEMA_NAME: &str = "wobblog_msgs/msg/Sensors";
+
+/// The columns a `/sensors` message may carry.
+const SENSOR_FIELDS: [&str; 8] = [
+    "ax_g",
+    "ay_g",
+    "az_g",
+    "gx_dps",
+    "gy_dps",
+    "gz_dps",
+    "steer_deg",
+    "speed_mps",
 ];
 
-/// Where a chosen column goes in MCAP (`"its sensor channel"` for a sensor
-/// field), or `None` when it has no home there.
+/// Where a chosen column goes in MCAP (`"/sensors"` for a sensor field), or
+/// `None` when it has no home there.
 #[must_use]
 pub fn home_of(column: &str) -> Option<&'static str> {
     match column {
         "t_s" => Some("every message's publish time (ns since boot)"),
         "utc" => Some("every message's log time (ns since 1970, UTC)"),
         "gps_lat_deg" | "gps_lon_deg" => Some("/gps (foxglove.LocationFix)"),
-        _ if SENSOR_GROUPS.iter().any(|g| g.2.contains(&column)) => Some("its sensor channel"),
+        _ if SENSOR_FIELDS.contains(&column) => Some(SENSORS_TOPIC),
         _ => None,
     }
 }
 
-/// A channel of row messages: its id and the chosen columns it carries.
-struct RowChannel {
+/// The `/sensors` channel: its id and the chosen columns it carries.
+struct SensorChannel {
     id: u16,
     columns: Vec<Column>,
 }
 
 /// Writes an MCAP file front to back on any writer.
 pub struct McapWriter<W: Write> {
-    writer: Writer<NoSeek<W>>,
-    rows: Vec<RowChannel>,
+    file: McapFile<W>,
+    /// Absent when no sensor column is chosen.
+    sensors: Option<SensorChannel>,
     /// Absent when no GPS column is chosen.
     gps: Option<u16>,
     events: u16,
@@ -153,46 +152,37 @@ struct LocationFix {
 
 impl<W: Write> McapWriter<W> {
     /// A writer of `columns` on `out`; the header and channel definitions
-    /// go out at once. Each sensor group's channel carries the chosen
-    /// columns of its group, in the order chosen, and is left out when none
-    /// is chosen; `/gps` is there when a GPS column is; `/events` always.
+    /// go out at once. `/sensors` carries the chosen sensor columns, in the
+    /// order chosen, and is left out when none is chosen; `/gps` is there
+    /// when a GPS column is; `/events` always.
     ///
     /// # Errors
     /// When `out` fails.
-    pub fn new(out: W, columns: &[Column]) -> Result<Self, McapError> {
-        let mut writer = WriteOptions::new()
-            .disable_seeking(true)
-            .compression(Some(Compression::Zstd))
-            // One thread: the CPU a decode costs is the CPU it uses.
-            .compression_threads(0)
-            .library(concat!("wobblog ", env!("CARGO_PKG_VERSION")))
-            .create(NoSeek::new(out))?;
-        let no_meta = BTreeMap::new();
+    pub fn new(out: W, columns: &[Column]) -> std::io::Result<Self> {
+        let mut file = McapFile::new(out, concat!("wobblog ", env!("CARGO_PKG_VERSION")))?;
         let mut channel = |topic: &str, schema_name: &str, schema: &str, json: bool| {
             let (schema_encoding, message_encoding) = if json {
                 ("jsonschema", "json")
             } else {
                 ("ros2msg", "cdr")
             };
-            let id = writer.add_schema(schema_name, schema_encoding, schema.as_bytes())?;
-            writer.add_channel(id, topic, message_encoding, &no_meta)
+            let id = file.add_schema(schema_name, schema_encoding, schema.as_bytes())?;
+            file.add_channel(id, topic, message_encoding)
         };
-        let mut rows = Vec::new();
-        for (topic, schema_name, names) in SENSOR_GROUPS {
-            let chosen: Vec<Column> = columns
-                .iter()
-                .filter(|c| names.contains(&c.name))
-                .copied()
-                .collect();
-            if !chosen.is_empty() {
-                let schema = numbers_schema(&chosen);
-                let id = channel(topic, schema_name, &schema, false)?;
-                rows.push(RowChannel {
-                    id,
-                    columns: chosen,
-                });
-            }
-        }
+        let chosen: Vec<Column> = columns
+            .iter()
+            .filter(|c| SENSOR_FIELDS.contains(&c.name))
+            .copied()
+            .collect();
+        let sensors = if chosen.is_empty() {
+            None
+        } else {
+            let schema = numbers_schema(&chosen);
+            Some(SensorChannel {
+                id: channel(SENSORS_TOPIC, SENSORS_SCHEMA_NAME, &schema, false)?,
+                columns: chosen,
+            })
+        };
         let gps = if columns.iter().any(|c| c.name.starts_with("gps_")) {
             Some(channel(
                 GPS_TOPIC,
@@ -205,8 +195,8 @@ impl<W: Write> McapWriter<W> {
         };
         let events = channel(EVENTS_TOPIC, "foxglove.Log", LOG_SCHEMA, true)?;
         Ok(Self {
-            writer,
-            rows,
+            file,
+            sensors,
             gps,
             events,
             sequence: 0,
@@ -235,57 +225,50 @@ impl<W: Write> McapWriter<W> {
             .unwrap_or(boot_ns)
     }
 
-    fn message(
-        &mut self,
-        channel_id: u16,
-        t_s: f64,
-        body: &impl Serialize,
-    ) -> Result<(), McapError> {
-        let data = serde_json::to_vec(body).map_err(std::io::Error::other)?;
-        self.message_data(channel_id, t_s, &data)
+    fn message(&mut self, channel_id: u16, t_s: f64, body: &impl Serialize) -> std::io::Result<()> {
+        let mut data = std::mem::take(&mut self.body);
+        data.clear();
+        serde_json::to_writer(&mut data, body).map_err(std::io::Error::other)?;
+        let written = self.message_data(channel_id, t_s, &data);
+        self.body = data;
+        written
     }
 
-    fn message_data(&mut self, channel_id: u16, t_s: f64, data: &[u8]) -> Result<(), McapError> {
+    fn message_data(&mut self, channel_id: u16, t_s: f64, data: &[u8]) -> std::io::Result<()> {
         let boot_ns = boot_ns(t_s);
         self.sequence = self.sequence.wrapping_add(1);
-        self.writer.write_to_known_channel(
-            &MessageHeader {
-                channel_id,
-                sequence: self.sequence,
-                log_time: self.log_time(boot_ns),
-                publish_time: boot_ns,
-            },
-            data,
-        )
+        let times = (self.log_time(boot_ns), boot_ns);
+        self.file.message(channel_id, self.sequence, times, data)
     }
 
-    /// Writes one row as one message per sensor group.
+    /// Writes one row as one `/sensors` message.
     ///
     /// # Errors
     /// When the output fails.
-    pub fn row(&mut self, row: &Row) -> Result<(), McapError> {
+    pub fn row(&mut self, row: &Row) -> std::io::Result<()> {
+        let Some(sensors) = &self.sensors else {
+            return Ok(());
+        };
+        let id = sensors.id;
         let mut body = std::mem::take(&mut self.body);
-        for k in 0..self.rows.len() {
-            body.clear();
-            body.extend_from_slice(&CDR_LE);
-            for column in &self.rows[k].columns {
-                // Sensor fields are numbers in every row.
-                let Value::Number(v) = (column.value)(row) else {
-                    continue;
-                };
+        body.clear();
+        body.extend_from_slice(&CDR_LE);
+        for column in &sensors.columns {
+            // Sensor fields are numbers in every row.
+            if let Value::Number(v) = (column.value)(row) {
                 body.extend_from_slice(&v.unwrap_or(f64::NAN).to_le_bytes());
             }
-            self.message_data(self.rows[k].id, row.t_s, &body)?;
         }
+        let written = self.message_data(id, row.t_s, &body);
         self.body = body;
-        Ok(())
+        written
     }
 
     /// Writes a GPS fix with a position (others have nothing for a map).
     ///
     /// # Errors
     /// When the output fails.
-    pub fn gps(&mut self, fix: &GpsFix) -> Result<(), McapError> {
+    pub fn gps(&mut self, fix: &GpsFix) -> std::io::Result<()> {
         let (Some(gps), Some(pos)) = (self.gps, GpsColumns::from_fix(fix)) else {
             return Ok(());
         };
@@ -310,7 +293,7 @@ impl<W: Write> McapWriter<W> {
     ///
     /// # Errors
     /// When the output fails.
-    pub fn event(&mut self, event: &LogEvent, log_name: &str) -> Result<(), McapError> {
+    pub fn event(&mut self, event: &LogEvent, log_name: &str) -> std::io::Result<()> {
         let details = event.kind.describe();
         let name = event.kind.name();
         let log = Log {
@@ -333,14 +316,11 @@ impl<W: Write> McapWriter<W> {
     ///
     /// # Errors
     /// When the output fails.
-    pub fn finish(&mut self, meta: &LogMetadata) -> Result<(), McapError> {
-        let metadata = Metadata {
-            name: "wobblog".into(),
-            metadata: meta.pairs(&self.columns).into_iter().collect(),
-        };
-        self.writer.write_metadata(&metadata)?;
+    pub fn finish(mut self, meta: &LogMetadata) -> std::io::Result<()> {
+        let pairs: BTreeMap<String, String> = meta.pairs(&self.columns).into_iter().collect();
+        self.file.metadata("wobblog", &pairs)?;
         // The output flushes itself when committed.
-        self.writer.finish().map(drop)
+        self.file.finish().map(drop)
     }
 }
 

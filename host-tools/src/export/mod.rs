@@ -4,6 +4,7 @@
 pub mod columns;
 mod lines;
 pub mod mcap;
+mod mcap_file;
 pub mod metadata;
 pub mod parquet;
 mod text;
@@ -49,8 +50,9 @@ pub enum Format {
     Jsonl,
     /// Apache Parquet (binary; typed columns, GPS columns nullable).
     Parquet,
-    /// MCAP for Foxglove (binary, zstd; a CDR channel per sensor group, GPS
-    /// as foxglove.LocationFix, events as foxglove.Log; log times in UTC).
+    /// MCAP for Foxglove (binary, zstd; one CDR message per frame on
+    /// /sensors, GPS as foxglove.LocationFix, events as foxglove.Log; log
+    /// times in UTC).
     Mcap,
 }
 
@@ -255,7 +257,7 @@ impl<W: Write + Send> RowWriter<W> {
         match &mut self.sink {
             Sink::Lines(w, _) => w.write(row),
             Sink::Parquet(w) => w.write(row).map_err(std::io::Error::other),
-            Sink::Mcap(..) => self.mcap()?.row(row).map_err(mcap_io_error),
+            Sink::Mcap(..) => self.mcap()?.row(row),
         }
     }
 
@@ -263,7 +265,7 @@ impl<W: Write + Send> RowWriter<W> {
     /// force on every row).
     pub fn gps(&mut self, fix: &GpsFix) -> std::io::Result<()> {
         match self.sink {
-            Sink::Mcap(..) => self.mcap()?.gps(fix).map_err(mcap_io_error),
+            Sink::Mcap(..) => self.mcap()?.gps(fix),
             _ => Ok(()),
         }
     }
@@ -271,7 +273,7 @@ impl<W: Write + Send> RowWriter<W> {
     /// Writes an event of the log named `log_name` (MCAP only).
     pub fn event(&mut self, event: &LogEvent, log_name: &str) -> std::io::Result<()> {
         match self.sink {
-            Sink::Mcap(..) => self.mcap()?.event(event, log_name).map_err(mcap_io_error),
+            Sink::Mcap(..) => self.mcap()?.event(event, log_name),
             _ => Ok(()),
         }
     }
@@ -290,7 +292,7 @@ impl<W: Write + Send> RowWriter<W> {
             return Err(std::io::Error::other("not an MCAP output"));
         };
         if let Some(out) = out.take() {
-            let mcap = mcap::McapWriter::new(out, &self.columns).map_err(mcap_io_error)?;
+            let mcap = mcap::McapWriter::new(out, &self.columns)?;
             *writer = Some(Box::new(mcap));
         }
         writer
@@ -305,16 +307,15 @@ impl<W: Write + Send> RowWriter<W> {
         match &mut self.sink {
             Sink::Lines(w, _) => w.flush(),
             Sink::Parquet(w) => w.finish(meta).map_err(std::io::Error::other),
-            Sink::Mcap(..) => self.mcap()?.finish(meta).map_err(mcap_io_error),
+            Sink::Mcap(..) => {
+                // Started here if no row came; finished once.
+                self.mcap()?;
+                let Sink::Mcap(writer, _) = &mut self.sink else {
+                    return Ok(());
+                };
+                writer.take().map_or(Ok(()), |w| w.finish(meta))
+            }
         }
-    }
-}
-
-/// Keeps the kind of an I/O error wrapped by `mcap`.
-fn mcap_io_error(err: ::mcap::McapError) -> std::io::Error {
-    match err {
-        ::mcap::McapError::Io(e) => e,
-        other => std::io::Error::other(other.to_string()),
     }
 }
 
