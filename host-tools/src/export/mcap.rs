@@ -51,17 +51,9 @@ pub const EVENTS_TOPIC: &str = "/events";
 /// The ROS 2 type of a `/sensors` message.
 const SENSORS_SCHEMA_NAME: &str = "wobblog_msgs/msg/Sensors";
 
-/// The columns a `/sensors` message may carry.
-const SENSOR_FIELDS: [&str; 8] = [
-    "ax_g",
-    "ay_g",
-    "az_g",
-    "gx_dps",
-    "gy_dps",
-    "gz_dps",
-    "steer_deg",
-    "speed_mps",
-];
+/// The columns a `/sensors` message may carry: the CSV's after `t_s` and
+/// before the GPS (`ax_g` ... `speed_mps`).
+const SENSOR_FIELDS: &[&str] = super::CSV_COLUMNS.split_at(9).0.split_at(1).1;
 
 /// Where a chosen column goes in MCAP (`"/sensors"` for a sensor field), or
 /// `None` when it has no home there.
