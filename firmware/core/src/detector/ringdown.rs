@@ -280,7 +280,10 @@ impl RingDown {
         } else if (1.0 - d.abs()).abs() < 1e-3 {
             0.5
         } else {
-            libm::sinf(pd) / (pd * (1.0 - d * d))
+            // sin(pi d) by the detector's own sine of d / 2 turns: libm's
+            // `sinf` would link its large-argument reduction and its 2/pi
+            // table into the firmware for this one value per kick.
+            sincos_turns(0.5 * d).0 / (pd * (1.0 - d * d))
         };
         let amp_deg = libm::expf(l_mean - sigma * t_mean) / gain.max(0.1);
         Some(Kick {
