@@ -384,41 +384,17 @@ pub(crate) fn cost() -> (Cost1, Cost1) {
     let n = MAX_KICKS as u32;
     // A weighted line: three weighted sums, then two centred ones, per
     // kick; five divisions.
-    let line = Cost1 {
-        mul: 7 * n + 5,
-        add: 7 * n,
-        other: 4,
-    };
+    let line = Cost1::new(7 * n + 5, 7 * n, 4);
     // A pass: per kick its residual in units of its uncertainty (a square
     // root) and its new weight; the median's insertion sort (at most
     // n (n - 1) / 2 compares and swaps); the line; the convergence test.
-    let pass = (Cost1::SQRT
-        + Cost1 {
-            mul: 7,
-            add: 4,
-            other: 2,
-        })
-        * n
-        + Cost1 {
-            mul: 1,
-            add: 5,
-            other: n * (n - 1) / 2 + 5,
-        }
-        + line;
+    let pass =
+        (Cost1::SQRT + Cost1::new(7, 4, 2)) * n + Cost1::new(1, 5, n * (n - 1) / 2 + 5) + line;
     // Then the residual variance (per kick), the t quantile, Fieller's
     // quadratic and its roots.
-    let interval = Cost1::SQRT
-        + Cost1 {
-            mul: 3 * n + 45,
-            add: 4 * n + 20,
-            other: 3 * n + 10,
-        };
+    let interval = Cost1::SQRT + Cost1::new(3 * n + 45, 4 * n + 20, 3 * n + 10);
     let estimate = line + pass * ITERATIONS as u32 + interval;
-    let update = Cost1 {
-        mul: 0,
-        add: 1,
-        other: 4,
-    };
+    let update = Cost1::new(0, 1, 4);
     (estimate, update)
 }
 

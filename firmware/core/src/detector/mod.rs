@@ -289,37 +289,23 @@ impl core::ops::Mul<u32> for Cost1 {
 }
 
 impl Cost1 {
+    /// `mul` multiplications, `add` additions, `other` compares and
+    /// bookkeeping.
+    pub(crate) const fn new(mul: u32, add: u32, other: u32) -> Self {
+        Self { mul, add, other }
+    }
+
     /// [`math::sqrtf`]: 3 divisions, 3 multiplications, 3 additions.
-    pub(crate) const SQRT: Self = Self {
-        mul: 6,
-        add: 3,
-        other: 2,
-    };
+    pub(crate) const SQRT: Self = Self::new(6, 3, 2);
     /// `libm::logf` (its source: a reduction, one division, a degree-4
     /// polynomial in `s^2`).
-    pub(crate) const LOG: Self = Self {
-        mul: 12,
-        add: 10,
-        other: 4,
-    };
+    pub(crate) const LOG: Self = Self::new(12, 10, 4);
     /// `libm::expf`, `libm::sinf` (a reduction and a short polynomial).
-    pub(crate) const EXP: Self = Self {
-        mul: 9,
-        add: 7,
-        other: 4,
-    };
+    pub(crate) const EXP: Self = Self::new(9, 7, 4);
     /// `libm::atan2f` (a division and `atanf`'s polynomial).
-    pub(crate) const ATAN2: Self = Self {
-        mul: 13,
-        add: 12,
-        other: 8,
-    };
+    pub(crate) const ATAN2: Self = Self::new(13, 12, 8);
     /// [`sincos_turns`] (also the canceller's first step).
-    pub(crate) const SINCOS: Self = Self {
-        mul: 13,
-        add: 12,
-        other: 2,
-    };
+    pub(crate) const SINCOS: Self = Self::new(13, 12, 2);
 }
 
 /// Analytical cost per sample of the detector and the margin warning

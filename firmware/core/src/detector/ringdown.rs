@@ -340,48 +340,25 @@ pub(crate) fn cost() -> (Cost1, Cost1) {
     // The oscillator's phase and sincos; per open segment a window and two
     // products into the sums; the speed's sum; a closing segment's centre,
     // scale and amplitude.
-    let per_sample = Cost1::SINCOS
-        + Cost1::SQRT
-        + Cost1 {
-            mul: 2 + 3 * open + 6,
-            add: 1 + 2 * open + 4,
-            other: 2 * open + 4,
-        };
+    let per_sample =
+        Cost1::SINCOS + Cost1::SQRT + Cost1::new(2 + 3 * open + 6, 1 + 2 * open + 4, 2 * open + 4);
     // Per segment and line fit: its power, half its logarithm, the three
     // weighted sums, then the two centred sums and the residual.
-    let segment = Cost1::LOG
-        + Cost1 {
-            mul: 12,
-            add: 12,
-            other: 2,
-        };
+    let segment = Cost1::LOG + Cost1::new(12, 12, 2);
     // Per line fit: the means, the slope, its standard error and the score.
-    let line = Cost1::SQRT
-        + Cost1 {
-            mul: 8,
-            add: 0,
-            other: 2,
-        };
+    let line = Cost1::SQRT + Cost1::new(8, 0, 2);
     let n = MAX_SEGMENTS as u32;
     let trims = MAX_TRIMMED as u32 + 1;
     let segments = trims * n - trims * (trims - 1) / 2;
     // The pulse pair over the neighbours, the frequency, the window's gain
     // (a sine) and the amplitude (an exponential).
-    let pulse_pair = Cost1 {
-        mul: 4,
-        add: 4,
-        other: 0,
-    };
+    let pulse_pair = Cost1::new(4, 4, 0);
     let fit = segment * segments
         + line * trims
         + pulse_pair * (n - 1)
         + Cost1::ATAN2
         + Cost1::EXP * 2
-        + Cost1 {
-            mul: 13,
-            add: 4,
-            other: 10,
-        };
+        + Cost1::new(13, 4, 10);
     (per_sample, fit)
 }
 
