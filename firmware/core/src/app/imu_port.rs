@@ -18,15 +18,10 @@ use embedded_hal_async::spi::SpiDevice;
 use super::ports::{DataReadyPort, ImuPort, ImuSample, NoDataReady, SensorError};
 use crate::drivers::icm42688::{Error, Icm42688};
 use crate::imu::Imu;
-use crate::imu_clock::{ClockStats, SampleClock};
+use crate::imu_clock::{self, ClockStats, SampleClock};
 
 /// Shortest time between two set-up attempts of a failed sensor.
 pub const RETRY: Duration = Duration::from_secs(1);
-
-/// FIFO samples read per frame at most: a frame brings one, the catch-up
-/// after the longest stall seven; more wait in the FIFO (it holds 128)
-/// for the next frame.
-pub const MAX_FIFO_SAMPLES_PER_READ: u16 = 16;
 
 /// Driver, channel, data-ready line and recovery state.
 pub struct Icm42688Port<SPI, D, R = NoDataReady> {
@@ -94,7 +89,7 @@ impl<SPI: SpiDevice, D: DelayNs, R: DataReadyPort> Icm42688Port<SPI, D, R> {
             Ok(()) => {
                 #[cfg(feature = "defmt")]
                 defmt::info!("IMU ready");
-                self.data_ready.drain_pulses(&mut |_| {});
+                self.data_ready.drain_pulses(&mut |_| true);
                 self.clock.restart();
                 self.ready = true;
                 Ok(())
@@ -119,13 +114,31 @@ impl<SPI: SpiDevice, D: DelayNs, R: DataReadyPort> Icm42688Port<SPI, D, R> {
     /// The wired read: pulses first, then the FIFO (the order
     /// [`SampleClock`] pairs them by), then the frame's value.
     async fn read_timed(&mut self, scheduled_us: u64) -> Result<ImuSample, SensorError> {
+        // `drain_pulses` hands over a pulse it has already taken: ask only
+        // while the clock has room.
         let clock = &mut self.clock;
-        self.data_ready.drain_pulses(&mut |t| clock.data_ready(t));
+        if clock.pulses_waiting() < imu_clock::PENDING {
+            self.data_ready.drain_pulses(&mut |t| clock.data_ready(t));
+        }
         let waiting = match self.driver.fifo_samples().await {
-            Ok(n) => n,
+            Ok(n) => usize::from(n),
             Err(e) => return Err(self.failed(&e)),
         };
-        for _ in 0..waiting.min(MAX_FIFO_SAMPLES_PER_READ) {
+        // Only as far as this frame's time: after a stall the FIFO and the
+        // pulse queue keep the rest for the catch-up frames that follow (up
+        // to the FIFO's 128 samples, 1.28 s, nothing is lost).
+        let mut read = 0;
+        while read < waiting && self.clock.wants_sample(scheduled_us) {
+            // The pulses of the samples counted, as far as the clock has
+            // room (a pulse drawn for a sample not counted would pass for
+            // one whose sample was lost).
+            let clock = &mut self.clock;
+            if clock.pulses_waiting() < (waiting - read).min(imu_clock::PENDING) {
+                self.data_ready.drain_pulses(&mut |t| {
+                    clock.data_ready(t) && clock.pulses_waiting() < waiting - read
+                });
+            }
+            read += 1;
             match self.driver.fifo_sample().await {
                 Ok(raw) => {
                     if let Some(raw) = raw {
@@ -136,7 +149,9 @@ impl<SPI: SpiDevice, D: DelayNs, R: DataReadyPort> Icm42688Port<SPI, D, R> {
                 Err(e) => return Err(self.failed(&e)),
             }
         }
-        let value = self.clock.frame(scheduled_us, Instant::now().as_micros());
+        let value =
+            self.clock
+                .frame_leaving(scheduled_us, Instant::now().as_micros(), waiting - read);
         self.skipped = self.skipped.saturating_add(value.skipped);
         let counts = value.counts.ok_or(SensorError::Stale)?;
         let mut sample = self.channel.scale(counts);
