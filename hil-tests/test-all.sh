@@ -40,6 +40,11 @@ grep -q "cd firmware/stm32f405 && cargo build --release" "$root_build_err"
 rm -f "$root_build_err"
 # Fails when flash > 192 KiB or static RAM > 64 KiB (firmware/docs/board.md).
 cargo run -q -p wobble-size-budget -- "${CARGO_TARGET_DIR:-target}/$TARGET/release/wobble-stm32f405"
+# A worst-case stack bound of the image (llvm-objdump, a few seconds), which
+# must fit the stack the image reserves; its resolution of indirect calls is
+# unit-tested on crafted images first (firmware/docs/board.md, stack depth).
+python3 firmware/size-budget/test_stack_bound.py
+python3 firmware/size-budget/stack_bound.py --check "${CARGO_TARGET_DIR:-target}/$TARGET/release/wobble-stm32f405"
 
 step "on-target tests (hil-tests/on-target): build and clippy; they run on a board with a probe"
 cargo build -p wobble-on-target --tests --target "$TARGET"

@@ -12,10 +12,18 @@
 //! tyre lags (rates and velocities left out: they scale with the eigenvalue).
 //! A mode's participation is the mean over its branches and those speeds.
 //!
+//! - the mode with the largest torso share (at least [`LEAN_MIN_TORSO`]) is
+//!   `lean`: a tense rider's lean oscillation carries much steer, but it is
+//!   not the wobble;
+//! - beside that lean, any other oscillation at 2 Hz or more on average with
+//!   roll or torso its largest angle and the tyre lags at least
+//!   [`SWAY_MIN_TYRE`] of it is the `sway`: the main frame rolling and
+//!   sliding sideways on the tyres' lateral compliance (mostly the rear
+//!   tyre's, whose cornering stiffness sets its frequency), the upper body
+//!   rolling against it on the hip (with no lean, a hip so stiff that no
+//!   mode has that torso share, the pair keeps the name `lean` below);
 //! - tyre lags more than [`TYRE_DOMINANCE`] times its largest angle: `other`;
-//! - torso the largest angle: `lean`; twist: `twist`; and the mode with the
-//!   largest torso share (at least [`LEAN_MIN_TORSO`]) is `lean` too: a tense
-//!   rider's lean oscillation carries much steer, but it is not the wobble;
+//! - torso the largest angle: `lean`; twist: `twist`;
 //! - roll or steer the largest, oscillating somewhere, with at least
 //!   [`WEAVE_MIN_ROLL_PER_STEER`] roll per steer and below 2 Hz on average: the
 //!   one with the largest roll share (of roll and steer) is the `weave` (a
@@ -43,6 +51,8 @@ pub const LEAN_MIN_TORSO: f64 = 0.1;
 pub const SAMPLES: usize = 16;
 /// A mode whose tyre lags are this many times its largest angle is a tyre mode.
 pub const TYRE_DOMINANCE: f64 = 4.0;
+/// The sway's tyre lags: at least this share of its participation.
+pub const SWAY_MIN_TYRE: f64 = 0.5;
 /// Weave rolls: at least this much roll per steer (amplitudes).
 pub const WEAVE_MIN_ROLL_PER_STEER: f64 = 0.2;
 /// Wobble is faster than this on average, rad/s (2 Hz).
@@ -103,6 +113,15 @@ impl Group {
             && self.oscillates
             && self.freq < WOBBLE_MIN_RAD_S
             && roll >= WEAVE_MIN_ROLL_PER_STEER * WEAVE_MIN_ROLL_PER_STEER * steer
+    }
+
+    /// The frame swaying on the tyres: an oscillation of roll or torso
+    /// carried mostly by the tyre lags.
+    fn sway_like(&self) -> bool {
+        self.oscillates
+            && self.freq >= WOBBLE_MIN_RAD_S
+            && self.shares.0[4] >= SWAY_MIN_TYRE
+            && matches!(self.largest_angle().0, StateRole::Roll | StateRole::Torso)
     }
 
     fn wobble_like(&self) -> bool {
@@ -341,6 +360,7 @@ fn classify(groups: &[Group], branches: usize) -> Vec<Mode> {
     let mut modes = vec![Mode::Other; branches];
     for (i, g) in groups.iter().enumerate() {
         let mode = match g.largest_angle().0 {
+            _ if lean.is_some_and(|l| l != i) && g.sway_like() => Mode::Sway,
             _ if g.tyre_only() => Mode::Other,
             StateRole::Torso => Mode::Lean,
             _ if Some(i) == lean => Mode::Lean,

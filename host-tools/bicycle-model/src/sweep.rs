@@ -26,6 +26,10 @@ pub enum Mode {
     Castering,
     /// Rider torso leaning on the hip.
     Lean,
+    /// The bicycle swaying on its tyres: the main frame rolling and sliding
+    /// sideways on the tyres' lateral compliance (their slip lags carry most
+    /// of the mode), the upper body rolling against it on the hip.
+    Sway,
     /// Steering-head twist.
     Twist,
     /// Anything else (tyre lags, ...).
@@ -42,6 +46,7 @@ impl Mode {
             Self::Capsize => "capsize",
             Self::Castering => "castering",
             Self::Lean => "lean",
+            Self::Sway => "sway",
             Self::Twist => "twist",
             Self::Other => "other",
         }
@@ -286,6 +291,7 @@ mod tests {
             Mode::Capsize,
             Mode::Castering,
             Mode::Lean,
+            Mode::Sway,
             Mode::Twist,
             Mode::Other,
         ];
@@ -298,6 +304,7 @@ mod tests {
                 "capsize",
                 "castering",
                 "lean",
+                "sway",
                 "twist",
                 "other"
             ]

@@ -68,6 +68,7 @@ fn colour(mode: Mode) -> RGBColor {
         Mode::Capsize => RGBColor(0x2c, 0xa0, 0x2c),
         Mode::Castering => RGBColor(0xff, 0x7f, 0x0e),
         Mode::Lean => RGBColor(0x94, 0x67, 0xbd),
+        Mode::Sway => RGBColor(0x17, 0xbe, 0xcf),
         Mode::Twist => RGBColor(0x8c, 0x56, 0x4b),
         Mode::Other => RGBColor(0x9f, 0x9f, 0x9f),
     }

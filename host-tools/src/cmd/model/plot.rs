@@ -14,12 +14,13 @@ use crate::CliError;
 
 /// Modes drawn unless `--all-modes` (the twist, near 30 Hz, would squash
 /// the frequency axis).
-pub const NAMED_MODES: [Mode; 5] = [
+pub const NAMED_MODES: [Mode; 6] = [
     Mode::Wobble,
     Mode::Weave,
     Mode::Capsize,
     Mode::Castering,
     Mode::Lean,
+    Mode::Sway,
 ];
 
 /// Arguments of `wobblog model plot`.
