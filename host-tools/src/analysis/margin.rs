@@ -63,11 +63,12 @@ pub struct KickPoint {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, clap::ValueEnum)]
 #[serde(rename_all = "lowercase")]
 pub enum Trend {
-    /// `sigma = a + b u`, with an allowance for sigma's bend beyond it
-    /// ([`Bend`]).
+    /// `sigma = a + b u + (k/2) u^2`, `a` and `b` fitted, `k` the
+    /// curvature assumed ([`BendPrior`]), with an allowance for a
+    /// different bend beyond the kicks ([`Bend`]).
     #[default]
     Line,
-    /// `sigma = a + b u + c u^2`.
+    /// `sigma = a + b u + c u^2`, all three fitted.
     Quadratic,
 }
 
@@ -100,16 +101,16 @@ pub struct Margin {
     /// The trend fitted.
     pub trend: Trend,
     /// Its coefficients `[a (1/s), b (1/s per m/s), c (1/s per (m/s)^2)]`
-    /// (no `c` for a line), if any.
+    /// (for the line `c` is fixed: half the curvature assumed), if any.
     pub coefficients: Option<Vec<f64>>,
-    /// The fit's covariance of the coefficients (rows), scaled by the
-    /// residuals' variance of unit weight.
+    /// The fit's covariance of the fitted coefficients (rows; `a` and `b`
+    /// for the line), scaled by the residuals' variance of unit weight.
     pub covariance: Option<Vec<Vec<f64>>>,
     /// The residuals' variance of unit weight (chi-square over the degrees
     /// of freedom of the kicks used): about 1 when the kicks scatter as
     /// their uncertainties say.
     pub unit_variance: Option<f64>,
-    /// The allowance for sigma's bend a straight line makes (none for a
+    /// The allowance for sigma's bend the line makes (none for a
     /// quadratic, which fits it).
     pub bend: Option<Bend>,
     /// Degrees of freedom of the t quantile.
@@ -134,7 +135,7 @@ impl Margin {
     }
 }
 
-/// The allowance a straight line makes for sigma's bend: its curvature
+/// The allowance the line makes for sigma's bend: its curvature
 /// `k` is taken as unknown, `prior_per_s_mps2` (the bend the trend is
 /// given, [`BendPrior`]) with standard deviation `sd_per_s_mps2`. A line
 /// fitted by least squares to `a + b u + (d/2) u^2` is off at `u` by
@@ -155,7 +156,7 @@ pub struct Bend {
     pub sd_per_s_mps2: f64,
 }
 
-/// What a straight line assumes about sigma's curvature beyond the kicks:
+/// What the line assumes about sigma's curvature beyond the kicks:
 /// a curvature `mean_per_s_mps2` (the trend is `a + b u + (mean/2) u^2`,
 /// `a` and `b` fitted), uncertain with standard deviation
 /// `sd_per_s_mps2` ([`Bend`]).
@@ -234,7 +235,7 @@ const SEARCH_RANGES: f64 = 4.0;
 #[must_use]
 pub fn method(trend: Trend) -> String {
     let shape = match trend {
-        Trend::Line => "straight line",
+        Trend::Line => "line",
         Trend::Quadratic => "quadratic",
     };
     let bend = match trend {
