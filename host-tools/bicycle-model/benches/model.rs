@@ -36,11 +36,20 @@ fn sweep_1000(c: &mut Criterion) {
     c.bench_function("wobble model, critical speeds from the pencil", |b| {
         b.iter(|| neutral_speeds(black_box(&pencil), (0.0, 10.0)));
     });
-    // The floor: the eigenvalues alone at the same 1000 speeds.
+    // The floor: the eigenvalues alone at the same 1000 speeds, and the same
+    // from nalgebra's Schur decomposition (the solver used before).
     c.bench_function("wobble model, 1000 eigenvalue calls", |b| {
         b.iter(|| {
             for &u in black_box(&speeds) {
                 black_box(wobble_model::eig::eigenvalues(&pencil.at(u)));
+            }
+        });
+    });
+    c.bench_function("wobble model, 1000 nalgebra Schur eigenvalue calls", |b| {
+        b.iter(|| {
+            for &u in black_box(&speeds) {
+                let schur = nalgebra::Schur::try_new(pencil.at(u), f64::EPSILON, 10_000);
+                black_box(schur.map(|s| s.complex_eigenvalues()));
             }
         });
     });

@@ -7,13 +7,16 @@
 //! model at standstill (tyre lags, `v` and `r` at u = 0) never make a
 //! critical speed.
 
-use nalgebra::Complex;
+use nalgebra::{Complex, DMatrix};
 use roots::{find_root_brent, SimpleConvergency};
 use serde::Serialize;
 
 use crate::eig::eigenvalues;
 use crate::model::Model;
-use crate::sweep::{Mode, Sweep, REAL_TOL};
+use crate::sweep::{matrix_of, Mode, Sweep, REAL_TOL};
+
+/// A state matrix as a function of speed.
+type StateMatrix<'a> = dyn Fn(f64) -> DMatrix<f64> + 'a;
 
 /// One zero crossing of a mode's real part.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
@@ -62,9 +65,9 @@ fn sign(v: Complex<f64>) -> i8 {
     }
 }
 
-/// The eigenvalue of `model` at `u` nearest `guess`.
-fn nearest(model: &Model, u: f64, guess: Complex<f64>) -> Complex<f64> {
-    eigenvalues(&model.state_matrix(u))
+/// The eigenvalue of `matrix(u)` nearest `guess`.
+fn nearest(matrix: &StateMatrix, u: f64, guess: Complex<f64>) -> Complex<f64> {
+    eigenvalues(&matrix(u))
         .unwrap_or_default()
         .into_iter()
         .min_by(|x, y| (x - guess).norm().total_cmp(&(y - guess).norm()))
@@ -75,7 +78,7 @@ fn nearest(model: &Model, u: f64, guess: Complex<f64>) -> Complex<f64> {
 /// the first step over which its real part changes sign, with the values at
 /// the step's ends.
 fn narrow(
-    model: &Model,
+    matrix: &StateMatrix,
     (ua, a): (f64, Complex<f64>),
     (ub, b): (f64, Complex<f64>),
 ) -> ((f64, Complex<f64>), (f64, Complex<f64>)) {
@@ -95,7 +98,7 @@ fn narrow(
         let v = if i == BRACKET_STEPS {
             b
         } else {
-            nearest(model, u, guess)
+            nearest(matrix, u, guess)
         };
         if sign(v) != 0 && sign(v) != sign(last.1) && sign(last.1) != 0 {
             return (last, (u, v));
@@ -153,11 +156,12 @@ impl Brackets {
     /// Each bracketed sign change of a named branch (`modes[branch]`),
     /// refined, in speed order.
     pub(crate) fn refine(&self, model: &Model, modes: &[Mode]) -> Vec<CriticalSpeed> {
+        let matrix = matrix_of(model);
         let mut out: Vec<CriticalSpeed> = self
             .found
             .iter()
             .filter(|b| modes.get(b.branch).is_some_and(|&m| m != Mode::Other))
-            .filter_map(|b| refine(model, modes[b.branch], b))
+            .filter_map(|b| refine(&*matrix, modes[b.branch], b))
             .collect();
         out.sort_by(|a, b| a.speed_mps.total_cmp(&b.speed_mps));
         out
@@ -165,9 +169,9 @@ impl Brackets {
 }
 
 /// The bracketed sign change, narrowed and refined by Brent's method.
-fn refine(model: &Model, mode: Mode, bracket: &Bracket) -> Option<CriticalSpeed> {
-    let ((ua, a), (ub, b)) = narrow(model, bracket.below, bracket.above);
-    let at = |u: f64| nearest(model, u, a + (b - a) * ((u - ua) / (ub - ua)));
+fn refine(matrix: &StateMatrix, mode: Mode, bracket: &Bracket) -> Option<CriticalSpeed> {
+    let ((ua, a), (ub, b)) = narrow(matrix, bracket.below, bracket.above);
+    let at = |u: f64| nearest(matrix, u, a + (b - a) * ((u - ua) / (ub - ua)));
     let mut conv = SimpleConvergency {
         eps: SPEED_TOL_MPS,
         max_iter: 200,

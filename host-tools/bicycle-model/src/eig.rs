@@ -1,11 +1,12 @@
 //! Eigenvalues and eigenvectors of a real state matrix.
 //!
-//! Eigenvalues come from nalgebra's real Schur decomposition. nalgebra has
-//! no eigenvectors for a non-symmetric matrix, so each one is found by two
+//! Eigenvalues come from the eigenvalues-only Hessenberg QR iteration of
+//! [`crate::hessenberg_qr`] (a sweep computes nothing else at most speeds).
+//! nalgebra has no eigenvectors for a non-symmetric matrix, so each one is found by two
 //! steps of inverse iteration on `A - lambda I` in complex arithmetic (LU):
 //! the vectors only serve to tell modes apart, so that is accurate enough.
 
-use nalgebra::{Complex, DMatrix, DVector, Schur};
+use nalgebra::{Complex, DMatrix, DVector};
 
 /// One eigenvalue with its (unit-norm) eigenvector.
 #[derive(Clone, Debug, PartialEq)]
@@ -16,18 +17,14 @@ pub struct Eigen {
     pub vector: DVector<Complex<f64>>,
 }
 
-/// Schur iterations before giving up on a matrix (NaN or pathological input).
-const MAX_SCHUR_ITERATIONS: usize = 10_000;
-
-/// The eigenvalues of `a`, or `None` if the decomposition does not
-/// converge (a matrix with NaN or infinite entries).
+/// The eigenvalues of `a`, or `None` if they cannot be computed (a matrix
+/// with NaN or infinite entries, or an iteration that does not converge).
 #[must_use]
 pub fn eigenvalues(a: &DMatrix<f64>) -> Option<Vec<Complex<f64>>> {
     if a.iter().any(|v| !v.is_finite()) {
         return None;
     }
-    let schur = Schur::try_new(a.clone(), f64::EPSILON, MAX_SCHUR_ITERATIONS)?;
-    Some(schur.complex_eigenvalues().iter().copied().collect())
+    crate::hessenberg_qr::eigenvalues(a)
 }
 
 /// Every eigenvalue of `a` with its eigenvector.

@@ -8,6 +8,7 @@
 pub mod critical;
 pub mod eig;
 pub mod fit;
+mod hessenberg_qr;
 pub mod model;
 pub mod multibody;
 mod naming;

@@ -239,7 +239,7 @@ impl Survey {
 }
 
 /// `model`'s state matrix as a function of speed (from its pencil if affine).
-fn matrix_of(model: &Model) -> Box<dyn Fn(f64) -> DMatrix<f64> + '_> {
+pub(crate) fn matrix_of(model: &Model) -> Box<dyn Fn(f64) -> DMatrix<f64> + '_> {
     match model.pencil() {
         Some(pencil) => Box::new(move |u| pencil.at(u)),
         None => Box::new(|u| model.state_matrix(u)),

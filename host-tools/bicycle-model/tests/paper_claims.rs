@@ -9,25 +9,19 @@
 //! quoted in the design notes and the issue, or a reading not yet checked
 //! against the paper (`model.md` says what was searched).
 
+mod support;
+
 use std::path::Path;
+use support::bundled;
 
 use wobble_model::{critical_speeds, CriticalSpeed, Mode, Model, ParamSet, Sweep};
 
 const BIKE: &str = "paper-test-bicycle.toml";
 const LIGHT: &str = "paper-test-bicycle-light-rider.toml";
 
-fn load(name: &str) -> ParamSet {
-    ParamSet::load(
-        &Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("params")
-            .join(name),
-    )
-    .unwrap()
-}
-
 /// `name` with each key multiplied by its factor.
 fn scaled(name: &str, changes: &[(&str, f64)]) -> ParamSet {
-    let mut set = load(name);
+    let mut set = bundled(name);
     for (key, factor) in changes {
         let v = set.value(key).unwrap();
         set.set_value(key, v * factor, "scaled for a claim")
@@ -39,7 +33,7 @@ fn scaled(name: &str, changes: &[(&str, f64)]) -> ParamSet {
 /// The bicycle with a point mass `m` at `(x, z)` added to body `section`
 /// (parallel axes, in the plane of symmetry).
 fn loaded(section: &str, m: f64, x: f64, z: f64) -> ParamSet {
-    let mut set = load(BIKE);
+    let mut set = bundled(BIKE);
     let get = |s: &ParamSet, k: &str| s.value(&format!("{section}.{k}")).unwrap();
     let (mb, xb, zb) = (get(&set, "mass"), get(&set, "x"), get(&set, "z"));
     let mass = mb + m;
@@ -130,12 +124,12 @@ impl Figures {
 type Verdict = (bool, String);
 
 fn wobble_speed_near_4() -> Verdict {
-    let s = Figures::tyres(&load(BIKE)).wobble_speed();
+    let s = Figures::tyres(&bundled(BIKE)).wobble_speed();
     ((3.5..=4.5).contains(&s), format!("{s:.2} m/s"))
 }
 
 fn frequency_rises_with_speed() -> Verdict {
-    let f = Figures::tyres(&load(BIKE));
+    let f = Figures::tyres(&bundled(BIKE));
     let (lo, hi) = (f.wobble_hz(2.0), f.wobble_hz(14.0));
     (
         hi - lo >= 1.5,
@@ -147,7 +141,7 @@ fn frequency_rises_with_speed() -> Verdict {
 }
 
 fn frequency_between_6_and_9_hz() -> Verdict {
-    let f = Figures::tyres(&load(BIKE));
+    let f = Figures::tyres(&bundled(BIKE));
     let hz: Vec<f64> = (4..=28).map(|i| f.wobble_hz(f64::from(i) * 0.5)).collect();
     let (lo, hi) = (
         hz.iter().copied().fold(f64::INFINITY, f64::min),
@@ -160,7 +154,7 @@ fn frequency_between_6_and_9_hz() -> Verdict {
 }
 
 fn wobble_unstable_above_its_speed() -> Verdict {
-    let f = Figures::tyres(&load(BIKE));
+    let f = Figures::tyres(&bundled(BIKE));
     let s = f.wobble_speed();
     let worst = speeds()
         .into_iter()
@@ -174,7 +168,10 @@ fn wobble_unstable_above_its_speed() -> Verdict {
 }
 
 fn light_rider_wobble_speed() -> Verdict {
-    let (heavy, light) = (Figures::tyres(&load(BIKE)), Figures::tyres(&load(LIGHT)));
+    let (heavy, light) = (
+        Figures::tyres(&bundled(BIKE)),
+        Figures::tyres(&bundled(LIGHT)),
+    );
     let (h, l) = (heavy.wobble_speed(), light.wobble_speed());
     (
         (5.0..=6.5).contains(&l) && l >= h + 0.8,
@@ -183,7 +180,10 @@ fn light_rider_wobble_speed() -> Verdict {
 }
 
 fn light_rider_frequency() -> Verdict {
-    let (heavy, light) = (Figures::tyres(&load(BIKE)), Figures::tyres(&load(LIGHT)));
+    let (heavy, light) = (
+        Figures::tyres(&bundled(BIKE)),
+        Figures::tyres(&bundled(LIGHT)),
+    );
     let d = light.onset_hz() - heavy.onset_hz();
     (
         (0.2..=0.8).contains(&d),
@@ -196,7 +196,7 @@ fn light_rider_frequency() -> Verdict {
 }
 
 fn tyres_destabilise_wobble() -> Verdict {
-    let set = load(BIKE);
+    let set = bundled(BIKE);
     let (t, n) = (Figures::tyres(&set), Figures::no_slip(&set));
     let least = (20..=40)
         .map(|i| {
@@ -216,7 +216,7 @@ fn tyres_destabilise_wobble() -> Verdict {
 
 /// The critical speed of `mode` with tyres and without slip.
 fn tyres_move(mode: Mode, unstable_above: bool) -> (f64, f64) {
-    let set = load(BIKE);
+    let set = bundled(BIKE);
     let speed = |f: &Figures| {
         f.critical(mode, unstable_above)
             .map_or(f64::INFINITY, |c| c.speed_mps)
@@ -242,7 +242,7 @@ fn tyres_stabilise_capsize() -> Verdict {
 
 /// The wobble speed and onset frequency of the bicycle and of `changed`.
 fn change(changed: &ParamSet) -> ((f64, f64), (f64, f64)) {
-    let (b, c) = (Figures::tyres(&load(BIKE)), Figures::tyres(changed));
+    let (b, c) = (Figures::tyres(&bundled(BIKE)), Figures::tyres(changed));
     (
         (b.wobble_speed(), b.onset_hz()),
         (c.wobble_speed(), c.onset_hz()),
@@ -285,7 +285,7 @@ fn cornering_stiffness_raises_frequency() -> Verdict {
 }
 
 fn camber_stiffness_minor() -> Verdict {
-    let s0 = Figures::tyres(&load(BIKE)).wobble_speed();
+    let s0 = Figures::tyres(&bundled(BIKE)).wobble_speed();
     let moved: Vec<f64> = [0.75, 1.25]
         .into_iter()
         .map(|k| {
@@ -331,7 +331,7 @@ fn front_wheel_inertia_destabilises() -> Verdict {
 }
 
 fn lighter_rider_stabilises() -> Verdict {
-    wobble_speed_moves(&load(LIGHT), true)
+    wobble_speed_moves(&bundled(LIGHT), true)
 }
 
 fn tense_rider_destabilises() -> Verdict {
@@ -340,7 +340,7 @@ fn tense_rider_destabilises() -> Verdict {
 
 fn head_angle() -> Verdict {
     let tilt = |deg: f64| {
-        let mut set = load(BIKE);
+        let mut set = bundled(BIKE);
         set.set_value(
             "geometry.steer_axis_tilt",
             deg,
@@ -613,7 +613,7 @@ fn the_claims_table_in_the_docs_matches_the_tests() {
 #[test]
 fn tensed_riders_lean_is_stable_and_oscillating() {
     for file in [BIKE, LIGHT] {
-        let f = Figures::tyres(&load(file));
+        let f = Figures::tyres(&bundled(file));
         assert!(f.sweep.of(Mode::Lean).count() >= 2, "{file}: a lean pair");
         for b in f.sweep.of(Mode::Lean) {
             for (u, v) in f.sweep.speeds_mps.iter().zip(&b.values) {

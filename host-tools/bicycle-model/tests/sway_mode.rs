@@ -5,19 +5,12 @@
 //! checked here against what its eigenvectors and its parameters say,
 //! computed directly from the state matrix rather than by the naming.
 
-use std::path::Path;
+mod support;
+
+use support::bundled;
 
 use wobble_model::eig::eigenvector;
 use wobble_model::{Complex, Mode, Model, ParamSet, Sweep};
-
-fn load(name: &str) -> ParamSet {
-    ParamSet::load(
-        &Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("params")
-            .join(name),
-    )
-    .unwrap()
-}
 
 /// 0.5 to 14 m/s every 0.5 m/s.
 fn speeds() -> Vec<f64> {
@@ -49,7 +42,7 @@ fn each_wobble_bicycle_has_one_sway_pair_at_13_to_18_hz() {
         "paper-test-bicycle-light-rider.toml",
         "test-bicycle.toml",
     ] {
-        let (_, sweep) = sweep(&load(file));
+        let (_, sweep) = sweep(&bundled(file));
         assert_eq!(sweep.of(Mode::Sway).count(), 2, "{file}: one sway pair");
         assert!(sweep.of(Mode::Lean).count() >= 2, "{file}: a lean too");
         for b in sweep.of(Mode::Sway) {
@@ -63,7 +56,7 @@ fn each_wobble_bicycle_has_one_sway_pair_at_13_to_18_hz() {
         }
     }
     // The tensed rider's lean is the 5-7 Hz pair, not the sway.
-    let (_, sweep) = sweep(&load("paper-test-bicycle.toml"));
+    let (_, sweep) = sweep(&bundled("paper-test-bicycle.toml"));
     for v in &sweep.upper(Mode::Lean).unwrap().values {
         assert!((5.0..7.0).contains(&hz(*v)), "lean {v}");
     }
@@ -75,7 +68,7 @@ fn each_wobble_bicycle_has_one_sway_pair_at_13_to_18_hz() {
 /// is opposite to the frame's roll (the frame rolls under a held torso).
 #[test]
 fn the_sway_is_the_frame_rolling_on_the_rear_tyre_under_the_torso() {
-    let (model, sweep) = sweep(&load("paper-test-bicycle.toml"));
+    let (model, sweep) = sweep(&bundled("paper-test-bicycle.toml"));
     let value = sway_at_5(&sweep);
     let x = eigenvector(&model.state_matrix(5.0), value);
     let names = model.state_names();
@@ -99,9 +92,9 @@ fn the_sway_is_the_frame_rolling_on_the_rear_tyre_under_the_torso() {
 /// than 2 %.
 #[test]
 fn the_sway_frequency_follows_the_rear_tyre() {
-    let base = hz(sway_at_5(&sweep(&load("paper-test-bicycle.toml")).1));
+    let base = hz(sway_at_5(&sweep(&bundled("paper-test-bicycle.toml")).1));
     let doubled = |key: &str| {
-        let mut set = load("paper-test-bicycle.toml");
+        let mut set = bundled("paper-test-bicycle.toml");
         let v = set.value(key).unwrap();
         set.set_value(key, 2.0 * v, "doubled for a test").unwrap();
         hz(sway_at_5(&sweep(&set).1))

@@ -230,3 +230,34 @@ fn twist_gravity_stiffness_through_the_forced_pitch() {
     let hz = ((p.head_stiffness + k) / inertia).sqrt() / std::f64::consts::TAU;
     println!("twist: K = {k:.1} N m/rad by gravity, {hz:.2} Hz with the frame locked");
 }
+
+/// The head's twist stiffness against a published measurement. The Zedler
+/// institute measured the head-tube stiffness of a carbon road frame alone
+/// (the fork replaced by a steel bar clamped in the head tube, the frame
+/// held at its rear drop-outs and twisted by a weight on the bar: the method
+/// of TOUR's frame tests) at 108.8 N m/deg per kg for an 884 g frame
+/// (Endorfin Carbon SL, light-bikes.de, 9 November 2007): 96.2 N m/deg, or
+/// 5511 N m/rad. A whole front assembly's twist puts the fork's and the
+/// wheel's compliance in series with the frame's, and a steel trekking
+/// frame is softer than that racing frame, so both test bicycles' head
+/// stiffness must lie below it; with it, the fork and wheel of the test
+/// bicycle would twist at no more than about 23 Hz with the frame locked.
+#[test]
+fn head_stiffness_below_a_measured_stiff_frame_alone() {
+    use wobble_model::multibody::BETA;
+    let frame_alone = 108.8 * 0.884 * 180.0 / std::f64::consts::PI;
+    assert!((frame_alone - 5511.0).abs() < 1.0, "{frame_alone} N m/rad");
+    for file in ["test-bicycle.toml", "paper-test-bicycle.toml"] {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("params")
+            .join(file);
+        let m = WobbleModel::from_set(&ParamSet::load(&path).unwrap()).unwrap();
+        let k = m.params.head_stiffness;
+        assert!(k < frame_alone, "{file}: {k} N m/rad");
+        let (inertia, gravity) = (m.lin.m[(2 + BETA, 2 + BETA)], m.lin.k[(2 + BETA, BETA)]);
+        let bound = ((frame_alone + gravity) / inertia).sqrt() / std::f64::consts::TAU;
+        let own = ((k + gravity) / inertia).sqrt() / std::f64::consts::TAU;
+        println!("{file}: head {k} N m/rad, {own:.2} Hz frame locked; a frame as stiff as the measured one: {bound:.2} Hz");
+        assert!(own < bound && bound < 25.0, "{file}: {own} / {bound} Hz");
+    }
+}

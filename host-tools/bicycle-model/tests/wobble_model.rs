@@ -2,21 +2,14 @@
 //! bicycle's wobble (the simulated corpus's; the seed paper's claims on the
 //! re-derived test bicycle are in `paper_claims.rs`).
 
-use std::path::Path;
+mod support;
+
+use support::bundled;
 
 use nalgebra::Complex;
 use wobble_model::multibody::{self, constrained_whipple};
 use wobble_model::wobble::{WobbleModel, WobbleParams};
 use wobble_model::{critical_speeds, Mode, Model, ParamSet, Sweep};
-
-fn set(name: &str) -> ParamSet {
-    ParamSet::load(
-        &Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("params")
-            .join(name),
-    )
-    .unwrap()
-}
 
 fn speeds() -> Vec<f64> {
     (5..=100).map(|i| f64::from(i) * 0.1).collect()
@@ -49,7 +42,7 @@ fn constrained_limit_is_the_lumped_whipple_bicycle_exactly() {
         "paper-test-bicycle.toml",
         "paper-test-bicycle-light-rider.toml",
     ] {
-        let p = WobbleParams::from_set(&set(file)).unwrap();
+        let p = WobbleParams::from_set(&bundled(file)).unwrap();
         let (geo, bodies) = p.description();
         let [m, c1, k0g, k2] = constrained_whipple(&multibody::linearise(&geo, &bodies));
         let want = p.to_benchmark().matrices();
@@ -92,7 +85,7 @@ fn stiffened(p: &WobbleParams, k: f64) -> WobbleParams {
 
 #[test]
 fn stiff_tyres_rigid_head_and_locked_torso_converge_to_whipple() {
-    let p = WobbleParams::from_set(&set("test-bicycle.toml")).unwrap();
+    let p = WobbleParams::from_set(&bundled("test-bicycle.toml")).unwrap();
     let whipple = p.to_benchmark().matrices();
     let mut last = f64::INFINITY;
     for k in [10.0, 100.0, 1000.0] {
@@ -120,7 +113,7 @@ fn stiff_tyres_rigid_head_and_locked_torso_converge_to_whipple() {
 
 #[test]
 fn test_bicycle_wobbles_near_6_hz_unstable_from_about_4_mps() {
-    let (w, speed) = wobble(&set("test-bicycle.toml"));
+    let (w, speed) = wobble(&bundled("test-bicycle.toml"));
     let f_low = hz(w[5]); // 1 m/s
     let f_high = hz(w[95]); // 10 m/s
     assert!((5.5..6.5).contains(&f_low), "{f_low} Hz at 1 m/s");
@@ -134,7 +127,7 @@ fn test_bicycle_wobbles_near_6_hz_unstable_from_about_4_mps() {
 }
 
 fn scaled(file: &str, key: &str, factor: f64) -> ParamSet {
-    let mut s = set(file);
+    let mut s = bundled(file);
     let v = s.value(key).unwrap();
     s.set_value(key, v * factor, "scaled in a test").unwrap();
     s
@@ -142,7 +135,7 @@ fn scaled(file: &str, key: &str, factor: f64) -> ParamSet {
 
 #[test]
 fn more_front_cornering_stiffness_raises_wobble_frequency_and_growth() {
-    let (base, _) = wobble(&set("test-bicycle.toml"));
+    let (base, _) = wobble(&bundled("test-bicycle.toml"));
     let (stiff, _) = wobble(&scaled(
         "test-bicycle.toml",
         "front_tyre.cornering_stiffness",
@@ -160,7 +153,7 @@ fn more_front_cornering_stiffness_raises_wobble_frequency_and_growth() {
 
 #[test]
 fn steering_head_damping_stabilises_wobble() {
-    let (base, base_speed) = wobble(&set("test-bicycle.toml"));
+    let (base, base_speed) = wobble(&bundled("test-bicycle.toml"));
     let (damped, damped_speed) = wobble(&scaled("test-bicycle.toml", "steer_head.damping", 2.0));
     for k in 0..base.len() {
         assert!(damped[k].re < base[k].re, "at {} m/s", speeds()[k]);
@@ -174,7 +167,7 @@ fn steering_head_damping_stabilises_wobble() {
 /// coarse grid follows the same branch as a fine one.
 #[test]
 fn wobble_keeps_its_name_whatever_the_hip_stiffness() {
-    let mut set = set("test-bicycle.toml");
+    let mut set = bundled("test-bicycle.toml");
     for hip in [
         500.0, 1000.0, 2000.0, 3000.0, 5000.0, 8000.0, 12000.0, 20000.0,
     ] {
@@ -216,14 +209,14 @@ fn wobble_keeps_its_name_whatever_the_hip_stiffness() {
 /// equals the assembled equations.
 #[test]
 fn state_matrix_is_the_affine_pencil() {
-    let model = Model::from_set(&set("test-bicycle.toml")).unwrap();
+    let model = Model::from_set(&bundled("test-bicycle.toml")).unwrap();
     let pencil = model.pencil().expect("the wobble model is affine in u");
     for u in [0.3, 2.0, 7.5, 14.0, 40.0] {
         let a = model.state_matrix(u);
         let scale = a.amax();
         assert!((pencil.at(u) - &a).amax() < 1e-12 * scale, "at {u} m/s");
     }
-    assert!(Model::from_set(&set("benchmark.toml"))
+    assert!(Model::from_set(&bundled("benchmark.toml"))
         .unwrap()
         .pencil()
         .is_none());
@@ -235,7 +228,7 @@ fn state_matrix_is_the_affine_pencil() {
 /// rider-lean model), with the same hip spring-damper.
 #[test]
 fn no_slip_counterpart_with_a_rigid_head_is_the_rider_lean_bicycle() {
-    let mut set = set("test-bicycle.toml");
+    let mut set = bundled("test-bicycle.toml");
     set.set_value("steer_head.stiffness", 1e9, "rigid").unwrap();
     let model = Model::no_slip_of(&set).unwrap();
     assert_eq!(model.state_names().len(), 8);
@@ -273,7 +266,7 @@ fn no_slip_counterpart_with_a_rigid_head_is_the_rider_lean_bicycle() {
 #[ignore = "writes a file for the LAPACK comparison"]
 fn write_pencil() {
     let out = std::env::var("PENCIL_OUT").expect("PENCIL_OUT names the file to write");
-    let pencil = Model::from_set(&set("test-bicycle.toml"))
+    let pencil = Model::from_set(&bundled("test-bicycle.toml"))
         .unwrap()
         .pencil()
         .unwrap();
@@ -296,7 +289,7 @@ fn write_pencil() {
 fn critical_speeds_are_the_pencils_neutral_speeds() {
     use wobble_model::neutral::neutral_speeds;
     for hip in [None, Some(2000.0)] {
-        let mut s = set("test-bicycle.toml");
+        let mut s = bundled("test-bicycle.toml");
         if let Some(k) = hip {
             s.set_value("hip.stiffness", k, "tense rider").unwrap();
         }

@@ -1,0 +1,366 @@
+//! Eigenvalues only of a small real matrix: Householder reduction to upper
+//! Hessenberg form, then the implicit double-shift (Francis) QR iteration,
+//! as LAPACK's `dgeev` does without eigenvectors (`dgehrd`, `dlahqr`).
+//!
+//! Written here because no crate of the stack has an eigenvalues-only path
+//! that is both fast and bounded for a 14 x 14 matrix: nalgebra's
+//! `Schur::try_new` (bounded) also accumulates the orthogonal factor and
+//! updates the whole Schur form, which is most of its cost in a sweep; its
+//! `complex_eigenvalues` skips the factor but iterates without limit and has
+//! no exceptional shifts, so a sweep could hang on an unlucky matrix; faer
+//! is costly to build (see `docs/model.md`). Here each double-shift step only
+//! touches the active block (no Schur form is kept), exceptional shifts break
+//! cycles, and the iterations are bounded as in `dlahqr`. The results agree
+//! with nalgebra's Schur decomposition to round-off (the tests below).
+
+use nalgebra::{Complex, DMatrix};
+
+/// Iterations allowed per eigenvalue, at least, as in `dlahqr` (30).
+const ITERATIONS_PER_ROW: usize = 30;
+/// An exceptional shift every this many iterations without deflation.
+const EXCEPTIONAL_EVERY: usize = 10;
+
+/// A square matrix, row-major, working storage of the iteration.
+struct Square {
+    n: usize,
+    a: Vec<f64>,
+}
+
+impl Square {
+    fn at(&self, i: usize, j: usize) -> f64 {
+        self.a[i * self.n + j]
+    }
+
+    fn set(&mut self, i: usize, j: usize, v: f64) {
+        self.a[i * self.n + j] = v;
+    }
+
+    /// Applies `I - tau v v^T` (`v[0] = 1`, `v.len()` rows from `r0`) from
+    /// the left to columns `cols`. Inlined, so that a reflector of a length
+    /// known where it is called (the QR steps' 3 and 2) is unrolled.
+    #[inline(always)]
+    fn reflect_rows(&mut self, r0: usize, v: &[f64], tau: f64, cols: std::ops::Range<usize>) {
+        let n = self.n;
+        for j in cols {
+            let mut s = 0.0;
+            for (k, vk) in v.iter().enumerate() {
+                s += vk * self.a[(r0 + k) * n + j];
+            }
+            s *= tau;
+            for (k, vk) in v.iter().enumerate() {
+                self.a[(r0 + k) * n + j] -= s * vk;
+            }
+        }
+    }
+
+    /// Applies `I - tau v v^T` from the right to rows `rows`, columns
+    /// `c0..c0 + v.len()`.
+    #[inline(always)]
+    fn reflect_cols(&mut self, c0: usize, v: &[f64], tau: f64, rows: std::ops::Range<usize>) {
+        let n = self.n;
+        for i in rows {
+            let row = &mut self.a[i * n + c0..i * n + c0 + v.len()];
+            let s = tau * row.iter().zip(v).map(|(x, y)| x * y).sum::<f64>();
+            for (x, y) in row.iter_mut().zip(v) {
+                *x -= s * y;
+            }
+        }
+    }
+}
+
+/// The Householder reflector `I - tau v v^T` with `v[0] = 1` taking `x` to
+/// `(beta, 0, ...)`; `x` is overwritten by `v`. `None` if `x` is already
+/// of that form.
+#[inline(always)]
+fn householder(x: &mut [f64]) -> Option<(f64, f64)> {
+    let tail: f64 = x[1..].iter().map(|v| v * v).sum();
+    if tail == 0.0 {
+        return None;
+    }
+    let alpha = x[0];
+    let beta = -alpha.signum() * (alpha * alpha + tail).sqrt();
+    let tau = (beta - alpha) / beta;
+    let scale = 1.0 / (alpha - beta);
+    x[0] = 1.0;
+    for v in &mut x[1..] {
+        *v *= scale;
+    }
+    Some((tau, beta))
+}
+
+/// Reduces `h` to upper Hessenberg form by a similarity (Householder).
+fn hessenberg(h: &mut Square) {
+    let n = h.n;
+    let mut v = vec![0.0; n];
+    for k in 0..n.saturating_sub(2) {
+        let m = n - k - 1;
+        for (i, vi) in v[..m].iter_mut().enumerate() {
+            *vi = h.at(k + 1 + i, k);
+        }
+        let Some((tau, beta)) = householder(&mut v[..m]) else {
+            continue;
+        };
+        h.reflect_rows(k + 1, &v[..m], tau, k + 1..n);
+        h.reflect_cols(k + 1, &v[..m], tau, 0..n);
+        h.set(k + 1, k, beta);
+        for i in k + 2..n {
+            h.set(i, k, 0.0);
+        }
+    }
+}
+
+/// The eigenvalues of the 2 x 2 block `[[a, b], [c, d]]`.
+fn block_2x2(a: f64, b: f64, c: f64, d: f64) -> [Complex<f64>; 2] {
+    let p = 0.5 * (a - d);
+    let bc = b * c;
+    let q = p * p + bc;
+    if q >= 0.0 {
+        // Real: the root of larger size first, the other from the product.
+        let z = p + q.sqrt().copysign(p);
+        let first = d + z;
+        let second = if z == 0.0 { first } else { d - bc / z };
+        [Complex::new(first, 0.0), Complex::new(second, 0.0)]
+    } else {
+        let im = (-q).sqrt();
+        [Complex::new(d + p, im), Complex::new(d + p, -im)]
+    }
+}
+
+/// The top of the active block ending at row `end`: the row below the last
+/// negligible subdiagonal entry (set to zero), or 0.
+fn block_start(h: &mut Square, end: usize) -> usize {
+    let tiny = f64::EPSILON * f64::EPSILON;
+    let mut l = end;
+    while l > 0 {
+        let off = h.at(l, l - 1).abs();
+        if off <= tiny || off <= f64::EPSILON * (h.at(l - 1, l - 1).abs() + h.at(l, l).abs()) {
+            h.set(l, l - 1, 0.0);
+            break;
+        }
+        l -= 1;
+    }
+    l
+}
+
+/// One implicit double-shift QR step on the active block `l..=en` with the
+/// shifts of the 2 x 2 matrix whose trace is `tr` and determinant `det`.
+fn double_shift_step(h: &mut Square, l: usize, en: usize, tr: f64, det: f64) {
+    // The first column of (H - s1)(H - s2), from the block's top.
+    let (h00, h01, h10, h11) = (
+        h.at(l, l),
+        h.at(l, l + 1),
+        h.at(l + 1, l),
+        h.at(l + 1, l + 1),
+    );
+    let mut v = [
+        h00 * h00 + h01 * h10 - tr * h00 + det,
+        h10 * (h00 + h11 - tr),
+        h10 * h.at(l + 2, l + 1),
+    ];
+    for k in l..en - 1 {
+        if k > l {
+            v = [h.at(k, k - 1), h.at(k + 1, k - 1), h.at(k + 2, k - 1)];
+        }
+        chase(h, l, en, k, &mut v);
+    }
+    // The last reflector has two rows.
+    let mut last = [h.at(en - 1, en - 2), h.at(en, en - 2)];
+    chase(h, l, en, en - 1, &mut last);
+}
+
+/// Moves the bulge at column `k` of the double-shift step on `l..=en` one
+/// row down by the reflector of `v` (the first column of the shift
+/// polynomial at `k == l`, else the bulge's column below the diagonal).
+#[inline(always)]
+fn chase<const N: usize>(h: &mut Square, l: usize, en: usize, k: usize, v: &mut [f64; N]) {
+    let Some((tau, beta)) = householder(v) else {
+        return;
+    };
+    if k > l {
+        h.set(k, k - 1, beta);
+        for i in 1..N {
+            h.set(k + i, k - 1, 0.0);
+        }
+    }
+    // Eigenvalues only: nothing outside the active block is needed.
+    h.reflect_rows(k, v, tau, k..en + 1);
+    h.reflect_cols(k, v, tau, l..(k + 4).min(en + 1));
+}
+
+/// The eigenvalues of `a` (finite entries), in the order they appear on the
+/// diagonal of its real Schur form, a pair with the positive imaginary part
+/// first; `None` if the iteration did not converge within its bound.
+#[must_use]
+pub fn eigenvalues(a: &DMatrix<f64>) -> Option<Vec<Complex<f64>>> {
+    let n = a.nrows();
+    // A power of two near the largest entry: scaling by it is exact.
+    let largest = a.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+    let scale = if largest > 0.0 {
+        2.0_f64.powi(largest.log2().round() as i32)
+    } else {
+        1.0
+    };
+    let mut h = Square {
+        n,
+        a: (0..n * n).map(|k| a[(k / n, k % n)] / scale).collect(),
+    };
+    hessenberg(&mut h);
+    let mut out = vec![Complex::new(0.0, 0.0); n];
+    let mut budget = ITERATIONS_PER_ROW * n.max(10);
+    let mut its = 0;
+    let mut end = n;
+    while end > 0 {
+        let en = end - 1;
+        let l = block_start(&mut h, en);
+        if l == en {
+            out[en] = Complex::new(h.at(en, en), 0.0);
+            end -= 1;
+            its = 0;
+            continue;
+        }
+        if l + 1 == en {
+            let pair = block_2x2(h.at(l, l), h.at(l, en), h.at(en, l), h.at(en, en));
+            out[l] = pair[0];
+            out[en] = pair[1];
+            end -= 2;
+            its = 0;
+            continue;
+        }
+        if budget == 0 {
+            return None;
+        }
+        budget -= 1;
+        its += 1;
+        let (tr, det) = if its % EXCEPTIONAL_EVERY == 0 {
+            // An ad hoc shift (`dlahqr`'s) breaks a cycle of the standard one.
+            let s = h.at(en, en - 1).abs() + h.at(en - 1, en - 2).abs();
+            let d = 0.75 * s + h.at(en, en);
+            (2.0 * d, d * d + 0.4375 * s * s)
+        } else {
+            let (p, q, r, t) = (
+                h.at(en - 1, en - 1),
+                h.at(en - 1, en),
+                h.at(en, en - 1),
+                h.at(en, en),
+            );
+            (p + t, p * t - q * r)
+        };
+        double_shift_step(&mut h, l, en, tr, det);
+    }
+    for v in &mut out {
+        *v *= scale;
+    }
+    Some(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::Schur;
+    use proptest::prelude::*;
+
+    /// Each of `got` matched to its own nearest of `want`; the largest
+    /// distance relative to `scale`.
+    fn worst_distance(got: &[Complex<f64>], want: &[Complex<f64>], scale: f64) -> f64 {
+        assert_eq!(got.len(), want.len());
+        let mut free: Vec<Complex<f64>> = want.to_vec();
+        let mut worst = 0.0_f64;
+        for g in got {
+            let (k, d) = free
+                .iter()
+                .map(|w| (w - g).norm())
+                .enumerate()
+                .min_by(|a, b| a.1.total_cmp(&b.1))
+                .unwrap();
+            free.swap_remove(k);
+            worst = worst.max(d / scale);
+        }
+        worst
+    }
+
+    fn reference(a: &DMatrix<f64>) -> Vec<Complex<f64>> {
+        Schur::new(a.clone())
+            .complex_eigenvalues()
+            .iter()
+            .copied()
+            .collect()
+    }
+
+    #[test]
+    fn small_matrices_with_known_eigenvalues() {
+        // A rotation-and-scale block, a real pair, and a Jordan-free triangle.
+        let a = DMatrix::from_row_slice(2, 2, &[1.0, -2.0, 2.0, 1.0]);
+        let mut e = eigenvalues(&a).unwrap();
+        e.sort_by(|x, y| x.im.total_cmp(&y.im));
+        assert_eq!(e, [Complex::new(1.0, -2.0), Complex::new(1.0, 2.0)]);
+        let b = DMatrix::from_row_slice(3, 3, &[2.0, 1.0, 5.0, 0.0, -3.0, 7.0, 0.0, 0.0, 0.5]);
+        let mut e: Vec<f64> = eigenvalues(&b).unwrap().iter().map(|c| c.re).collect();
+        e.sort_by(f64::total_cmp);
+        assert_eq!(e, [-3.0, 0.5, 2.0]);
+        assert_eq!(eigenvalues(&DMatrix::zeros(0, 0)).unwrap(), []);
+        assert_eq!(
+            eigenvalues(&DMatrix::zeros(4, 4)).unwrap(),
+            [Complex::new(0.0, 0.0); 4]
+        );
+    }
+
+    /// A companion matrix of `(x - 1)(x - 2)...(x - 8)`: real, well apart,
+    /// but far from normal.
+    #[test]
+    fn a_companion_matrix_gives_its_polynomials_roots() {
+        let roots: Vec<f64> = (1..=8).map(f64::from).collect();
+        let mut coeffs = vec![1.0];
+        for r in &roots {
+            let mut next = vec![0.0; coeffs.len() + 1];
+            for (i, c) in coeffs.iter().enumerate() {
+                next[i] += c;
+                next[i + 1] -= r * c;
+            }
+            coeffs = next;
+        }
+        let n = roots.len();
+        let a = DMatrix::from_fn(n, n, |i, j| {
+            if i == 0 {
+                -coeffs[j + 1]
+            } else if i == j + 1 {
+                1.0
+            } else {
+                0.0
+            }
+        });
+        let got = eigenvalues(&a).unwrap();
+        let want: Vec<Complex<f64>> = roots.iter().map(|&r| Complex::new(r, 0.0)).collect();
+        assert!(worst_distance(&got, &want, 8.0) < 1e-9);
+    }
+
+    /// A permutation matrix: the unit roots, where the standard shifts
+    /// stall without the exceptional ones.
+    #[test]
+    fn a_cyclic_permutation_converges_to_the_unit_roots() {
+        let n = 6;
+        let a = DMatrix::from_fn(n, n, |i, j| if (j + 1) % n == i { 1.0 } else { 0.0 });
+        let got = eigenvalues(&a).unwrap();
+        let want: Vec<Complex<f64>> = (0..n)
+            .map(|k| Complex::from_polar(1.0, 2.0 * std::f64::consts::PI * k as f64 / n as f64))
+            .collect();
+        assert!(worst_distance(&got, &want, 1.0) < 1e-12);
+    }
+
+    proptest! {
+        /// Random matrices of any size up to 16: the eigenvalues of
+        /// nalgebra's Schur decomposition, to round-off of the matrix's size.
+        #[test]
+        fn random_matrices_match_nalgebra(
+            n in 1..=16usize,
+            entries in proptest::collection::vec(-1.0e3..1.0e3f64, 256),
+            scale_exp in -6..6i32,
+        ) {
+            let s = 10f64.powi(scale_exp);
+            let a = DMatrix::from_fn(n, n, |i, j| s * entries[i * 16 + j]);
+            let norm = a.norm();
+            let got = eigenvalues(&a).unwrap();
+            let d = worst_distance(&got, &reference(&a), norm);
+            prop_assert!(d < 1e-10, "n = {}: {:e}", n, d);
+        }
+    }
+}
