@@ -380,7 +380,8 @@ pub fn markdown(with_speed: &Report, without_speed: &Report) -> String {
         let _ = writeln!(
             s,
             "\nArithmetic per sample (analytical, `DetectorConfig::cost`): average {} mul + {} add, \
-             worst (a sample that ends a hop) {} mul + {} add; {} Goertzel steps per hop. \
+             worst (a sample that ends a hop, fires the alert and reports a kick) {} mul + {} add; \
+             {} Goertzel steps per hop. \
              Add the harmonic canceller when speed is known: at most {} mul + {} add per sample. \
              See `firmware/docs/detector.md` for cycles on the Cortex-M4F.",
             c.average.mul, c.average.add, c.worst.mul, c.worst.add, c.goertzel_steps_per_hop,

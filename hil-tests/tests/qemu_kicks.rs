@@ -8,11 +8,12 @@
 //! measurement's accuracy of their truth, and the warning before the
 //! wobble speed.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use wobble_core::format::{KickRingDown, MarginRecord, MarginState};
 use wobble_hil::corpus::simulated::campaign::{self, SpeedUp};
-use wobble_hil::qemu::{self, decode, fixture, Scenario};
+use wobble_hil::corpus::simulated::Simulation;
+use wobble_hil::qemu::{self, decode, fixture, DetectorBench, Outcome, Scenario};
 
 const PLAN: SpeedUp = SpeedUp {
     fractions: (0.55, 0.95),
@@ -21,28 +22,69 @@ const PLAN: SpeedUp = SpeedUp {
 };
 const SEED: u64 = 7;
 
-#[test]
-fn a_ride_with_kicks_writes_kick_and_margin_records() {
+/// The ride (the test bicycle), its wobble speed, its frame count, and the
+/// image's run of it: as a ride, or (`bench`) timing the detector over it.
+fn run_ride(bench: bool) -> (Simulation, f64, usize, PathBuf, Outcome) {
     let variant = &campaign::variants().expect("variants")[0];
     let (sim, wobble_speed) = campaign::speed_up_ride(variant, &PLAN, SEED).expect("ride");
     let rows = sim.fixture.rows().expect("rows");
     let frames = u32::try_from(rows.len()).expect("frames");
     let end_us = u64::from(frames) * fixture::FRAME_US;
     let gps = fixture::gps_schedule(qemu::GPS_CAPTURE, qemu::GPS_START_US, end_us).expect("gps");
-    let dir = qemu::work_dir(Path::new(env!("CARGO_TARGET_TMPDIR")), "kicks").expect("dir");
+    let name = if bench { "kicks_cost" } else { "kicks" };
+    let dir = qemu::work_dir(Path::new(env!("CARGO_TARGET_TMPDIR")), name).expect("dir");
     let setup = qemu::Setup {
         dir: dir.clone(),
-        scenario: Scenario::ride(frames),
+        scenario: Scenario {
+            bench_detector: bench,
+            ..Scenario::ride(frames)
+        },
         rows: &rows,
         gps: &gps,
         config: None,
     };
     let out = qemu::run(&setup, |_| Ok(()), |_| {}).expect("qemu run");
+    (sim, wobble_speed, rows.len(), dir, out)
+}
+
+/// The detector's cost on this ride, with the ring-down fits and margin
+/// estimates it makes (`qemu_detector_cost.rs` times a ride without kicks),
+/// within the per-sample budgets.
+#[test]
+fn the_detector_cost_on_a_ride_with_kicks() {
+    let (_, _, frames, _, out) = run_ride(true);
+    assert_eq!(out.code, 0, "{:?}", out.lines);
+    let b = out.detector_bench().expect("BENCH line");
+    assert_eq!(b.samples, frames as u64);
+    // The card's 13 kick records and 4 estimates (its fifth margin record
+    // is the warning).
+    assert!(b.kicks >= 10 && b.estimates >= 3, "{b:?}");
+    println!(
+        "FIGURES detector cost, ride with kicks: {} instructions per sample on average over {} \
+         samples; worst sample {} (sample {}); worst sample with a kick {} (of it the margin \
+         estimate {}); {} kicks measured, {} margin estimates, {} alert changes",
+        b.mean,
+        b.samples,
+        b.worst,
+        b.worst_at,
+        b.worst_kick,
+        b.worst_margin,
+        b.kicks,
+        b.estimates,
+        b.alert_changes
+    );
+    assert!(b.mean <= DetectorBench::MEAN_BUDGET, "{b:?}");
+    assert!(b.worst <= DetectorBench::WORST_BUDGET, "{b:?}");
+}
+
+#[test]
+fn a_ride_with_kicks_writes_kick_and_margin_records() {
+    let (sim, wobble_speed, frames, dir, out) = run_ride(false);
     assert_eq!(out.code, 0, "{:?}", out.lines);
     let logs = decode::logs(&out.card, &dir).expect("decode");
     assert_eq!(logs.len(), 1);
     let log = &logs[0];
-    assert_eq!(log.frames.len(), rows.len());
+    assert_eq!(log.frames.len(), frames);
     assert_eq!(log.stats.unknown_records, 0);
 
     // The kicks measured on board, within 0.3 1/s and 0.2 Hz of their truth

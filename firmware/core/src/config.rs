@@ -722,8 +722,14 @@ pub enum Source {
 /// parses it. A file longer than `buf`, or one whose reading failed part
 /// way, is cut after its last whole line read and the rest reported as
 /// [`FAULT_UNREADABLE`] (line 0).
-pub fn load<D: BlockDevice, T: TimeSource>(
-    volumes: &VolumeManager<D, T>,
+pub fn load<
+    D: BlockDevice,
+    T: TimeSource,
+    const DIRS: usize,
+    const FILES: usize,
+    const VOLUMES: usize,
+>(
+    volumes: &VolumeManager<D, T, DIRS, FILES, VOLUMES>,
     buf: &mut [u8],
 ) -> (Loaded, Source) {
     let defaults = |source| (Config::parse(b""), source);
@@ -762,8 +768,14 @@ pub fn load<D: BlockDevice, T: TimeSource>(
 /// Reads `file` into `buf`; returns the length read and whether that was
 /// the whole file. A read error is not the end of the file: what follows
 /// it is missing, and the caller reports it.
-fn read_into<D: BlockDevice, T: TimeSource>(
-    volumes: &VolumeManager<D, T>,
+fn read_into<
+    D: BlockDevice,
+    T: TimeSource,
+    const DIRS: usize,
+    const FILES: usize,
+    const VOLUMES: usize,
+>(
+    volumes: &VolumeManager<D, T, DIRS, FILES, VOLUMES>,
     file: embedded_sdmmc::RawFile,
     buf: &mut [u8],
 ) -> (usize, bool) {

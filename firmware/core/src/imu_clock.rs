@@ -55,9 +55,14 @@ pub const AGE_US: u64 = 12_000;
 /// plus [`AGE_US`], so the frames of a catch-up burst still find theirs.
 pub const HISTORY: usize = 16;
 
+/// Samples the sensor's FIFO holds (2 KiB of 16-byte packets): the longest
+/// stall, 1.28 s, after which nothing is lost.
+pub const FIFO_CAPACITY: usize = 128;
+
 /// Data-ready times or samples waiting for their partner. A tick brings one
-/// of each, a catch-up after the longest stall seven.
-const PENDING: usize = 16;
+/// of each; after a stall the rest wait in the sensor's FIFO and the
+/// adapter's pulse queue, taken as the catch-up frames need them.
+pub const PENDING: usize = 16;
 
 /// Two samples further apart than this are not interpolated between, µs:
 /// the sensor was gone (four periods).
@@ -169,7 +174,8 @@ impl SampleClock {
     }
 
     /// A data-ready pulse at `t_us` (MCU time, µs since boot), in order.
-    pub fn data_ready(&mut self, t_us: u64) {
+    /// Returns whether the clock has room for more pulses now.
+    pub fn data_ready(&mut self, t_us: u64) -> bool {
         // A waiting sample seen before this pulse is not its sample: its
         // own pulse was lost.
         while let Some(w) = self.waiting.front().copied() {
@@ -186,6 +192,13 @@ impl SampleClock {
         }
         let _ = self.pulses.push_back(t_us);
         self.pair();
+        !self.pulses.is_full()
+    }
+
+    /// Pulses waiting for their samples.
+    #[must_use]
+    pub fn pulses_waiting(&self) -> usize {
+        self.pulses.len()
     }
 
     /// The next sample from the FIFO, in order; `None` for one the sensor
@@ -199,13 +212,32 @@ impl SampleClock {
         self.pair();
     }
 
+    /// Whether the frame due at `frame_us` still lacks the sample after its
+    /// time: the port reads the FIFO until it has it, and leaves the rest
+    /// there (the FIFO is the buffer of a catch-up burst, not this clock).
+    #[must_use]
+    pub fn wants_sample(&self, frame_us: u64) -> bool {
+        let t_us = frame_us.saturating_sub(AGE_US);
+        self.history.back().is_none_or(|s| s.t_us < t_us)
+    }
+
     /// The value of the frame due at `frame_us`, after this tick's pulses
-    /// and samples, the FIFO read having ended at `read_us` (module docs).
+    /// and samples, the FIFO read having ended at `read_us` and the whole
+    /// FIFO read (module docs).
     pub fn frame(&mut self, frame_us: u64, read_us: u64) -> FrameValue {
-        // Every pulse handed in before the FIFO was read has had its sample:
-        // one still alone has lost it.
-        while let Some(t_us) = self.pulses.pop_front() {
-            self.place(t_us, None);
+        self.frame_leaving(frame_us, read_us, 0)
+    }
+
+    /// As [`SampleClock::frame`], with `unread` samples left in the FIFO:
+    /// the oldest `unread` pulses still alone are theirs and wait.
+    pub fn frame_leaving(&mut self, frame_us: u64, read_us: u64, unread: usize) -> FrameValue {
+        // Every other pulse handed in before the FIFO was read has had its
+        // sample: one still alone has lost it (the FIFO overflowed, and the
+        // sensor dropped its oldest samples).
+        while self.pulses.len() > unread {
+            if let Some(t_us) = self.pulses.pop_front() {
+                self.place(t_us, None);
+            }
         }
         // A sample found by an earlier read would have been paired with its
         // pulse by now: the pulse was lost (or the data-ready line is dead).
@@ -413,5 +445,38 @@ mod tests {
         assert_eq!(c.frame(162_000, 162_100).counts, None);
         c.restart();
         assert_eq!(c.frame(212_000, 212_100).counts, None);
+    }
+
+    #[test]
+    fn a_pulse_whose_sample_is_still_in_the_fifo_waits_for_it() {
+        let mut c = SampleClock::new();
+        for k in 0..3 {
+            c.data_ready(100_000 + k * 10_000);
+        }
+        c.sample(Some(raw(0)));
+        c.sample(Some(raw(1)));
+        assert!(!c.wants_sample(120_000));
+        assert!(c.wants_sample(135_000));
+        // The third sample is still in the FIFO: its pulse waits for it.
+        assert_eq!(c.frame_leaving(120_000, 120_100, 1).skipped, 0);
+        assert_eq!(c.pulses_waiting(), 1);
+        c.sample(Some(raw(2)));
+        let v = c.frame_leaving(130_000, 130_100, 0);
+        assert_eq!(v.skipped, 0);
+        assert_eq!(v.counts.map(|a| a[0]), Some(1.8));
+        assert_eq!(c.stats().samples, 3);
+        // With the FIFO said empty, a pulse still alone has lost its sample.
+        c.data_ready(130_000);
+        assert_eq!(c.frame(140_000, 140_100).skipped, 1);
+    }
+
+    #[test]
+    fn the_clock_says_when_it_has_no_room_for_pulses() {
+        let mut c = SampleClock::new();
+        for k in 0..PENDING as u64 - 1 {
+            assert!(c.data_ready(100_000 + k * 10_000));
+        }
+        assert!(!c.data_ready(300_000));
+        assert_eq!(c.pulses_waiting(), PENDING);
     }
 }

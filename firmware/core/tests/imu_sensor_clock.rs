@@ -7,9 +7,10 @@
 //! exactly which instant of the sensor's output it holds. With the
 //! data-ready times every frame must hold the output of exactly
 //! `AGE_US` before its tick, every sample must be used, none counted lost,
-//! also through a 66 ms stall. The once-per-tick read of the data
-//! registers (the port without a data-ready line, as the board read before)
-//! gets the 0-10 ms sawtooth, repeated and missed samples: the last test
+//! also through a 66 ms stall and through one of 1.23 s, as long as the
+//! FIFO holds. The once-per-tick read of the data registers (the port
+//! without a data-ready line, as the board read before) gets the 0-10 ms
+//! sawtooth, repeated and missed samples: the last test
 //! shows it.
 
 mod icm42688_support;
@@ -27,7 +28,7 @@ use wobble_core::app::imu_port::Icm42688Port;
 use wobble_core::app::ports::{DataReadyPort, ImuPort, ImuSample, SensorError};
 use wobble_core::drivers::icm42688::{reg, Config, Icm42688};
 use wobble_core::imu::{Imu, ImuConfig};
-use wobble_core::imu_clock::AGE_US;
+use wobble_core::imu_clock::{AGE_US, FIFO_CAPACITY};
 use wobble_core::stall::LONGEST_STALL_US;
 
 const TICK_US: u64 = 10_000;
@@ -60,6 +61,10 @@ impl Sensor {
             self.produced += 1;
             if !self.on {
                 continue;
+            }
+            // Stream mode: a full FIFO drops its oldest sample.
+            if self.fifo.len() == FIFO_CAPACITY {
+                self.fifo.pop_front();
             }
             self.fifo.push_back(k);
             self.newest = Some(k);
@@ -144,11 +149,13 @@ struct Pulses(Rc<RefCell<Sensor>>);
 impl DataReadyPort for Pulses {
     const WIRED: bool = true;
 
-    fn drain_pulses(&mut self, pulse: &mut dyn FnMut(u64)) {
+    fn drain_pulses(&mut self, pulse: &mut dyn FnMut(u64) -> bool) {
         let mut s = self.0.borrow_mut();
         s.catch_up();
         while let Some(t) = s.pulses.pop_front() {
-            pulse(t);
+            if !pulse(t) {
+                break;
+            }
         }
     }
 }
@@ -176,12 +183,12 @@ fn index_of(s: &ImuSample) -> f64 {
 }
 
 /// Reads `frames` frames at 100 Hz, each late by a pseudo-random 0-0.8 ms
-/// and, from `stall_at`, a 66 ms stall whose missed ticks are read back to
-/// back; returns (tick, answer) per frame.
+/// and, with `stall` = (frame, µs), a stall at that frame whose missed
+/// ticks are read back to back; returns (tick, answer) per frame.
 fn ride(
     port: &mut impl ImuPort,
     frames: u64,
-    stall_at: Option<u64>,
+    stall: Option<(u64, u64)>,
 ) -> Vec<(u64, Result<ImuSample, SensorError>)> {
     let start = Instant::now().as_micros();
     let mut seed = 0x2545_f491_u64;
@@ -190,8 +197,8 @@ fn ride(
         let tick = start + k * TICK_US;
         seed = seed.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1);
         let mut read_at = tick + (seed >> 33) % 800;
-        if stall_at.is_some_and(|s| k == s) {
-            read_at = tick + u64::from(LONGEST_STALL_US);
+        if let Some((_, us)) = stall.filter(|&(at, _)| at == k) {
+            read_at = tick + us;
         }
         let now = Instant::now().as_micros();
         if read_at > now {
@@ -205,8 +212,22 @@ fn ride(
 // One test: the mock clock is shared by every test of this binary.
 #[test]
 fn frames_hold_the_sensor_output_at_a_fixed_age_whatever_the_drift() {
-    for drift in [-0.02, -0.015, -0.01, -0.003, 0.0, 0.003, 0.01, 0.015, 0.02] {
-        for phase in [0.0, 0.31, 0.77, 0.99] {
+    let drifts = [-0.02, -0.015, -0.01, -0.003, 0.0, 0.003, 0.01, 0.015, 0.02];
+    let longest = u64::from(LONGEST_STALL_US);
+    fixed_age_through_a_stall(&drifts, &[0.0, 0.31, 0.77, 0.99], longest);
+    // A stall as long as the FIFO holds, the sensor 2 % fast at most: the
+    // FIFO keeps every sample, and each catch-up frame gets its own.
+    let fifo_full = FIFO_CAPACITY as u64 * TICK_US * 96 / 100;
+    fixed_age_through_a_stall(&[-0.02, 0.0, 0.02], &[0.0, 0.77], fifo_full);
+    the_read_once_per_tick_has_a_sawtooth_age_and_repeats_and_misses_samples();
+}
+
+/// Every frame after the first two holds the sensor's output `AGE_US`
+/// before its tick, none skipped, through a stall of `stall_us` at frame
+/// 300, for each drift and phase.
+fn fixed_age_through_a_stall(drifts: &[f64], phases: &[f64], stall_us: u64) {
+    for &drift in drifts {
+        for &phase in phases {
             let s = sensor(drift, phase);
             let driver = Icm42688::new(Bus(s.clone()), Config::default());
             let mut port = Icm42688Port::with_data_ready(
@@ -216,17 +237,22 @@ fn frames_hold_the_sensor_output_at_a_fixed_age_whatever_the_drift() {
                 Pulses(s.clone()),
             );
             block_on(port.start());
-            let frames = ride(&mut port, 600, Some(300));
+            let frames = ride(&mut port, 600, Some((300, stall_us)));
             let sensor = s.borrow();
             for (n, (tick, answer)) in frames.iter().enumerate().skip(2) {
-                let sample = answer.unwrap_or_else(|e| panic!("drift {drift} frame {n}: {e:?}"));
+                let sample = answer.unwrap_or_else(|e| {
+                    panic!("stall {stall_us} µs, drift {drift} frame {n}: {e:?}")
+                });
                 let t = sensor.time_of(index_of(&sample));
                 let age = *tick as f64 - t;
                 assert!(
                     (age - AGE_US as f64).abs() < 3.0,
-                    "drift {drift} phase {phase} frame {n}: age {age} µs"
+                    "stall {stall_us} µs, drift {drift} phase {phase} frame {n}: age {age} µs"
                 );
-                assert_eq!(sample.skipped, 0, "drift {drift} frame {n}");
+                assert_eq!(
+                    sample.skipped, 0,
+                    "stall {stall_us} µs, drift {drift} frame {n}"
+                );
                 assert!((sample.gyro_dps[0] * 65.5 + sample.accel_g[0] * 2048.0).abs() < 0.05);
             }
             let (stats, period) = port.clock();
@@ -248,7 +274,6 @@ fn frames_hold_the_sensor_output_at_a_fixed_age_whatever_the_drift() {
             );
         }
     }
-    the_read_once_per_tick_has_a_sawtooth_age_and_repeats_and_misses_samples();
 }
 
 /// What the board did before, for the record: the newest register sample,

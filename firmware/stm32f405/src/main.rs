@@ -20,29 +20,24 @@ use embassy_stm32::interrupt;
 use embassy_stm32::interrupt::{InterruptExt, Priority};
 use embassy_stm32::peripherals::{ADC1, IWDG};
 use embassy_stm32::spi::Spi;
-use embassy_stm32::time::Hertz;
 use embassy_stm32::Peri;
-use embassy_time::{Delay, Instant};
-use embedded_hal_bus::spi::ExclusiveDevice;
-use embedded_sdmmc::VolumeManager;
+use embassy_time::Instant;
 use static_cell::StaticCell;
 use wobble_core::app::sampler::{Sampler, SamplerPorts};
 use wobble_core::app::{gps, sampler, writer};
 use wobble_core::boot;
 use wobble_core::channels::{RecordQueue, SharedStatus};
 use wobble_core::config::{self, Config, Loaded, KEY_COUNT, MAX_TEXT_LEN};
-use wobble_core::drivers::icm42688::{self, Icm42688};
 use wobble_core::format::Record;
 use wobble_core::frame_assembly::FrameConfig;
-use wobble_core::imu::Imu;
-use wobble_core::logger::{CardLogger, FixedTime, HeaderSpec, LoggerConfig};
+use wobble_core::logger::{CardLogger, FixedTime, HeaderSpec, LoggerConfig, Volumes};
 use wobble_core::steering::Steering;
 use wobble_core::wheel::WheelSpeed;
 use {defmt_rtt as _, panic_probe as _};
 
 use wobble_stm32f405::adapters::card::SdCard;
 use wobble_stm32f405::adapters::gps::GpsAdapter;
-use wobble_stm32f405::adapters::imu::{DataReadyAdapter, ImuAdapter};
+use wobble_stm32f405::adapters::imu::ImuAdapter;
 use wobble_stm32f405::adapters::rider::{AlertPins, MarkerButton, StatusLight};
 use wobble_stm32f405::adapters::steering::SteeringAdapter;
 use wobble_stm32f405::adapters::wheel::WheelAdapter;
@@ -219,7 +214,7 @@ fn card_and_config(pins: pins::CardPins) -> (SdCard, Loaded) {
         adapters::card::spi_config(wobble_core::drivers::sdcard::IDENTIFICATION_CLOCK_HZ),
     );
     let cs = Output::new(pins.cs, Level::High, Speed::VeryHigh);
-    let volumes = VolumeManager::new(adapters::card::card(bus, cs), FixedTime::EPOCH);
+    let volumes = Volumes::new_with_limits(adapters::card::card(bus, cs), FixedTime::EPOCH, 0);
     let mut file = [0u8; CONFIG_FILE_BYTES];
     let (loaded, source) = config::load(&volumes, &mut file);
     defmt::info!("config: {}, {} faults", source, loaded.faults.first().len());
@@ -253,22 +248,7 @@ fn sampler_parts(
     rider: pins::RiderPins,
     config: &Config,
 ) -> (Sampler, Ports) {
-    let mut spi_config = embassy_stm32::spi::Config::default();
-    spi_config.frequency = Hertz(clocks::IMU_SPI_HZ);
-    let bus = Spi::new(
-        imu.spi, imu.sck, imu.mosi, imu.miso, imu.tx_dma, imu.rx_dma, Irqs, spi_config,
-    );
-    let cs = Output::new(imu.cs, Level::High, Speed::VeryHigh);
-    let device = ExclusiveDevice::new(bus, cs, Delay).unwrap_or_else(|e| match e {});
-    let driver_config = icm42688::Config::default();
-    // `Config::parse` only lets through what the core's modules accept.
-    let channel = defmt::unwrap!(Imu::try_new(driver_config.imu_config(config.imu)).ok());
-    let imu = ImuAdapter::with_data_ready(
-        Icm42688::new(device, driver_config),
-        channel,
-        Delay,
-        DataReadyAdapter::default(),
-    );
+    let imu = adapters::imu::port(imu, config.imu);
 
     let steering = SteeringAdapter::new(
         steering_adc(steering.adc, steering.wiper, steering.dma),

@@ -15,11 +15,12 @@
 use embassy_futures::join::join;
 use embassy_stm32::gpio::Output;
 use embassy_time::{Duration, Instant, Ticker, Timer};
-use embedded_sdmmc::{Mode, VolumeIdx, VolumeManager};
+use embedded_sdmmc::{Mode, VolumeIdx};
 use wobble_core::app::gps_setup;
 use wobble_core::app::ports::{ImuPort, SteeringPort, WheelPort};
 use wobble_core::boot::ResetCause;
-use wobble_core::logger::FixedTime;
+use wobble_core::detector::math::sqrtf;
+use wobble_core::logger::{FixedTime, Volumes};
 use wobble_core::selftest::{
     failure_code, fat32_free_mib, write_report, Measurements, TEST_WINDOW_US,
 };
@@ -67,20 +68,11 @@ async fn imu_at_rest(imu: &mut ImuAdapter) -> Option<f32> {
         ticker.next().await;
         if let Ok(s) = imu.read(Instant::now().as_micros()).await {
             let [x, y, z] = s.accel_g;
-            sum += sqrt(x * x + y * y + z * z);
+            sum += sqrtf(x * x + y * y + z * z);
             n += 1;
         }
     }
     (n > 0).then(|| sum / n as f32)
-}
-
-/// `sqrt` without `std`: Newton's iteration, plenty for a 10 % check.
-fn sqrt(v: f32) -> f32 {
-    let mut r = if v > 1.0 { v } else { 1.0 };
-    for _ in 0..20 {
-        r = 0.5 * (r + v / r);
-    }
-    r
 }
 
 /// Steering range and wheel edges over the test window, status LED
@@ -111,7 +103,7 @@ async fn sensors(
 
 /// Write and read speed, KiB/s, through a scratch file that is deleted
 /// afterwards (logs are never touched).
-fn card_speed(volumes: &VolumeManager<SdCard, FixedTime>) -> Option<(u32, u32)> {
+fn card_speed(volumes: &Volumes<SdCard, FixedTime>) -> Option<(u32, u32)> {
     let volume = volumes.open_volume(VolumeIdx(0)).ok()?;
     let root = volume.open_root_dir().ok()?;
     let block = [0x5Au8; 512];
@@ -146,7 +138,7 @@ fn card_speed(volumes: &VolumeManager<SdCard, FixedTime>) -> Option<(u32, u32)> 
     Some((write, read))
 }
 
-fn write_report_file(volumes: &VolumeManager<SdCard, FixedTime>, text: &str) -> bool {
+fn write_report_file(volumes: &Volumes<SdCard, FixedTime>, text: &str) -> bool {
     let write = || -> Option<()> {
         let volume = volumes.open_volume(VolumeIdx(0)).ok()?;
         let root = volume.open_root_dir().ok()?;
@@ -206,7 +198,7 @@ pub async fn run(p: Parts) -> ! {
     // here, at the bench, and verified by the next self-test.
     m.bor = Some(crate::startup::program_bor_level3());
     m.stack_bytes = Some(crate::startup::stack_use());
-    let volumes = VolumeManager::new(card, FixedTime::EPOCH);
+    let volumes = Volumes::new_with_limits(card, FixedTime::EPOCH, 0);
     m.card_free_mib = volumes.device(|card| fat32_free_mib(card)).unwrap_or(0);
     m.card_kib_s = card_speed(&volumes);
     let mut text = heapless::String::<512>::new();

@@ -10,19 +10,12 @@ use defmt_rtt as _;
 #[cfg(test)]
 #[embedded_test::tests]
 mod tests {
-    use embassy_stm32::gpio::{Level, Output, Speed};
-    use embassy_stm32::spi::{Config as SpiConfig, Spi};
-    use embassy_stm32::time::Hertz;
-    use embassy_time::{Delay, Duration, Instant, Ticker, Timer};
-    use embedded_hal_bus::spi::ExclusiveDevice;
+    use embassy_time::{Duration, Instant, Ticker, Timer};
     use wobble_core::app::ports::{DataReadyPort, ImuPort};
-    use wobble_core::drivers::icm42688::{self, Icm42688};
-    use wobble_core::imu::{Imu, ImuConfig};
+    use wobble_core::imu::ImuConfig;
     use wobble_core::imu_clock::NOMINAL_PERIOD_US;
-    use wobble_stm32f405::adapters::imu::{DataReadyAdapter, ImuAdapter};
+    use wobble_stm32f405::adapters::imu::{self, DataReadyAdapter, ImuAdapter};
     use wobble_stm32f405::adapters::wheel::{self, WheelTimer};
-    use wobble_stm32f405::clocks;
-    use wobble_stm32f405::pins::Irqs;
 
     /// The sensor's oscillator is within a few per cent of 100 Hz.
     const PERIOD_TOLERANCE: f32 = 0.03;
@@ -31,30 +24,7 @@ mod tests {
     fn imu() -> (ImuAdapter, WheelTimer) {
         let (board, _) = wobble_on_target::board();
         let timer = wheel::start(board.wheel);
-        let pins = board.imu;
-        let mut config = SpiConfig::default();
-        config.frequency = Hertz(clocks::IMU_SPI_HZ);
-        let bus = Spi::new(
-            pins.spi,
-            pins.sck,
-            pins.mosi,
-            pins.miso,
-            pins.tx_dma,
-            pins.rx_dma,
-            Irqs,
-            config,
-        );
-        let cs = Output::new(pins.cs, Level::High, Speed::VeryHigh);
-        let device = ExclusiveDevice::new(bus, cs, Delay).unwrap_or_else(|e| match e {});
-        let driver_config = icm42688::Config::default();
-        let channel =
-            defmt::unwrap!(Imu::try_new(driver_config.imu_config(ImuConfig::DEFAULT)).ok());
-        let port = ImuAdapter::with_data_ready(
-            Icm42688::new(device, driver_config),
-            channel,
-            Delay,
-            DataReadyAdapter::default(),
-        );
+        let port = imu::port(board.imu, ImuConfig::DEFAULT);
         (port, timer)
     }
 
@@ -68,9 +38,7 @@ mod tests {
         let mut times: heapless::Vec<u64, 256> = heapless::Vec::new();
         for _ in 0..200 {
             Timer::after_millis(10).await;
-            pulses.drain_pulses(&mut |t| {
-                let _ = times.push(t);
-            });
+            pulses.drain_pulses(&mut |t| times.push(t).is_ok());
         }
         defmt::assert!(times.len() >= 190, "{} pulses in 2 s", times.len());
         let span = (times[times.len() - 1] - times[0]) as f32;

@@ -26,14 +26,15 @@ use embassy_time::{Delay, Instant};
 use embedded_sdmmc::VolumeManager;
 use static_cell::StaticCell;
 use wobble_core::app::imu_port::Icm42688Port;
-use wobble_core::app::ports::{AlertOutput, LoggerHealth, StatusLed};
+use wobble_core::app::ports::{AlertOutput, LoggerHealth, SensorError, StatusLed};
 use wobble_core::app::sampler::{Sampler, SamplerPorts};
 use wobble_core::app::{gps, sampler, writer};
 use wobble_core::channels::{RecordQueue, SharedStatus};
 use wobble_core::config::{self, Config, Loaded, KEY_COUNT, MAX_TEXT_LEN};
+use wobble_core::detector::MarginWarning;
 use wobble_core::drivers::icm42688::{self, Icm42688};
 use wobble_core::format::Record;
-use wobble_core::frame_assembly::FrameConfig;
+use wobble_core::frame_assembly::{FrameAssembler, FrameConfig, TickInputs};
 use wobble_core::gps::{GpsConfig, GpsReceiver};
 use wobble_core::imu::Imu;
 use wobble_core::logger::{
@@ -226,35 +227,89 @@ fn card_and_config(scenario: &'static Scenario) -> (SemihostingCard, Loaded) {
     (card, loaded)
 }
 
-/// Most steering samples the detector benchmark holds.
-const BENCH_SAMPLES: usize = 3000;
-
-/// Times the wobble detector alone over the ride's steering at 4 m/s:
-/// `BENCH detector samples=N us=T`, virtual time, which the harness turns
-/// into instructions. The samples are read first, so no file access is
-/// timed.
+/// Times the wobble detector and the margin warning over the ride, as the
+/// sampler runs them on each frame (`Sampler::step`): the frame's steering
+/// angle and wheel speed, as the card stores them, into `Detector::push`,
+/// the kick it reports into `MarginWarning::add_kick`, and the warning's
+/// `update`. Only that work is timed (virtual time, which the harness turns
+/// into instructions), not the reading of the ride nor the frame's
+/// assembly: `BENCH detector samples=N ns=T max_ns=W max_at=K
+/// kick_max_ns=.. margin_max_ns=.. alert_changes=.. kicks=.. estimates=..
+/// clock_ns=..`,
+/// where `max_at` is the sample (from 0) of the worst one, `kick_max_ns`
+/// the worst sample that reported a kick (the ring-down fit and the margin
+/// estimate run on it) and `margin_max_ns` the worst margin estimate alone.
 fn bench_detector(ride: &mut Ride, config: &Config) -> ! {
-    static SAMPLES: StaticCell<heapless::Vec<f32, BENCH_SAMPLES>> = StaticCell::new();
-    let samples = SAMPLES.init(heapless::Vec::new());
-    let (Ok(mut steering), Ok(mut detector)) =
-        (Steering::try_new(config.steering), config.detector())
-    else {
+    let (Ok(mut steering), Ok(mut detector), Ok(mut wheel)) = (
+        Steering::try_new(config.steering),
+        config.detector(),
+        WheelSpeed::try_new(config.wheel),
+    ) else {
         rejected()
     };
-    while let Some(deg) = ride.next_steer_deg(&mut steering) {
-        if samples.push(deg).is_err() {
+    let mut margin = MarginWarning::new(config.alert.margin_mps);
+    let mut frames = FrameAssembler::new(FrameConfig::DEFAULT);
+    let (mut samples, mut total_ns, mut max_ns, mut max_at) = (0u32, 0u64, 0u64, 0u32);
+    let (mut kick_max_ns, mut margin_max_ns) = (0u64, 0u64);
+    let (mut alerts, mut kicks, mut estimates) = (0u32, 0u32, 0u32);
+    // What one reading of the clock costs: the least of a few back to back.
+    let clock_ns = (0..8)
+        .map(|_| {
+            let t0 = time_driver::now_ns();
+            time_driver::now_ns() - t0
+        })
+        .min()
+        .unwrap_or(0);
+    let mut t_us = 0u64;
+    loop {
+        t_us += sampler::FRAME_PERIOD_US;
+        let now_us = t_us;
+        let Some(steer) = ride.next_bench_row(&mut steering, &mut |age| {
+            wheel.on_edge(now_us.saturating_sub(u64::from(age)));
+        }) else {
             break;
+        };
+        let frame = frames.tick(
+            t_us,
+            &TickInputs {
+                imu: Err(SensorError::Stale),
+                steering: steer,
+                wheel: wheel.sample(t_us),
+                last_gps_fix_us: None,
+                marker: false,
+            },
+        );
+        let (deg, speed) = (frame.steer_deg(), Some(frame.speed_mps()));
+        let start = time_driver::now_ns();
+        let event = detector.push(deg, speed);
+        let kick = detector.take_kick();
+        let mut margin_ns = 0;
+        if let Some(k) = kick {
+            let t0 = time_driver::now_ns();
+            estimates += u32::from(margin.add_kick(&k).is_some());
+            margin_ns = (time_driver::now_ns() - t0).saturating_sub(clock_ns);
         }
+        let _ = margin.update(t_us, speed);
+        // The clock's own cost, and on a kick's sample that of the two
+        // readings around the margin estimate, are taken out.
+        let clocks = if kick.is_some() { 3 } else { 1 };
+        let ns = (time_driver::now_ns() - start).saturating_sub(clocks * clock_ns);
+        total_ns += ns;
+        if ns > max_ns {
+            (max_ns, max_at) = (ns, samples);
+        }
+        if kick.is_some() {
+            kicks += 1;
+            kick_max_ns = kick_max_ns.max(ns);
+            margin_max_ns = margin_max_ns.max(margin_ns);
+        }
+        alerts += u32::from(event.is_some());
+        samples += 1;
     }
-    let start = Instant::now();
-    let alerts = samples
-        .iter()
-        .filter(|&&deg| detector.push(deg, Some(4.0)).is_some())
-        .count();
-    let us = Instant::now().as_micros() - start.as_micros();
     report::line(format_args!(
-        "BENCH detector samples={} us={us} alert_changes={alerts}",
-        samples.len()
+        "BENCH detector samples={samples} ns={total_ns} max_ns={max_ns} max_at={max_at} \
+         kick_max_ns={kick_max_ns} margin_max_ns={margin_max_ns} alert_changes={alerts} \
+         kicks={kicks} estimates={estimates} clock_ns={clock_ns}"
     ));
     semihosting::process::exit(0)
 }

@@ -115,12 +115,19 @@ impl Ride {
         }
     }
 
-    /// The next row's steering angle through `channel`, degrees; `None` at
-    /// the end.
-    pub fn next_steer_deg(&mut self, channel: &mut Steering) -> Option<f32> {
+    /// The next row for the detector benchmark: its steering sample
+    /// through `channel` (`Stale` without a conversion), after handing each
+    /// of its wheel edges' ages (µs, oldest first) to `edge_age_us`; `None`
+    /// at the end.
+    pub fn next_bench_row(
+        &mut self,
+        channel: &mut Steering,
+        edge_age_us: &mut impl FnMut(u16),
+    ) -> Option<Result<SteeringSample, SensorError>> {
         let row = read_row(&mut self.file)?;
+        row.edges_age_us.iter().rev().for_each(|&a| edge_age_us(a));
         channel.push_all(&row.adc);
-        channel.take().map(|s| s.deg)
+        Some(channel.take().ok_or(SensorError::Stale))
     }
 
     /// The current row's IMU data registers.

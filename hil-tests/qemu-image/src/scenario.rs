@@ -14,7 +14,7 @@
 //! | `imu_stuck_ms=A:B` | the IMU's data registers freeze from A to B ms |
 //! | `steer_open_ms=A:B` | the potentiometer's wiper is open (ADC at full scale) from A to B ms |
 //! | `gps_garbage_ms=A:B` | the GPS sends noise instead of NMEA from A to B ms |
-//! | `bench=detector` | no ride: time the wobble detector over the ride's steering |
+//! | `bench=detector` | no ride: time the wobble detector and the margin warning over the ride's steering and wheel speed |
 
 use heapless::Vec;
 

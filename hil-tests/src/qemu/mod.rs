@@ -13,7 +13,7 @@ pub mod decode;
 pub mod fixture;
 pub mod run;
 
-pub use run::{image, run, Outcome, Scenario, Setup, ICOUNT_SHIFT};
+pub use run::{image, run, DetectorBench, Outcome, Scenario, Setup, ICOUNT_SHIFT};
 
 use std::path::{Path, PathBuf};
 

@@ -78,8 +78,9 @@ pub struct Scenario {
     pub steer_open_ms: Option<(u32, u32)>,
     /// GPS noise from/to, ms.
     pub gps_garbage_ms: Option<(u32, u32)>,
-    /// Instead of riding, time the wobble detector over the ride's steering
-    /// and report it in a `BENCH` line.
+    /// Instead of riding, time the wobble detector and the margin warning
+    /// over the ride's steering and wheel speed and report it in a `BENCH`
+    /// line ([`Outcome::detector_bench`]).
     pub bench_detector: bool,
 }
 
@@ -227,6 +228,61 @@ impl Outcome {
                 ))
             })
             .collect()
+    }
+}
+
+/// The detector benchmark's figures (the image's `BENCH` line), in
+/// instructions on QEMU's fixed instruction clock ([`ICOUNT_SHIFT`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct DetectorBench {
+    /// Samples timed.
+    pub samples: u64,
+    /// Mean per sample.
+    pub mean: u64,
+    /// The worst sample...
+    pub worst: u64,
+    /// ...and which (from 0).
+    pub worst_at: u64,
+    /// The worst sample that reported a kick (its ring-down fit and the
+    /// margin estimate ran on it).
+    pub worst_kick: u64,
+    /// The worst margin estimate alone.
+    pub worst_margin: u64,
+    /// Alert switchings, kicks reported and margin estimates made.
+    pub alert_changes: u64,
+    /// See `alert_changes`.
+    pub kicks: u64,
+    /// See `alert_changes`.
+    pub estimates: u64,
+}
+
+impl DetectorBench {
+    /// A 10 ms frame at 168 MHz is 1.68 M cycles: the detector may take at
+    /// most 1 % of it on average...
+    pub const MEAN_BUDGET: u64 = 16_800;
+    /// ...and 10 % on its worst sample (the sampler's tick must leave the
+    /// GPS and card tasks their time).
+    pub const WORST_BUDGET: u64 = 168_000;
+}
+
+impl Outcome {
+    /// The detector benchmark's figures, if the run reported them.
+    #[must_use]
+    pub fn detector_bench(&self) -> Option<DetectorBench> {
+        let n = |key| self.number("BENCH", key);
+        let instructions = |ns: u64| ns >> ICOUNT_SHIFT;
+        let samples = n("samples").filter(|&s| s > 0)?;
+        Some(DetectorBench {
+            samples,
+            mean: instructions(n("ns")?) / samples,
+            worst: instructions(n("max_ns")?),
+            worst_at: n("max_at")?,
+            worst_kick: instructions(n("kick_max_ns")?),
+            worst_margin: instructions(n("margin_max_ns")?),
+            alert_changes: n("alert_changes")?,
+            kicks: n("kicks")?,
+            estimates: n("estimates")?,
+        })
     }
 }
 

@@ -22,27 +22,21 @@ use super::run::Run;
 pub const MATCH_S: f64 = 0.5;
 
 /// The host's stated uncertainty of a card record's sigma is its stated
-/// standard error scaled by this...
-///
-/// The on-board fit (`firmware/core/src/detector/ringdown.rs`) takes its
-/// Hann segments of 0.3 s every 0.1 s as independent. For white noise two
-/// Hann windows overlapping by two thirds and by one third correlate by
-/// 0.471 and 0.029 (the window's normalised autocorrelation), which
-/// multiplies the variance of a slope fitted through them by about
-/// `1 + 2 (0.471 + 0.029) = 2.0`: a factor of 1.4 on the error. The
-/// actual errors are larger still, for the reason the host's own fit
-/// errors are (the road rings the mode at its own frequency through the
-/// ring-down, see [`super::kicks::stated_sd`]).
-pub const CARD_SE_FACTOR: f64 = 3.3;
+/// standard error scaled by this... The board's margin warning weighs its
+/// kicks by the same (`wobble_core::detector::Kick::sigma_sd_per_s`), so the
+/// calibration and its reasons live in the core
+/// ([`wobble_core::detector::SIGMA_SE_FACTOR`]).
+pub const CARD_SE_FACTOR: f64 = wobble_core::detector::SIGMA_SE_FACTOR;
 /// ... with this (1/s) added in quadrature.
-pub const CARD_SD_FLOOR_PER_S: f64 = 0.0175;
+pub const CARD_SD_FLOOR_PER_S: f64 = wobble_core::detector::SIGMA_SD_FLOOR_PER_S;
 
 /// The standard uncertainty of a card record's sigma from its stated
 /// standard error `se`: `sqrt((CARD_SE_FACTOR se)^2 +
-/// CARD_SD_FLOOR_PER_S^2)`. Calibrated as the host's ([`super::kicks::stated_sd`]):
-/// on seeds 100-111 (844 kicks the board measured), checked on seeds
-/// 200-249: 66.0 % of the errors within one SD and 92.4 % within two; with
-/// the record's own error, 43 % within two.
+/// CARD_SD_FLOOR_PER_S^2)`, in `f64` (the board's is `f32`). Calibrated as
+/// the host's own ([`super::kicks::stated_sd`]): on seeds 100-111 (844
+/// kicks the board measured), checked on seeds 200-249: 66.0 % of the
+/// errors within one SD and 92.4 % within two; with the record's own
+/// error, 43 % within two.
 #[must_use]
 pub fn card_sd(se: f64) -> f64 {
     (CARD_SE_FACTOR * se).hypot(CARD_SD_FLOOR_PER_S)

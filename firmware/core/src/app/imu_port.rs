@@ -11,6 +11,8 @@
 //! tick, and samples that reach no frame are counted. Without it (the QEMU
 //! machine), the newest sample is read once per frame, 0-10 ms old.
 
+use core::borrow::BorrowMut;
+
 use embassy_time::{Duration, Instant};
 use embedded_hal_async::delay::DelayNs;
 use embedded_hal_async::spi::SpiDevice;
@@ -18,23 +20,22 @@ use embedded_hal_async::spi::SpiDevice;
 use super::ports::{DataReadyPort, ImuPort, ImuSample, NoDataReady, SensorError};
 use crate::drivers::icm42688::{Error, Icm42688};
 use crate::imu::Imu;
-use crate::imu_clock::{ClockStats, SampleClock};
+use crate::imu_clock::{self, ClockStats, SampleClock};
 
 /// Shortest time between two set-up attempts of a failed sensor.
 pub const RETRY: Duration = Duration::from_secs(1);
 
-/// FIFO samples read per frame at most: a frame brings one, the catch-up
-/// after the longest stall seven; more wait in the FIFO (it holds 128)
-/// for the next frame.
-pub const MAX_FIFO_SAMPLES_PER_READ: u16 = 16;
-
 /// Driver, channel, data-ready line and recovery state.
-pub struct Icm42688Port<SPI, D, R = NoDataReady> {
+///
+/// The sample clock (`C`, about 1 KiB) is owned by default; the board
+/// lends it a `&'static mut SampleClock` instead, so that it sits once in a
+/// static and not in every task future the port is moved through.
+pub struct Icm42688Port<SPI, D, R = NoDataReady, C = SampleClock> {
     driver: Icm42688<SPI>,
     channel: Imu,
     delay: D,
     data_ready: R,
-    clock: SampleClock,
+    clock: C,
     /// Skipped samples not yet handed to a frame (a stale frame has none).
     skipped: u32,
     ready: bool,
@@ -53,12 +54,28 @@ impl<SPI: SpiDevice, D: DelayNs, R: DataReadyPort> Icm42688Port<SPI, D, R> {
     /// As [`Icm42688Port::new`], with the sensor's data-ready pulses timed
     /// by `data_ready`.
     pub fn with_data_ready(driver: Icm42688<SPI>, channel: Imu, delay: D, data_ready: R) -> Self {
+        Self::with_clock(driver, channel, delay, data_ready, SampleClock::new())
+    }
+}
+
+impl<SPI: SpiDevice, D: DelayNs, R: DataReadyPort, C: BorrowMut<SampleClock>>
+    Icm42688Port<SPI, D, R, C>
+{
+    /// As [`Icm42688Port::with_data_ready`], pairing samples and pulses in
+    /// `clock` (which the first set-up restarts).
+    pub fn with_clock(
+        driver: Icm42688<SPI>,
+        channel: Imu,
+        delay: D,
+        data_ready: R,
+        clock: C,
+    ) -> Self {
         Self {
             driver,
             channel,
             delay,
             data_ready,
-            clock: SampleClock::new(),
+            clock,
             skipped: 0,
             ready: false,
             next_attempt: Instant::MIN,
@@ -73,7 +90,8 @@ impl<SPI: SpiDevice, D: DelayNs, R: DataReadyPort> Icm42688Port<SPI, D, R> {
 
     /// What the sample clock counted so far, and its period estimate.
     pub fn clock(&self) -> (ClockStats, f32) {
-        (self.clock.stats(), self.clock.period_us())
+        let clock = self.clock.borrow();
+        (clock.stats(), clock.period_us())
     }
 
     async fn ensure_ready(&mut self) -> Result<(), SensorError> {
@@ -94,8 +112,8 @@ impl<SPI: SpiDevice, D: DelayNs, R: DataReadyPort> Icm42688Port<SPI, D, R> {
             Ok(()) => {
                 #[cfg(feature = "defmt")]
                 defmt::info!("IMU ready");
-                self.data_ready.drain_pulses(&mut |_| {});
-                self.clock.restart();
+                self.data_ready.drain_pulses(&mut |_| true);
+                self.clock.borrow_mut().restart();
                 self.ready = true;
                 Ok(())
             }
@@ -119,24 +137,46 @@ impl<SPI: SpiDevice, D: DelayNs, R: DataReadyPort> Icm42688Port<SPI, D, R> {
     /// The wired read: pulses first, then the FIFO (the order
     /// [`SampleClock`] pairs them by), then the frame's value.
     async fn read_timed(&mut self, scheduled_us: u64) -> Result<ImuSample, SensorError> {
-        let clock = &mut self.clock;
-        self.data_ready.drain_pulses(&mut |t| clock.data_ready(t));
+        // `drain_pulses` hands over a pulse it has already taken: ask only
+        // while the clock has room.
+        let clock = self.clock.borrow_mut();
+        if clock.pulses_waiting() < imu_clock::PENDING {
+            self.data_ready.drain_pulses(&mut |t| clock.data_ready(t));
+        }
         let waiting = match self.driver.fifo_samples().await {
-            Ok(n) => n,
+            Ok(n) => usize::from(n),
             Err(e) => return Err(self.failed(&e)),
         };
-        for _ in 0..waiting.min(MAX_FIFO_SAMPLES_PER_READ) {
+        // Only as far as this frame's time: after a stall the FIFO and the
+        // pulse queue keep the rest for the catch-up frames that follow (up
+        // to the FIFO's 128 samples, 1.28 s, nothing is lost).
+        let mut read = 0;
+        while read < waiting && self.clock.borrow_mut().wants_sample(scheduled_us) {
+            // The pulses of the samples counted, as far as the clock has
+            // room (a pulse drawn for a sample not counted would pass for
+            // one whose sample was lost).
+            let clock = self.clock.borrow_mut();
+            if clock.pulses_waiting() < (waiting - read).min(imu_clock::PENDING) {
+                self.data_ready.drain_pulses(&mut |t| {
+                    clock.data_ready(t) && clock.pulses_waiting() < waiting - read
+                });
+            }
+            read += 1;
             match self.driver.fifo_sample().await {
                 Ok(raw) => {
                     if let Some(raw) = raw {
                         self.channel.watch(raw);
                     }
-                    self.clock.sample(raw);
+                    self.clock.borrow_mut().sample(raw);
                 }
                 Err(e) => return Err(self.failed(&e)),
             }
         }
-        let value = self.clock.frame(scheduled_us, Instant::now().as_micros());
+        let value = self.clock.borrow_mut().frame_leaving(
+            scheduled_us,
+            Instant::now().as_micros(),
+            waiting - read,
+        );
         self.skipped = self.skipped.saturating_add(value.skipped);
         let counts = value.counts.ok_or(SensorError::Stale)?;
         let mut sample = self.channel.scale(counts);
@@ -157,7 +197,9 @@ impl<SPI: SpiDevice, D: DelayNs, R: DataReadyPort> Icm42688Port<SPI, D, R> {
     }
 }
 
-impl<SPI: SpiDevice, D: DelayNs, R: DataReadyPort> ImuPort for Icm42688Port<SPI, D, R> {
+impl<SPI: SpiDevice, D: DelayNs, R: DataReadyPort, C: BorrowMut<SampleClock>> ImuPort
+    for Icm42688Port<SPI, D, R, C>
+{
     async fn read(&mut self, scheduled_us: u64) -> Result<ImuSample, SensorError> {
         self.ensure_ready().await?;
         let sample = if R::WIRED {

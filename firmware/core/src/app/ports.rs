@@ -48,9 +48,11 @@ pub trait DataReadyPort {
     /// once per frame, its newest sample 0-10 ms old.
     const WIRED: bool;
 
-    /// Hands the time of every pulse since the last call to `pulse`,
-    /// oldest first, as µs since boot.
-    fn drain_pulses(&mut self, pulse: &mut dyn FnMut(u64));
+    /// Hands the time of each pulse since the last call to `pulse`, oldest
+    /// first, as µs since boot, until `pulse` returns `false` (it has taken
+    /// that one and wants no more now): the rest wait in the adapter's
+    /// queue, which holds a full FIFO's worth.
+    fn drain_pulses(&mut self, pulse: &mut dyn FnMut(u64) -> bool);
 }
 
 /// No data-ready line (the QEMU machine's emulated sensor has none).
@@ -60,7 +62,7 @@ pub struct NoDataReady;
 impl DataReadyPort for NoDataReady {
     const WIRED: bool = false;
 
-    fn drain_pulses(&mut self, _pulse: &mut dyn FnMut(u64)) {}
+    fn drain_pulses(&mut self, _pulse: &mut dyn FnMut(u64) -> bool) {}
 }
 
 /// The steering potentiometer, calibrated.

@@ -42,7 +42,7 @@ pub use harmonics::{sincos_turns, HarmonicCanceller};
 pub use machine::{AlertEvent, Detector, Estimate};
 pub use margin::{MarginEvent, MarginWarning, WobbleSpeed};
 pub use pattern::{AlertOutput, AlertPattern, ApproachConfig, PatternConfig};
-pub use ringdown::Kick;
+pub use ringdown::{Kick, SIGMA_SD_FLOOR_PER_S, SIGMA_SE_FACTOR};
 
 /// Longest analysis window, samples (0.64 s at 100 Hz).
 pub const MAX_WINDOW: usize = 64;
@@ -220,19 +220,30 @@ impl DetectorConfig {
             add: 12 + 2 * rotations + 6 * orders + 2,
             other: 6,
         };
+        let (ringdown, kick_fit) = ringdown::cost();
+        let (margin_estimate, margin_update) = margin::cost();
+        let average = per_sample
+            + Cost1 {
+                mul: per_hop.mul.div_ceil(hop),
+                add: per_hop.add.div_ceil(hop),
+                other: per_hop.other.div_ceil(hop),
+            }
+            + margin_update;
         Ok(Cost {
-            worst: Cost1 {
-                mul: per_sample.mul + per_hop.mul + on_alert.mul,
-                add: per_sample.add + per_hop.add + on_alert.add,
-                other: per_sample.other + per_hop.other + on_alert.other,
-            },
-            average: Cost1 {
-                mul: per_sample.mul + per_hop.mul.div_ceil(hop),
-                add: per_sample.add + per_hop.add.div_ceil(hop),
-                other: per_sample.other + per_hop.other.div_ceil(hop),
-            },
+            // A ring-down fit (a segment below the floor) and the alert can
+            // fall on the sample that ends a hop: everything at once.
+            worst: per_sample
+                + per_hop
+                + on_alert
+                + ringdown
+                + kick_fit
+                + margin_estimate
+                + margin_update,
+            average,
             canceller,
             goertzel_steps_per_hop: k * n,
+            ringdown,
+            kick: kick_fit + margin_estimate,
         })
     }
 }
@@ -255,23 +266,77 @@ pub struct Cost1 {
     pub other: u32,
 }
 
-/// Analytical cost per sample of the detector.
+impl core::ops::Add for Cost1 {
+    type Output = Self;
+    fn add(self, o: Self) -> Self {
+        Self {
+            mul: self.mul + o.mul,
+            add: self.add + o.add,
+            other: self.other + o.other,
+        }
+    }
+}
+
+impl core::ops::Mul<u32> for Cost1 {
+    type Output = Self;
+    fn mul(self, n: u32) -> Self {
+        Self {
+            mul: self.mul * n,
+            add: self.add * n,
+            other: self.other * n,
+        }
+    }
+}
+
+impl Cost1 {
+    /// `mul` multiplications, `add` additions, `other` compares and
+    /// bookkeeping.
+    pub(crate) const fn new(mul: u32, add: u32, other: u32) -> Self {
+        Self { mul, add, other }
+    }
+
+    /// [`math::sqrtf`]: 3 divisions, 3 multiplications, 3 additions.
+    pub(crate) const SQRT: Self = Self::new(6, 3, 2);
+    /// `libm::logf` (its source: a reduction, one division, a degree-4
+    /// polynomial in `s^2`).
+    pub(crate) const LOG: Self = Self::new(12, 10, 4);
+    /// `libm::expf`, `libm::sinf` (a reduction and a short polynomial).
+    pub(crate) const EXP: Self = Self::new(9, 7, 4);
+    /// `libm::atan2f` (a division and `atanf`'s polynomial).
+    pub(crate) const ATAN2: Self = Self::new(13, 12, 8);
+    /// [`sincos_turns`] (also the canceller's first step).
+    pub(crate) const SINCOS: Self = Self::new(13, 12, 2);
+}
+
+/// Analytical cost per sample of the detector and the margin warning
+/// ([`MarginWarning`], which the sampler runs beside it).
 ///
 /// `worst` is a sample that ends a hop (the whole Goertzel bank runs then) on
-/// which the alert also fires (one more bank over the frequency window);
-/// `average` spreads the hop's work over its samples. Both exclude the
-/// harmonic canceller, which runs on every sample when the speed is known and
-/// costs at most `canceller` more.
+/// which the alert also fires (one more bank over the frequency window), a
+/// kick's ring-down is fitted and the margin re-estimated from it (the most
+/// that can fall on one sample); `average` spreads the hop's work over its
+/// samples, with no kick being measured. Both exclude the harmonic
+/// canceller, which runs on every sample when the speed is known and costs
+/// at most `canceller` more.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Cost {
-    /// A sample on which the bank is evaluated and the alert fires.
+    /// A sample on which the bank is evaluated, the alert fires and a kick
+    /// is reported.
     pub worst: Cost1,
-    /// Average over a hop.
+    /// Average over a hop, no kick being measured (the margin warning's
+    /// per-sample check included).
     pub average: Cost1,
     /// Harmonic canceller, per sample, when the speed is known (worst case).
     pub canceller: Cost1,
     /// Goertzel recursion steps per hop (bins x window).
     pub goertzel_steps_per_hop: u32,
+    /// More per sample while a kick's ring-down is measured (at most 1.95 s
+    /// after each kick).
+    pub ringdown: Cost1,
+    /// Once per kick, on the sample that reports it: the ring-down fit and
+    /// the margin estimate (worst case: [`margin::MAX_KICKS`] kicks and
+    /// every reweighting pass).
+    pub kick: Cost1,
 }
 
 /// Why a [`DetectorConfig`] was rejected.
@@ -462,6 +527,7 @@ impl Params {
 
 #[cfg(test)]
 mod tests {
+    extern crate std;
     use super::*;
 
     #[test]
@@ -530,8 +596,51 @@ mod tests {
     #[test]
     fn cost_of_defaults() {
         let c = DetectorConfig::default().cost().unwrap();
+        std::println!("FIGURES cost: {c:?}");
         assert_eq!(c.goertzel_steps_per_hop, 17 * 40);
-        assert!(c.average.mul < 200 && c.worst.mul < 2200, "{c:?}");
+        assert!(c.average.mul < 200, "{c:?}");
         assert!(c.canceller.mul < 150, "{c:?}");
+        // While a ring is measured: an oscillator and 3 open segments.
+        assert!(c.ringdown.mul > 20 && c.ringdown.mul < 60, "{c:?}");
+        // The worst sample holds the kick-free worst (2 banks, < 2200 mul)
+        // and a kick's work, which is larger.
+        let (ringdown, fit) = ringdown::cost();
+        let (estimate, update) = margin::cost();
+        assert_eq!(c.kick, fit + estimate);
+        let kick_free = c.worst.mul - c.kick.mul - ringdown.mul - update.mul;
+        assert!(kick_free > 2000 && kick_free < 2200, "{c:?}");
+        assert!(c.kick.mul > kick_free, "{c:?}");
+    }
+
+    /// What the detector and the margin warning hold (no allocation):
+    /// `cargo test -p wobble-core --lib memory_of -- --nocapture`.
+    #[test]
+    fn memory_of_the_detector_and_the_margin_warning() {
+        let (d, m) = (
+            core::mem::size_of::<Detector>(),
+            core::mem::size_of::<MarginWarning>(),
+        );
+        std::println!("FIGURES memory: Detector {d} B, MarginWarning {m} B");
+        assert!(d < 4096 && m < 512, "{d} {m}");
+    }
+
+    /// The ring-down fit is three line fits over the segments and a few
+    /// transcendental functions; the margin estimate, [`margin::ITERATIONS`]
+    /// reweighting passes over [`margin::MAX_KICKS`] kicks, dominates.
+    #[test]
+    fn the_kick_costs_scale_with_their_sizes() {
+        let (_, fit) = ringdown::cost();
+        let (estimate, update) = margin::cost();
+        // Per segment and fit at least a logarithm and its weights.
+        let passes = (16 + 15 + 14) as u32;
+        assert!(fit.mul >= passes * (Cost1::LOG.mul + 2), "{fit:?}");
+        assert!(fit.mul < 2 * passes * (Cost1::LOG.mul + 12), "{fit:?}");
+        // Per pass and kick at least a residual, a weight and a line term,
+        // and the median's insertion sort.
+        let (n, k) = (margin::MAX_KICKS as u32, margin::ITERATIONS as u32);
+        assert!(estimate.mul >= k * n * 10, "{estimate:?}");
+        assert!(estimate.other >= k * n * (n - 1) / 2, "{estimate:?}");
+        assert!(estimate.mul > 4 * fit.mul, "{estimate:?} {fit:?}");
+        assert!(update.mul == 0 && update.other <= 4, "{update:?}");
     }
 }

@@ -26,6 +26,7 @@
 //! logarithm; one `atan2` per kick. Memory: about 300 bytes, no allocation.
 
 use super::harmonics::sincos_turns;
+use super::Cost1;
 use crate::format::{quantise_i16, quantise_u16, KickRingDown};
 
 /// The push and the high-pass's answer to it are skipped for this long after
@@ -49,6 +50,28 @@ const MAX_SEGMENT_LEN: usize = 64;
 /// Segments open at once: `SEGMENT_S / STRIDE_S`.
 const OPEN: usize = 3;
 
+/// The standard uncertainty of a kick's sigma ([`Kick::sigma_sd_per_s`]) is
+/// its fit's standard error scaled by this...
+///
+/// The fit takes its Hann segments of 0.3 s every 0.1 s as independent. For
+/// white noise two Hann windows overlapping by two thirds and by one third
+/// correlate by 0.471 and 0.029 (the window's normalised autocorrelation),
+/// which multiplies the variance of a slope fitted through them by about
+/// `1 + 2 (0.471 + 0.029) = 2.0`: a factor of 1.4 on the error. The actual
+/// errors are larger still: the road keeps ringing the mode at its own
+/// frequency and decay through the ring-down, which no fit can tell from
+/// the kick's ring. The host (`wobblog margin`) states the same uncertainty
+/// of a card's kick records from these constants.
+pub const SIGMA_SE_FACTOR: f64 = 3.3;
+/// ... with this (1/s) added in quadrature: an error that no single fit
+/// sees. Both calibrated on the simulated kick campaigns of seeds 100-111
+/// (844 kicks measured by this code, so that the median |error| / SD is the
+/// normal distribution's 0.674 in each fifth of the kicks sorted by their
+/// standard error), and checked on seeds 200-249: 66.0 % of the errors
+/// within one SD and 92.4 % within two; with the fit's own standard error,
+/// 43 % within two (`host-tools/docs/kick-testing.md`).
+pub const SIGMA_SD_FLOOR_PER_S: f64 = 0.0175;
+
 /// A kick's ring-down as the detector measured it.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -62,7 +85,9 @@ pub struct Kick {
     pub freq_hz: f32,
     /// Growth rate of the ring, 1/s (negative: it decays).
     pub sigma_per_s: f32,
-    /// Standard error of `sigma_per_s` from the fit's residuals, 1/s.
+    /// Standard error of `sigma_per_s` from the fit's residuals, 1/s (an
+    /// optimistic one: [`Kick::sigma_sd_per_s`] is the calibrated
+    /// uncertainty).
     pub sigma_se_per_s: f32,
     /// Ring amplitude extrapolated back to the kick, degrees (zero to peak).
     pub amp_deg: f32,
@@ -71,6 +96,16 @@ pub struct Kick {
 }
 
 impl Kick {
+    /// The calibrated standard uncertainty of `sigma_per_s`, 1/s:
+    /// `sqrt((SIGMA_SE_FACTOR se)^2 + SIGMA_SD_FLOOR_PER_S^2)` of the fit's
+    /// standard error `se`.
+    #[must_use]
+    pub fn sigma_sd_per_s(&self) -> f32 {
+        let (k, e0) = (SIGMA_SE_FACTOR as f32, SIGMA_SD_FLOOR_PER_S as f32);
+        let s = k * self.sigma_se_per_s;
+        super::math::sqrtf(s * s + e0 * e0)
+    }
+
     /// The card-log record of this kick, reported on the sample at local
     /// time `now_us` of a detector running at `sample_rate_hz`.
     #[must_use]
@@ -280,7 +315,10 @@ impl RingDown {
         } else if (1.0 - d.abs()).abs() < 1e-3 {
             0.5
         } else {
-            libm::sinf(pd) / (pd * (1.0 - d * d))
+            // sin(pi d) by the detector's own sine of d / 2 turns: libm's
+            // `sinf` would link its large-argument reduction and its 2/pi
+            // table into the firmware for this one value per kick.
+            sincos_turns(0.5 * d).0 / (pd * (1.0 - d * d))
         };
         let amp_deg = libm::expf(l_mean - sigma * t_mean) / gain.max(0.1);
         Some(Kick {
@@ -294,6 +332,37 @@ impl RingDown {
             segments: seg.len() as u8,
         })
     }
+}
+
+/// The measurement's arithmetic (see [`super::Cost`]): per sample while a
+/// ring is measured (on the sample a segment closes), and the fit on the
+/// sample that reports the kick (worst case: [`MAX_SEGMENTS`] segments,
+/// fitted whole and without the first one and two).
+pub(crate) fn cost() -> (Cost1, Cost1) {
+    let open = OPEN as u32;
+    // The oscillator's phase and sincos; per open segment a window and two
+    // products into the sums; the speed's sum; a closing segment's centre,
+    // scale and amplitude.
+    let per_sample =
+        Cost1::SINCOS + Cost1::SQRT + Cost1::new(2 + 3 * open + 6, 1 + 2 * open + 4, 2 * open + 4);
+    // Per segment and line fit: its power, half its logarithm, the three
+    // weighted sums, then the two centred sums and the residual.
+    let segment = Cost1::LOG + Cost1::new(12, 12, 2);
+    // Per line fit: the means, the slope, its standard error and the score.
+    let line = Cost1::SQRT + Cost1::new(8, 0, 2);
+    let n = MAX_SEGMENTS as u32;
+    let trims = MAX_TRIMMED as u32 + 1;
+    let segments = trims * n - trims * (trims - 1) / 2;
+    // The pulse pair over the neighbours, the frequency, the window's gain
+    // (a sine) and the amplitude (an exponential).
+    let pulse_pair = Cost1::new(4, 4, 0);
+    let fit = segment * segments
+        + line * trims
+        + pulse_pair * (n - 1)
+        + Cost1::ATAN2
+        + Cost1::EXP * 2
+        + Cost1::new(13, 4, 10);
+    (per_sample, fit)
 }
 
 /// A weighted straight line through `ln |X_k|` against `t_k`.

@@ -170,9 +170,15 @@ pub enum CloseError {
     Card,
 }
 
+/// The card's file system with room for one volume, directory and file
+/// open at a time: all the logger needs. The board reads `CONFIG.TXT` and
+/// runs the self-test through the same type, so the firmware holds one
+/// copy of embedded-sdmmc's code, not one per set of limits.
+pub type Volumes<D, T> = VolumeManager<D, T, 1, 1, 1>;
+
 /// The logger (see the module docs).
 pub struct CardLogger<'a, D: BlockDevice, T: TimeSource> {
-    fs: VolumeManager<D, T, 1, 1, 1>,
+    fs: Volumes<D, T>,
     header: HeaderSpec<'a>,
     config: LoggerConfig,
     encoder: BlockEncoder,
@@ -209,7 +215,7 @@ impl<'a, D: BlockDevice, T: TimeSource> CardLogger<'a, D, T> {
     /// A logger that will open the card at the first [`Self::poll`].
     pub fn new(device: D, time: T, header: HeaderSpec<'a>, config: LoggerConfig) -> Self {
         Self {
-            fs: VolumeManager::new_with_limits(device, time, 0),
+            fs: Volumes::new_with_limits(device, time, 0),
             header,
             config,
             encoder: BlockEncoder::new(),

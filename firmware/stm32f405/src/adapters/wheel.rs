@@ -47,9 +47,10 @@ const FILTER: FilterValue = FilterValue::FDTS_DIV32_N8;
 /// is latched in hardware, so only the queueing waits.
 const IRQ_PRIORITY: Priority = Priority::P5;
 
-/// IMU data-ready pulses waiting: one per 10 ms frame, seven after the
-/// longest stall; 32 cover 320 ms.
-const PULSE_QUEUE_LEN: usize = 32;
+/// IMU data-ready pulses waiting: one per 10 ms frame, and one per sample
+/// the sensor's FIFO holds after a stall (1.28 s), so that every sample of
+/// such a stall keeps its own time.
+const PULSE_QUEUE_LEN: usize = wobble_core::imu_clock::FIFO_CAPACITY + 8;
 
 /// Capture interrupt -> sampler: wheel edges (channel 1).
 static EDGES: Channel<CriticalSectionRawMutex, RawCapture, EDGE_QUEUE_LEN> = Channel::new();
@@ -112,7 +113,7 @@ pub fn start(pins: WheelPins) -> WheelTimer {
 fn TIM5() {
     let tim = pac::TIM5;
     let sr = tim.sr().read();
-    for (n, queue) in [(0, &EDGES), (1, &PULSES)] {
+    for n in [0, 1] {
         if !sr.ccif(n) {
             continue;
         }
@@ -136,7 +137,13 @@ fn TIM5() {
             }
             tim.sr().write_value(clear);
         }
-        if queue.try_send(raw).is_err() {
+        // The two queues differ in length, hence in type.
+        let sent = if n == 0 {
+            EDGES.try_send(raw)
+        } else {
+            PULSES.try_send(raw)
+        };
+        if sent.is_err() {
             LOST[n].fetch_add(1, Ordering::Relaxed);
         }
     }
@@ -209,10 +216,12 @@ impl DataReadyAdapter {
 impl DataReadyPort for DataReadyAdapter {
     const WIRED: bool = true;
 
-    fn drain_pulses(&mut self, pulse: &mut dyn FnMut(u64)) {
+    fn drain_pulses(&mut self, pulse: &mut dyn FnMut(u64) -> bool) {
         while let Ok(raw) = PULSES.try_receive() {
             if let Ok(t_us) = self.clock.edge_time_us(raw) {
-                pulse(t_us);
+                if !pulse(t_us) {
+                    break;
+                }
             }
         }
     }
