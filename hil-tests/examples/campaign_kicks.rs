@@ -6,7 +6,9 @@
 //! ```text
 //! SEEDS=100..112 cargo run -p wobble-hil --release --example campaign_kicks > kicks.csv
 //! ```
-//! `PUSH=1` rides the campaigns with pushes instead of knocks.
+//! `PUSH=1` rides the campaigns with pushes instead of knocks;
+//! `VARIANTS=unseen` rides the bicycles no calibration was tuned on
+//! (`campaign::unseen_variants`) instead of the four usual ones.
 
 use wobble_core::config::Config;
 use wobble_hil::corpus::signal::WHEEL_CIRCUMFERENCE_M;
@@ -30,7 +32,13 @@ fn main() -> Result<(), String> {
          host_speed_mps,host_sigma_per_s,host_sd_per_s,host_freq_hz,\
          card_speed_mps,card_sigma_per_s,card_se_per_s,card_freq_hz,card_segments"
     );
-    for v in &campaign::variants()? {
+    // VARIANTS=unseen rides the bicycles nothing was tuned on.
+    let variants = if std::env::var("VARIANTS").is_ok_and(|v| v == "unseen") {
+        campaign::unseen_variants()
+    } else {
+        campaign::variants()?
+    };
+    for v in &variants {
         for seed in from..to {
             let c = campaign::simulate(v, &plan, seed)?;
             for pass in &c.passes {

@@ -8,12 +8,13 @@
 //! SEEDS=100..112 cargo run -p wobble-hil --release --example campaign_kicks > kicks.csv
 //! cargo run -p wobble-hil --release --example margin_coverage -- kicks.csv
 //! ```
-//! `VERBOSE=1` prints every campaign.
+//! `VERBOSE=1` prints every campaign; `BEND=-0.04:0.02` adds a line
+//! assuming that curvature (mean:SD, 1/s per (m/s)^2).
 
 use std::collections::BTreeMap;
 
 use wobblog::analysis::campaign_kicks::card_sd;
-use wobblog::analysis::margin::{predict_with, KickPoint, Trend};
+use wobblog::analysis::margin::{predict_bent, BendPrior, KickPoint, Trend};
 
 /// One line of the CSV: the campaign, the truth, and the two measurements.
 struct Line {
@@ -75,6 +76,27 @@ fn parse(text: &str) -> Result<Vec<Line>, String> {
         .collect()
 }
 
+/// `BEND=MEAN:SD[,MEAN:SD...]`: more curvature priors for the line, 1/s
+/// per (m/s)^2.
+fn extra_priors() -> Result<Vec<(String, Trend, BendPrior)>, String> {
+    let Ok(spec) = std::env::var("BEND") else {
+        return Ok(Vec::new());
+    };
+    spec.split(',')
+        .map(|p| {
+            let (mean, sd) = p
+                .split_once(':')
+                .and_then(|(m, s)| Some((m.parse().ok()?, s.parse().ok()?)))
+                .ok_or(format!("BEND: {p} is not MEAN:SD"))?;
+            let prior = BendPrior {
+                mean_per_s_mps2: mean,
+                sd_per_s_mps2: sd,
+            };
+            Ok((format!("line, bend {mean} SD {sd}"), Trend::Line, prior))
+        })
+        .collect()
+}
+
 /// `k` of `n` as a percentage with its binomial standard error.
 fn rate(k: usize, n: usize) -> String {
     let p = k as f64 / n.max(1) as f64;
@@ -123,13 +145,24 @@ fn main() -> Result<(), String> {
         ),
         ("card", |l: &Line| l.card.clone()),
     ] {
-        for trend in [Trend::Line, Trend::Quadratic] {
+        let mut fits = vec![
+            ("line".to_owned(), Trend::Line, BendPrior::DEFAULT),
+            (
+                "line, unsigned bend".to_owned(),
+                Trend::Line,
+                BendPrior::UNSIGNED,
+            ),
+            ("quadratic".to_owned(), Trend::Quadratic, BendPrior::DEFAULT),
+        ];
+        fits.extend(extra_priors()?);
+        for (label, trend, prior) in &fits {
+            let (trend, prior) = (*trend, *prior);
             let (mut covered, mut within5, mut n) = (0, 0, 0);
             let mut errors = Vec::new();
             for ((variant, seed), kicks) in &campaigns {
                 let truth = kicks[0].wobble_speed_mps;
                 let points: Vec<KickPoint> = kicks.iter().filter_map(|l| pick(l)).collect();
-                let m = predict_with(&points, trend);
+                let m = predict_bent(&points, trend, prior);
                 n += 1;
                 let inside =
                     matches!(m.ci95_mps, [Some(lo), Some(hi)] if lo <= truth && truth <= hi);
@@ -139,7 +172,7 @@ fn main() -> Result<(), String> {
                 errors.extend(err);
                 if verbose {
                     println!(
-                        "  {name} {trend:?} {variant} {seed}: true {truth:.3} predicted {:?} ci \
+                        "  {name} {label} {variant} {seed}: true {truth:.3} predicted {:?} ci \
                          {:?} used {} {:?}",
                         m.wobble_speed_mps, m.ci95_mps, m.kicks_used, m.warnings
                     );
@@ -148,7 +181,7 @@ fn main() -> Result<(), String> {
             errors.sort_by(f64::total_cmp);
             let mean = errors.iter().sum::<f64>() / errors.len().max(1) as f64;
             println!(
-                "{name} kicks, {trend:?}: interval covers the truth in {}; within 5 % in {}; \
+                "{name} kicks, {label}: interval covers the truth in {}; within 5 % in {}; \
                  error mean {:+.1} %, range {:+.1} to {:+.1} %",
                 rate(covered, n),
                 rate(within5, n),

@@ -11,7 +11,10 @@ use wobble_hil::corpus::simulated::bike::Bike;
 use wobble_hil::corpus::simulated::campaign::{self, wobble_speed_mps};
 
 fn main() -> Result<(), String> {
-    for v in &campaign::variants()? {
+    // The campaigns' four bicycles, then the two nothing was tuned on.
+    let mut variants = campaign::variants()?;
+    variants.extend(campaign::unseen_variants());
+    for v in &variants {
         let mut bike = Bike::from_set(&v.params()?, 1.0 / FS_HZ)?;
         let w = wobble_speed_mps(&mut bike).ok_or("no wobble speed")?;
         println!("{}: wobble speed {w:.3} m/s", v.name);

@@ -234,14 +234,38 @@ fn margin_predicts_each_bicycle_within_5_percent() {
     assert_eq!(bad, 0, "{table}");
 }
 
+/// Every kick of `c` as the host measures it from each pass's steering
+/// (without the card round trip, to keep it short).
+fn host_points(c: &Campaign) -> Vec<KickPoint> {
+    c.passes
+        .iter()
+        .flat_map(|p| {
+            let rows = wobble_hil::corpus::parse_rows(&p.fixture.csv).unwrap();
+            let run = Run {
+                t_s: rows.iter().map(|r| r.t_s).collect(),
+                steer_deg: rows.iter().map(|r| f64::from(r.steer_deg)).collect(),
+                speed_mps: rows.iter().map(|r| f64::from(r.speed_mps)).collect(),
+                ..Run::default()
+            };
+            find_kicks(&run, WHEEL_CIRCUMFERENCE_M)
+        })
+        .map(|k| KickPoint {
+            speed_mps: k.speed_mps,
+            sigma_per_s: k.sigma_per_s,
+            sigma_sd_per_s: k.sigma_sd_per_s,
+            freq_hz: k.freq_hz,
+        })
+        .collect()
+}
+
 /// Coverage of the 95 % interval and the prediction's error over more
-/// campaigns (3 seeds on each of the four bicycles, kicks measured from
-/// each pass's steering without the card round trip, to keep it short).
-/// Over 48 campaigns (seeds 100-111) the interval covered the truth in 44
-/// (92 ± 4 %), over 200 (seeds 200-249, not tuned on) in 188 (94 ± 2 %),
-/// see `host-tools/docs/kick-testing.md` (`examples/margin_coverage.rs`).
-/// This test guards them: at least 9 of these 12 covered (9 are), none off by
-/// more than 7 %.
+/// campaigns (3 seeds on each of the four bicycles, kicks measured by the
+/// host). Over 48 campaigns (seeds 100-111) the interval covered the truth
+/// in 47 (98 ± 2 %), over 200 not tuned on (seeds 200-249) in 193 (96 ± 1
+/// %), over 200 more (seeds 300-349) in the share
+/// `host-tools/docs/kick-testing.md` gives (`examples/margin_coverage.rs`).
+/// This test guards them: at least 10 of these 12 covered (11 are), none
+/// off by more than 5 % (the worst is 4.4 %).
 #[test]
 fn interval_coverage_and_error_over_seeds() {
     let variants = campaign::variants().unwrap();
@@ -250,27 +274,7 @@ fn interval_coverage_and_error_over_seeds() {
     for v in &variants {
         for seed in 100..103 {
             let c = campaign::simulate(v, &Plan::default(), seed).unwrap();
-            let pts: Vec<KickPoint> = c
-                .passes
-                .iter()
-                .flat_map(|p| {
-                    let rows = wobble_hil::corpus::parse_rows(&p.fixture.csv).unwrap();
-                    let run = Run {
-                        t_s: rows.iter().map(|r| r.t_s).collect(),
-                        steer_deg: rows.iter().map(|r| f64::from(r.steer_deg)).collect(),
-                        speed_mps: rows.iter().map(|r| f64::from(r.speed_mps)).collect(),
-                        ..Run::default()
-                    };
-                    find_kicks(&run, WHEEL_CIRCUMFERENCE_M)
-                })
-                .map(|k| KickPoint {
-                    speed_mps: k.speed_mps,
-                    sigma_per_s: k.sigma_per_s,
-                    sigma_sd_per_s: k.sigma_sd_per_s,
-                    freq_hz: k.freq_hz,
-                })
-                .collect();
-            let m = predict(&pts);
+            let m = predict(&host_points(&c));
             let truth = c.wobble_speed_mps;
             n += 1;
             let inside = matches!(m.ci95_mps, [Some(lo), Some(hi)] if lo <= truth && truth <= hi);
@@ -289,8 +293,33 @@ fn interval_coverage_and_error_over_seeds() {
         "{table}covered {covered} of {n}; worst error {:.1} %",
         100.0 * worst
     );
-    assert!(covered >= 9, "{table}covered {covered} of {n}");
-    assert!(worst <= 0.07, "{table}worst {worst}");
+    assert!(covered >= 10, "{table}covered {covered} of {n}");
+    assert!(worst <= 0.05, "{table}worst {worst}");
+}
+
+/// A bicycle nothing was tuned on (`campaign::unseen_variants`: the
+/// paper's test bicycle re-derived for the model, with its 55 kg rider):
+/// the prediction within 5 % of its wobble speed and the interval holding
+/// it, on two campaigns (over 50, seeds 200-249: 49 within 5 %, 50
+/// covered; `host-tools/docs/kick-testing.md`).
+#[test]
+fn margin_holds_on_a_bicycle_never_tuned_on() {
+    let unseen = campaign::unseen_variants();
+    let v = unseen
+        .iter()
+        .find(|v| v.name == "paper-light-rider")
+        .expect("the unseen bicycle");
+    for seed in 200..202 {
+        let c = campaign::simulate(v, &Plan::default(), seed).unwrap();
+        let m = predict(&host_points(&c));
+        let truth = c.wobble_speed_mps;
+        let w = m.wobble_speed_mps.expect("a prediction");
+        assert!((w / truth - 1.0).abs() <= 0.05, "{seed}: {truth} {m:?}");
+        assert!(
+            matches!(m.ci95_mps, [Some(lo), Some(hi)] if lo <= truth && truth <= hi),
+            "{seed}: {truth} {m:?}"
+        );
+    }
 }
 
 /// `--model`: the test bicycle's file fitted (steering-head stiffness and

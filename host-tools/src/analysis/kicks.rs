@@ -30,6 +30,25 @@
 //!    from the kick's ring, so the residuals do not show it. The stated
 //!    uncertainty is the fit's error calibrated against the truth of the
 //!    simulated campaigns ([`stated_sd`]).
+//!
+//! Why this is not the board's measurement refined (the board's is
+//! `wobble_core::detector::ringdown`, the same physics in `f32`): the two
+//! share only the idea (skip the push, measure a decaying sinusoid in the
+//! wobble band), not a step. The board must decide causally, in one pass,
+//! in 300 bytes: it starts at the impulse detector's trigger (which is held
+//! off for 1 s after every impulse and off during an alert and below
+//! walking speed), skips a fixed 0.15 s, demodulates at a fixed frequency
+//! and fits `ln |X|` of Hann segments it cannot revisit. The host has the
+//! whole record: it finds kicks in a zero-phase band (no group delay, the
+//! push's answer on both sides of it), starts the fit after the envelope's
+//! peak (which the board cannot know when it starts), fits the samples
+//! themselves with a wheel harmonic beside the ring, and corrects sigma's
+//! error for the residuals' colour. Starting from the board's kicks would
+//! lose the kicks it misses (a kick inside another's hold-off, a log
+//! without kick records) and gain nothing the host's own start values
+//! lack: the board's sigma is biased (-0.023 1/s) and its error a third
+//! larger (`host-tools/docs/kick-testing.md`). The board's values are kept
+//! beside the host's instead (`campaign_kicks`).
 
 use std::f64::consts::TAU;
 

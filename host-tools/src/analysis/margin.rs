@@ -4,15 +4,17 @@
 //! rises towards zero as the speed approaches the wobble speed, and the
 //! trend's zero is the prediction.
 //!
-//! - **Trend**: a straight line `sigma = a + b u` ([`Trend::Line`], the
-//!   default) or a quadratic `sigma = a + b u + c u^2`
+//! - **Trend**: a line bent by the model's curvature, `sigma = a + b u +
+//!   (k/2) u^2` with `a`, `b` fitted and `k` fixed ([`Trend::Line`], the
+//!   default), or a quadratic `sigma = a + b u + c u^2` fitted whole
 //!   ([`Trend::Quadratic`]). sigma bends: on the model's bicycles its
 //!   slope falls by about a quarter between half the wobble speed and the
 //!   wobble speed, mostly beyond the kicks, where no fit can see it, so a
-//!   line through kicks at 0.45-0.85 of it crosses zero early. The line's
-//!   interval allows for a bend of the size the model shows, of either
-//!   sign ([`Bend`], [`BEND_SD_PER_S_MPS2`]); a quadratic fitted to the
-//!   kicks extrapolates the small bend it sees within their range and its
+//!   straight line through kicks at 0.45-0.85 of it crosses zero early.
+//!   The line takes the model's concave bend ([`BEND_MEAN_PER_S_MPS2`])
+//!   and its interval allows for a bend that differs from it
+//!   ([`Bend`], [`BEND_SD_PER_S_MPS2`]); a quadratic fitted to the kicks
+//!   extrapolates the small bend it sees within their range and its
 //!   noise, and does worse on the simulated campaigns
 //!   (`host-tools/docs/kick-testing.md`).
 //! - **Fit**: weighted by each kick's uncertainty (`1 / sd^2`) and made
@@ -61,11 +63,12 @@ pub struct KickPoint {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, clap::ValueEnum)]
 #[serde(rename_all = "lowercase")]
 pub enum Trend {
-    /// `sigma = a + b u`, with an allowance for sigma's bend beyond it
-    /// ([`Bend`]).
+    /// `sigma = a + b u + (k/2) u^2`, `a` and `b` fitted, `k` the
+    /// curvature assumed ([`BendPrior`]), with an allowance for a
+    /// different bend beyond the kicks ([`Bend`]).
     #[default]
     Line,
-    /// `sigma = a + b u + c u^2`.
+    /// `sigma = a + b u + c u^2`, all three fitted.
     Quadratic,
 }
 
@@ -98,16 +101,16 @@ pub struct Margin {
     /// The trend fitted.
     pub trend: Trend,
     /// Its coefficients `[a (1/s), b (1/s per m/s), c (1/s per (m/s)^2)]`
-    /// (no `c` for a line), if any.
+    /// (for the line `c` is fixed: half the curvature assumed), if any.
     pub coefficients: Option<Vec<f64>>,
-    /// The fit's covariance of the coefficients (rows), scaled by the
-    /// residuals' variance of unit weight.
+    /// The fit's covariance of the fitted coefficients (rows; `a` and `b`
+    /// for the line), scaled by the residuals' variance of unit weight.
     pub covariance: Option<Vec<Vec<f64>>>,
     /// The residuals' variance of unit weight (chi-square over the degrees
     /// of freedom of the kicks used): about 1 when the kicks scatter as
     /// their uncertainties say.
     pub unit_variance: Option<f64>,
-    /// The allowance for sigma's bend a straight line makes (none for a
+    /// The allowance for sigma's bend the line makes (none for a
     /// quadratic, which fits it).
     pub bend: Option<Bend>,
     /// Degrees of freedom of the t quantile.
@@ -132,21 +135,53 @@ impl Margin {
     }
 }
 
-/// The allowance a straight line makes for sigma's bend: its curvature is
-/// taken as unknown, with standard deviation `sd_per_s_mps2` about zero.
-/// A line fitted by least squares to `a + b u + (k/2) u^2` is off at `u`
-/// by exactly `(k/2) ((u - m)^2 - v)`, `m` and `v` the weighted mean and
-/// variance of the kicks' speeds (the line absorbs the rest), so the
-/// trend's value at `u` is uncertain by that much more: in quadrature,
-/// `(sd/2) |(u - m)^2 - v|`.
+/// The allowance the line makes for sigma's bend: its curvature
+/// `k` is taken as unknown, `prior_per_s_mps2` (the bend the trend is
+/// given, [`BendPrior`]) with standard deviation `sd_per_s_mps2`. A line
+/// fitted by least squares to `a + b u + (d/2) u^2` is off at `u` by
+/// exactly `(d/2) ((u - m)^2 - v)`, `m` and `v` the weighted mean and
+/// variance of the kicks' speeds (the line absorbs the rest); the kicks
+/// are fitted with the prior's bend taken out, so `d` is the curvature's
+/// departure from the prior and the trend's value at `u` is uncertain by
+/// that much more: in quadrature, `(sd/2) |(u - m)^2 - v|`.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Bend {
     /// Weighted mean speed of the kicks used, m/s.
     pub mean_mps: f64,
     /// Weighted variance of their speeds, (m/s)^2.
     pub variance_mps2: f64,
-    /// Standard deviation of the curvature allowed, 1/s per (m/s)^2.
+    /// The curvature the trend is bent by, 1/s per (m/s)^2.
+    pub prior_per_s_mps2: f64,
+    /// Standard deviation of the curvature about it, 1/s per (m/s)^2.
     pub sd_per_s_mps2: f64,
+}
+
+/// What the line assumes about sigma's curvature beyond the kicks:
+/// a curvature `mean_per_s_mps2` (the trend is `a + b u + (mean/2) u^2`,
+/// `a` and `b` fitted), uncertain with standard deviation
+/// `sd_per_s_mps2` ([`Bend`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BendPrior {
+    /// Curvature assumed, 1/s per (m/s)^2.
+    pub mean_per_s_mps2: f64,
+    /// Its standard deviation, 1/s per (m/s)^2.
+    pub sd_per_s_mps2: f64,
+}
+
+impl BendPrior {
+    /// The default: the model's bend ([`BEND_MEAN_PER_S_MPS2`],
+    /// [`BEND_SD_PER_S_MPS2`]).
+    pub const DEFAULT: Self = Self {
+        mean_per_s_mps2: BEND_MEAN_PER_S_MPS2,
+        sd_per_s_mps2: BEND_SD_PER_S_MPS2,
+    };
+    /// No bend assumed, only allowed for, of either sign and the model's
+    /// size: a straight line, as `wobblog margin` fitted it before it used
+    /// the bend's sign.
+    pub const UNSIGNED: Self = Self {
+        mean_per_s_mps2: 0.0,
+        sd_per_s_mps2: -BEND_MEAN_PER_S_MPS2,
+    };
 }
 
 impl Bend {
@@ -177,14 +212,21 @@ const HUBER_K: f64 = 1.345;
 const MIN_SD_PER_S: f64 = 0.02;
 /// IRLS iterations of each stage (each converges in a handful).
 const ITERATIONS: usize = 50;
-/// The curvature a straight line allows sigma, standard deviation, 1/s
-/// per (m/s)^2 (see [`Bend`]). On the wobble model's bicycles of the
-/// simulated campaigns sigma is concave: its slope falls from 0.44, 0.37,
-/// 0.43 and 0.46 1/s per m/s at 0.45 of the wobble speed to 0.34, 0.27,
-/// 0.33 and 0.39 at the wobble speed, a mean curvature of -0.046, -0.037,
-/// -0.044 and -0.037 (`cargo run -p wobble-hil --release --example
-/// wobble_bend`): the allowance is the size of that bend, of either sign.
-pub const BEND_SD_PER_S_MPS2: f64 = 0.04;
+/// The curvature the line is bent by, 1/s per (m/s)^2 (see [`BendPrior`]).
+/// On the wobble model's bicycles of the simulated campaigns sigma is
+/// concave: its slope falls from 0.44, 0.37, 0.43 and 0.46 1/s per m/s at
+/// 0.45 of the wobble speed to 0.34, 0.27, 0.33 and 0.39 at the wobble
+/// speed, a mean curvature of -0.046, -0.037, -0.044 and -0.037 (`cargo
+/// run -p wobble-hil --release --example wobble_bend`), rounded here. It
+/// takes out the bias a straight line has (its zero falls early by about
+/// 2.4 %).
+pub const BEND_MEAN_PER_S_MPS2: f64 = -0.04;
+/// The standard deviation of the curvature about [`BEND_MEAN_PER_S_MPS2`],
+/// 1/s per (m/s)^2 (see [`Bend`]): half its size, so that the allowance
+/// holds a concave bend from none (a straight trend) to twice the model's
+/// at two SD. A convex bend (sigma steepening towards the wobble speed)
+/// is outside it.
+pub const BEND_SD_PER_S_MPS2: f64 = 0.02;
 /// The interval is searched up to this many measured ranges beyond the
 /// fastest kick; an end further out is open.
 const SEARCH_RANGES: f64 = 4.0;
@@ -193,13 +235,13 @@ const SEARCH_RANGES: f64 = 4.0;
 #[must_use]
 pub fn method(trend: Trend) -> String {
     let shape = match trend {
-        Trend::Line => "straight line",
+        Trend::Line => "line",
         Trend::Quadratic => "quadratic",
     };
     let bend = match trend {
         Trend::Line => format!(
-            ", plus a curvature allowance of {BEND_SD_PER_S_MPS2} 1/s per (m/s)^2 (SD) for \
-             sigma's bend"
+            ", the line bent by sigma's curvature on the model's bicycles \
+             ({BEND_MEAN_PER_S_MPS2} 1/s per (m/s)^2, SD {BEND_SD_PER_S_MPS2})"
         ),
         Trend::Quadratic => String::new(),
     };
@@ -476,9 +518,17 @@ pub fn predict(kicks: &[KickPoint]) -> Margin {
     predict_with(kicks, Trend::default())
 }
 
-/// Predicts the wobble speed from `kicks` by fitting `trend`.
+/// Predicts the wobble speed from `kicks` by fitting `trend` (a line with
+/// the default [`BendPrior`]).
 #[must_use]
 pub fn predict_with(kicks: &[KickPoint], trend: Trend) -> Margin {
+    predict_bent(kicks, trend, BendPrior::DEFAULT)
+}
+
+/// Predicts the wobble speed from `kicks` by fitting `trend`, a line
+/// assuming `prior` about sigma's curvature (a quadratic ignores it).
+#[must_use]
+pub fn predict_bent(kicks: &[KickPoint], trend: Trend, prior: BendPrior) -> Margin {
     let usable: Vec<usize> = (0..kicks.len())
         .filter(|&i| {
             let k = &kicks[i];
@@ -515,7 +565,14 @@ pub fn predict_with(kicks: &[KickPoint], trend: Trend) -> Margin {
     let u: Vec<f64> = usable.iter().map(|&i| kicks[i].speed_mps).collect();
     let y: Vec<f64> = usable.iter().map(|&i| kicks[i].sigma_per_s).collect();
     let sd: Vec<f64> = usable.iter().map(|&i| kicks[i].sigma_sd_per_s).collect();
-    let Some(fit) = robust_fit(&u, &y, &sd, trend.terms()) else {
+    // The line is fitted to the kicks with the prior's bend taken out, then
+    // bent back: `c` of `a + b u + c u^2` is fixed at half the curvature.
+    let c_prior = match trend {
+        Trend::Line => 0.5 * prior.mean_per_s_mps2,
+        Trend::Quadratic => 0.0,
+    };
+    let unbent: Vec<f64> = u.iter().zip(&y).map(|(u, y)| y - c_prior * u * u).collect();
+    let Some(fit) = robust_fit(&u, &unbent, &sd, trend.terms()) else {
         out.warnings.push(format!(
             "the kicks' speeds do not spread enough to fit a {}",
             match trend {
@@ -535,7 +592,11 @@ pub fn predict_with(kicks: &[KickPoint], trend: Trend) -> Margin {
         (lo.min(u[k]), hi.max(u[k]))
     });
     out.speed_range_mps = Some([lo_u, hi_u]);
-    out.coefficients = Some(fit.coef.clone());
+    let coef = match trend {
+        Trend::Line => vec![fit.coef[0], fit.coef[1], c_prior],
+        Trend::Quadratic => fit.coef.clone(),
+    };
+    out.coefficients = Some(coef.clone());
     out.covariance = Some(fit.cov.clone());
     out.unit_variance = Some(fit.unit_variance);
     out.dof = used.len().saturating_sub(trend.terms()).max(1);
@@ -559,15 +620,16 @@ pub fn predict_with(kicks: &[KickPoint], trend: Trend) -> Margin {
         out.bend = Some(Bend {
             mean_mps: mean,
             variance_mps2: var_u,
-            sd_per_s_mps2: BEND_SD_PER_S_MPS2,
+            prior_per_s_mps2: prior.mean_per_s_mps2,
+            sd_per_s_mps2: prior.sd_per_s_mps2,
         });
     }
     let bend = out.bend.clone();
     let var = |v: f64| total_variance(&fit.cov, bend.as_ref(), v);
     let span = hi_u - lo_u;
     let cap = hi_u + SEARCH_RANGES * span.max(MIN_SPAN_MPS);
-    let rising = slope(&fit.coef, hi_u);
-    let zero = upward_zero(&fit.coef, lo_u, cap);
+    let rising = slope(&coef, hi_u);
+    let zero = upward_zero(&coef, lo_u, cap);
     let t = t_975(out.dof);
     let step = span.max(MIN_SPAN_MPS) / 400.0;
     let Some(zero) = zero else {
@@ -582,7 +644,7 @@ pub fn predict_with(kicks: &[KickPoint], trend: Trend) -> Margin {
         }
         // What the data still say: the speeds from the fastest kick up at
         // which the trend could be zero.
-        let inside = |v: f64| value(&fit.coef, v).powi(2) <= t * t * var(v);
+        let inside = |v: f64| value(&coef, v).powi(2) <= t * t * var(v);
         out.ci95_mps[0] = (0..=((cap - hi_u) / step) as usize)
             .map(|i| hi_u + step * i as f64)
             .find(|&v| inside(v));
@@ -605,7 +667,7 @@ pub fn predict_with(kicks: &[KickPoint], trend: Trend) -> Margin {
         ));
         open = true;
     }
-    let (lo, hi) = profile_interval(&fit.coef, var, t, zero, (step, cap));
+    let (lo, hi) = profile_interval(&coef, var, t, zero, (step, cap));
     out.ci95_mps = [lo, hi.filter(|_| !open)];
     if hi.is_none() {
         // A trend within its noise puts the zero anywhere beyond the lower
@@ -644,7 +706,7 @@ mod tests {
     }
 
     /// Exact points on a line: both trends give the line's zero, the
-    /// interval tight.
+    /// interval tight (the line assuming no bend).
     #[test]
     fn exact_line_gives_its_zero() {
         let pts: Vec<(f64, f64)> = (0..10)
@@ -654,7 +716,7 @@ mod tests {
             })
             .collect();
         for trend in [Trend::Line, Trend::Quadratic] {
-            let m = predict_with(&kicks(&pts, 0.05), trend);
+            let m = predict_bent(&kicks(&pts, 0.05), trend, BendPrior::UNSIGNED);
             let w = m.wobble_speed_mps.unwrap();
             assert!((w - 4.2).abs() < 1e-6, "{m:?}");
             let [lo, hi] = m.ci95_mps;
@@ -682,6 +744,35 @@ mod tests {
         let line = predict_with(&kicks(&pts, 0.03), Trend::Line);
         let w = line.wobble_speed_mps.unwrap();
         assert!(w < 4.1, "{line:?}");
+    }
+
+    /// Exact points on a trend bent as the prior says, `0.4 (u - 4.2) +
+    /// (k/2) (u - 4.2)^2` with the prior's `k`, at 0.45-0.85 of its zero:
+    /// the default line finds the zero, its coefficients are the trend's,
+    /// and the interval holds it; a line assuming no bend crosses early,
+    /// by the 2-3 % the model's bicycles show.
+    #[test]
+    fn the_prior_bend_takes_out_the_lines_bias() {
+        let (zero, k) = (4.2, BEND_MEAN_PER_S_MPS2);
+        let pts: Vec<(f64, f64)> = (0..18)
+            .map(|i| {
+                let u = zero * (0.45 + 0.4 * f64::from(i / 2) / 8.0);
+                (u, 0.4 * (u - zero) + 0.5 * k * (u - zero).powi(2))
+            })
+            .collect();
+        let m = predict(&kicks(&pts, 0.03));
+        assert!((m.wobble_speed_mps.unwrap() - zero).abs() < 1e-6, "{m:?}");
+        let c = m.coefficients.as_ref().unwrap();
+        // Expanded: a = -0.4 zero + (k/2) zero^2, b = 0.4 - k zero, c = k/2.
+        let want = [-0.4 * zero + 0.5 * k * zero * zero, 0.4 - k * zero, 0.5 * k];
+        for (c, w) in c.iter().zip(want) {
+            assert!((c - w).abs() < 1e-9, "{c} {w}");
+        }
+        assert!(matches!(m.ci95_mps, [Some(lo), Some(hi)] if lo < zero && zero < hi));
+        assert_eq!(m.bend.as_ref().unwrap().prior_per_s_mps2, k);
+        let straight = predict_bent(&kicks(&pts, 0.03), Trend::Line, BendPrior::UNSIGNED);
+        let early = 1.0 - straight.wobble_speed_mps.unwrap() / zero;
+        assert!((0.015..0.04).contains(&early), "{early}");
     }
 
     /// Fieller's closed form for a line `a + b u` with covariance
@@ -773,14 +864,16 @@ mod tests {
     /// The interval's coverage is about its stated 95 % (400 draws: 1.1 %
     /// is one standard error) where its assumptions hold: a quadratic on
     /// a parabola, and the line with its bend allowance on trends whose
-    /// curvature is drawn with the allowance's SD. A line without the
-    /// allowance (an allowance of almost nothing) covers far less.
+    /// curvature is drawn as the prior says (its mean, its SD). A trend
+    /// bent far beyond the allowance is covered far less.
     #[test]
     fn the_interval_covers_at_its_stated_rate() {
         let quadratic = coverage(Trend::Quadratic, || -0.3);
         assert!((0.92..=0.98).contains(&quadratic), "{quadratic}");
         let mut normal = normals(0x9E37_79B9_7F4A_7C15);
-        let line = coverage(Trend::Line, || BEND_SD_PER_S_MPS2 * normal());
+        let line = coverage(Trend::Line, || {
+            BEND_MEAN_PER_S_MPS2 + BEND_SD_PER_S_MPS2 * normal()
+        });
         assert!((0.92..=0.99).contains(&line), "{line}");
         let bent = coverage(Trend::Line, || -0.3);
         assert!(bent < 0.5, "{bent}");

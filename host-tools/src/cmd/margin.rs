@@ -47,8 +47,9 @@ pub struct Args {
     /// `card` (only the card's records) or `host` (only the host's).
     #[arg(long, value_enum, default_value_t = Prefer::Best)]
     pub kicks: Prefer,
-    /// The trend of sigma against speed: `line` (a straight line whose
-    /// interval allows for sigma's bend beyond the kicks) or `quadratic`
+    /// The trend of sigma against speed: `line` (a line bent as sigma bends
+    /// on the model's bicycles, its interval allowing for a different bend
+    /// beyond the kicks) or `quadratic`
     /// (fitted to the kicks alone: worse on the simulated campaigns).
     #[arg(long, value_enum, default_value_t = Trend::Line)]
     pub trend: Trend,
@@ -86,7 +87,8 @@ pub struct Report {
     /// The trend fitted (`quadratic` or `line`).
     pub trend: Trend,
     /// Its coefficients `[a, b, c]` of `sigma = a + b u + c u^2` (1/s,
-    /// speed in m/s; no `c` for a line).
+    /// speed in m/s; for the line `c` is not fitted but half the curvature
+    /// it assumes).
     pub coefficients: Option<Vec<f64>>,
     /// The kicks' scatter about the trend over what their uncertainties
     /// say (variance of unit weight; the interval is widened by it when

@@ -165,7 +165,7 @@ impl Figure for MarginPlot {
                 .draw_series(LineSeries::new(fit, FIT.stroke_width(2)))
                 .map_err(err)?
                 .label(match self.margin.trend {
-                    Trend::Line => "robust straight line",
+                    Trend::Line => "robust line, the model's bend",
                     Trend::Quadratic => "robust quadratic",
                 })
                 .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], FIT.stroke_width(2)));

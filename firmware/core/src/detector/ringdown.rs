@@ -24,6 +24,13 @@
 //! Cost: per sample, while measuring, one oscillator rotation and one
 //! complex multiply-add per open segment (at most 3); per segment, one
 //! logarithm; one `atan2` per kick. Memory: about 300 bytes, no allocation.
+//!
+//! The host's measurement (`wobblog`'s `analysis::kicks`, `f64`) is another
+//! algorithm on purpose, not this one refined: with the whole record it
+//! fits the samples after the envelope's peak in a zero-phase band, which
+//! a causal, one-pass, fixed-memory measurement cannot do; this one is
+//! what the board can afford, and the host keeps its records beside its
+//! own (see there).
 
 use super::harmonics::sincos_turns;
 use super::Cost1;

@@ -110,6 +110,30 @@ pub fn variants() -> Result<Vec<Variant>, String> {
     ])
 }
 
+/// Bicycles no part of the margin method was tuned on (neither the kicks'
+/// uncertainties nor the bend): the paper's test bicycle as re-derived
+/// for the model (`paper-test-bicycle.toml`, a tensed rider's hip, tyres
+/// from the literature, its own head stiffness and damping) and the same
+/// with its 55 kg rider, for judging the prediction on a bicycle never
+/// used for tuning.
+#[must_use]
+pub fn unseen_variants() -> Vec<Variant> {
+    vec![
+        Variant {
+            name: "paper-test-bicycle",
+            description: "the paper's test bicycle as re-derived for the model, 83 kg rider",
+            file: "paper-test-bicycle.toml",
+            changes: Vec::new(),
+        },
+        Variant {
+            name: "paper-light-rider",
+            description: "the paper's test bicycle as re-derived for the model, 55 kg rider",
+            file: "paper-test-bicycle-light-rider.toml",
+            changes: Vec::new(),
+        },
+    ]
+}
+
 /// `section.key` of `set` for each of `keys`, times `factor`.
 fn scaled(
     set: &ParamSet,
