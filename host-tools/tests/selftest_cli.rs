@@ -5,7 +5,7 @@ use std::path::Path;
 
 use assert_cmd::Command;
 use wobble_core::boot::{BorCheck, ResetCause};
-use wobble_core::selftest::{write_report, Measurements};
+use wobble_core::selftest::{write_report, Measurements, PulseTrain};
 
 fn run(path: &Path) -> (Option<i32>, String, String) {
     let out = Command::cargo_bin("wobblog")
@@ -23,6 +23,10 @@ fn run(path: &Path) -> (Option<i32>, String, String) {
 
 #[test]
 fn a_report_is_printed_with_its_failures_named() {
+    let mut data_ready = PulseTrain::default();
+    for k in 0..100u64 {
+        data_ready.pulse(2_000_000 + k * 10_000);
+    }
     let m = Measurements {
         imu_id: Some(0x47),
         accel_g: Some(0.99),
@@ -36,6 +40,7 @@ fn a_report_is_printed_with_its_failures_named() {
         reset: Some(ResetCause::Watchdog),
         bor: Some(BorCheck::Level3),
         stack_bytes: Some((14_000, 86_000)),
+        imu_data_ready: Some(data_ready),
     };
     let mut text = String::new();
     write_report(&m, &mut text).unwrap();
@@ -47,7 +52,7 @@ fn a_report_is_printed_with_its_failures_named() {
     assert_eq!(code, Some(1), "{stderr}");
     assert!(stderr.contains("SELFTEST.TXT: 2 checks failed"), "{stderr}");
     let lines: Vec<&str> = stdout.lines().collect();
-    assert_eq!(lines.len(), 10, "{stdout}");
+    assert_eq!(lines.len(), 11, "{stdout}");
     assert!(
         lines[0].starts_with("imu       pass  who_am_i=0x47"),
         "{stdout}"
@@ -57,6 +62,10 @@ fn a_report_is_printed_with_its_failures_named() {
     assert_eq!(lines[8], "stack     pass  used=14000 of 86000 bytes");
     assert_eq!(
         lines[9],
+        "imu_drdy  pass  pulses=100 period_us=10000 longest_gap_us=10000"
+    );
+    assert_eq!(
+        lines[10],
         "failed: wheel, reset (see firmware/docs/board.md, bring-up)"
     );
     // The input is never touched.

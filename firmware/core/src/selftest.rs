@@ -22,6 +22,7 @@ use embedded_sdmmc::{Block, BlockDevice, BlockIdx};
 
 use crate::boot::{BorCheck, ResetCause};
 use crate::drivers::icm42688::reg::WHO_AM_I_VALUE;
+use crate::imu_clock::NOMINAL_PERIOD_US;
 
 /// How long the rider turns the bar and spins the wheel, µs.
 pub const TEST_WINDOW_US: u64 = 10_000_000;
@@ -44,6 +45,65 @@ const MIN_WHEEL_EDGES: u32 = 50;
 const MIN_CARD_KIB_S: u32 = 100;
 /// An hour of logging is about 11 MB.
 const MIN_FREE_MIB: u32 = 64;
+/// The IMU's data-ready pulses must come at its configured output data
+/// rate ([`NOMINAL_PERIOD_US`]) to within this, in per mille: the sensor's
+/// own oscillator is within a few per cent (the sample clock absorbs that
+/// while riding), a wrong rate is off by a factor.
+const DATA_READY_TOLERANCE_PER_MILLE: u64 = 30;
+/// Pulses at least, over the [`DATA_READY_WINDOW_US`] window (a full second
+/// brings 100).
+const MIN_DATA_READY_PULSES: u32 = 50;
+/// How long the board counts data-ready pulses, µs.
+pub const DATA_READY_WINDOW_US: u64 = 1_000_000;
+
+/// The IMU's data-ready line (INT1) over the self-test's window: the pulses
+/// counted, their first and last time and the longest gap between two, µs
+/// on the MCU clock.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct PulseTrain {
+    /// Pulses seen.
+    pub pulses: u32,
+    /// Time of the first pulse.
+    pub first_us: u64,
+    /// Time of the last pulse.
+    pub last_us: u64,
+    /// Longest time between two consecutive pulses.
+    pub longest_gap_us: u64,
+}
+
+impl PulseTrain {
+    /// Adds the next pulse, at `t_us` (pulses come in order).
+    pub fn pulse(&mut self, t_us: u64) {
+        if self.pulses == 0 {
+            self.first_us = t_us;
+        } else {
+            let gap = t_us.saturating_sub(self.last_us);
+            self.longest_gap_us = self.longest_gap_us.max(gap);
+        }
+        self.last_us = t_us;
+        self.pulses = self.pulses.saturating_add(1);
+    }
+
+    /// The mean time between pulses, µs; `None` with fewer than two.
+    #[must_use]
+    pub fn mean_period_us(&self) -> Option<u64> {
+        let intervals = u64::from(self.pulses.checked_sub(1)?);
+        (intervals > 0).then(|| (self.last_us - self.first_us) / intervals)
+    }
+
+    /// Whether the line pulses at the configured rate: enough pulses, a
+    /// mean period within the tolerance, and no pulse missing (no gap of
+    /// one and a half periods).
+    #[must_use]
+    pub fn at_rate(&self) -> bool {
+        let nominal = u64::from(NOMINAL_PERIOD_US);
+        self.pulses >= MIN_DATA_READY_PULSES
+            && self.mean_period_us().is_some_and(|t| {
+                t.abs_diff(nominal) * 1000 <= nominal * DATA_READY_TOLERANCE_PER_MILLE
+            })
+            && self.longest_gap_us * 2 <= nominal * 3
+    }
+}
 
 /// What the board measured.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -72,6 +132,9 @@ pub struct Measurements {
     pub bor: Option<BorCheck>,
     /// Deepest stack use since power-on, and the stack's size, bytes.
     pub stack_bytes: Option<(u32, u32)>,
+    /// The IMU's data-ready pulses over [`DATA_READY_WINDOW_US`], if
+    /// counted.
+    pub imu_data_ready: Option<PulseTrain>,
 }
 
 /// At most this share of the stack, in percent, may have been used: the
@@ -111,10 +174,12 @@ pub enum Check {
     Bor,
     /// The stack's high-water mark leaves room.
     Stack,
+    /// The IMU's data-ready line pulses at its output data rate.
+    ImuDataReady,
 }
 
 /// Every check, in order.
-pub const CHECKS: [Check; 9] = [
+pub const CHECKS: [Check; 10] = [
     Check::Imu,
     Check::Steering,
     Check::Wheel,
@@ -124,6 +189,7 @@ pub const CHECKS: [Check; 9] = [
     Check::Reset,
     Check::Bor,
     Check::Stack,
+    Check::ImuDataReady,
 ];
 
 impl Check {
@@ -140,6 +206,7 @@ impl Check {
             Self::Reset => "reset",
             Self::Bor => "bor",
             Self::Stack => "stack",
+            Self::ImuDataReady => "imu_drdy",
         }
     }
 
@@ -172,6 +239,7 @@ impl Check {
             Self::Stack => m
                 .stack_bytes
                 .is_some_and(|(used, size)| used * 100 <= size * MAX_STACK_USE_PERCENT),
+            Self::ImuDataReady => m.imu_data_ready.is_some_and(|p| p.at_rate()),
         };
         if pass {
             Verdict::Pass
@@ -234,6 +302,17 @@ impl Check {
             Self::Stack => match m.stack_bytes {
                 None => out.write_str("not measured"),
                 Some((used, size)) => write!(out, "used={used} of {size} bytes"),
+            },
+            Self::ImuDataReady => match m.imu_data_ready {
+                None => out.write_str("not measured"),
+                Some(p) if p.pulses == 0 => out.write_str("no pulses (INT1 to PA1)"),
+                Some(p) => write!(
+                    out,
+                    "pulses={} period_us={} longest_gap_us={}",
+                    p.pulses,
+                    p.mean_period_us().unwrap_or(0),
+                    p.longest_gap_us
+                ),
             },
         }
     }
@@ -377,7 +456,20 @@ mod tests {
             reset: Some(ResetCause::PowerOn),
             bor: Some(BorCheck::Level3),
             stack_bytes: Some((14_000, 86_000)),
+            imu_data_ready: Some(pulses(100, 10_150, 0)),
         }
+    }
+
+    /// `n` pulses `period_us` apart from 5 s on, the one after pulse
+    /// `missing` (if not 0) left out.
+    fn pulses(n: u32, period_us: u64, missing: u32) -> PulseTrain {
+        let mut p = PulseTrain::default();
+        for k in 0..n {
+            if missing == 0 || k != missing {
+                p.pulse(5_000_000 + u64::from(k) * period_us);
+            }
+        }
+        p
     }
 
     #[test]
@@ -390,7 +482,7 @@ mod tests {
     #[test]
     fn each_fault_fails_its_own_check_and_gives_its_code() {
         type Spoil = fn(&mut Measurements);
-        let cases: [(Check, Spoil); 17] = [
+        let cases: [(Check, Spoil); 23] = [
             (Check::Imu, |m| m.imu_id = Some(0x00)),
             (Check::Imu, |m| m.accel_g = Some(0.5)),
             (Check::Imu, |m| m.accel_g = None),
@@ -415,6 +507,26 @@ mod tests {
             }),
             (Check::Stack, |m| m.stack_bytes = Some((43_001, 86_000))),
             (Check::Stack, |m| m.stack_bytes = None),
+            // INT1 not wired, or the sensor not pulsing.
+            (Check::ImuDataReady, |m| {
+                m.imu_data_ready = Some(pulses(0, 0, 0))
+            }),
+            (Check::ImuDataReady, |m| m.imu_data_ready = None),
+            // A sensor at 50 Hz or 200 Hz instead of its 100 Hz.
+            (Check::ImuDataReady, |m| {
+                m.imu_data_ready = Some(pulses(50, 20_000, 0));
+            }),
+            (Check::ImuDataReady, |m| {
+                m.imu_data_ready = Some(pulses(200, 5_000, 0));
+            }),
+            // 4 % fast: outside the 3 % the oscillator may be off.
+            (Check::ImuDataReady, |m| {
+                m.imu_data_ready = Some(pulses(104, 9_600, 0));
+            }),
+            // One pulse missing in the second.
+            (Check::ImuDataReady, |m| {
+                m.imu_data_ready = Some(pulses(100, 10_000, 40));
+            }),
         ];
         for (check, spoil) in cases {
             let mut m = good();
@@ -427,6 +539,43 @@ mod tests {
             let code = CHECKS.iter().position(|&c| c == check).unwrap() as u8 + 1;
             assert_eq!(failure_code(&m), code);
         }
+    }
+
+    #[test]
+    fn a_silent_data_ready_line_is_named_in_the_report() {
+        let m = Measurements {
+            imu_data_ready: Some(PulseTrain::default()),
+            ..good()
+        };
+        let mut text = String::new();
+        write_report(&m, &mut text).unwrap();
+        assert!(
+            text.ends_with("imu_drdy FAIL no pulses (INT1 to PA1)\n"),
+            "{text}"
+        );
+        assert_eq!(failure_code(&m), 10);
+        let m = good();
+        let mut text = String::new();
+        write_report(&m, &mut text).unwrap();
+        assert!(
+            text.ends_with("imu_drdy PASS pulses=100 period_us=10150 longest_gap_us=10150\n"),
+            "{text}"
+        );
+    }
+
+    #[test]
+    fn a_pulse_train_measures_its_period_and_gaps() {
+        let p = pulses(100, 10_000, 40);
+        assert_eq!(p.pulses, 99);
+        assert_eq!(p.longest_gap_us, 20_000);
+        // 99 pulses over 99 periods: 98 intervals of 990 000 / 98 µs.
+        assert_eq!(p.mean_period_us(), Some(10_102));
+        assert!(!p.at_rate());
+        assert!(pulses(100, 10_290, 0).at_rate());
+        assert!(!pulses(100, 10_310, 0).at_rate());
+        assert!(pulses(100, 9_710, 0).at_rate());
+        assert!(!pulses(49, 10_000, 0).at_rate());
+        assert_eq!(pulses(1, 10_000, 0).mean_period_us(), None);
     }
 
     #[test]

@@ -1,5 +1,6 @@
 //! The wobble logger on an STM32F405RG board: brings up the clocks and the
-//! peripherals of `pins.rs`, reads `CONFIG.TXT`, and hands everything to
+//! peripherals of `pins.rs`, reads `CONFIG.TXT` (both through the library's
+//! `assembly`, which on-target tests can call too), and hands everything to
 //! the core's tasks.
 //!
 //! | executor | priority | tasks |
@@ -10,38 +11,32 @@
 #![no_std]
 #![no_main]
 
-use wobble_stm32f405::{adapters, clocks, pins, startup, watchdog};
+use wobble_stm32f405::assembly::{
+    card_and_config, header, marker_held, sampler_parts, Ports, FIRMWARE,
+};
+use wobble_stm32f405::{adapters, clocks, startup, watchdog};
 
 use cortex_m_rt::entry;
 use embassy_executor::{Executor, InterruptExecutor};
-use embassy_stm32::adc::{Adc, AdcChannel, Exten, RingBufferedAdc, SampleTime, CONTINUOUS};
-use embassy_stm32::gpio::{Input, Level, Output, Pull, Speed};
+use embassy_stm32::gpio::{Level, Output, Speed};
 use embassy_stm32::interrupt;
 use embassy_stm32::interrupt::{InterruptExt, Priority};
-use embassy_stm32::peripherals::{ADC1, IWDG};
-use embassy_stm32::spi::Spi;
+use embassy_stm32::peripherals::IWDG;
 use embassy_stm32::Peri;
 use embassy_time::Instant;
 use static_cell::StaticCell;
-use wobble_core::app::sampler::{Sampler, SamplerPorts};
+use wobble_core::app::sampler::Sampler;
 use wobble_core::app::{gps, sampler, writer};
 use wobble_core::boot;
 use wobble_core::channels::{RecordQueue, SharedStatus};
-use wobble_core::config::{self, Config, Loaded, KEY_COUNT, MAX_TEXT_LEN};
+use wobble_core::config;
 use wobble_core::format::Record;
-use wobble_core::frame_assembly::FrameConfig;
-use wobble_core::logger::{CardLogger, FixedTime, HeaderSpec, LoggerConfig, Volumes};
-use wobble_core::steering::Steering;
-use wobble_core::wheel::WheelSpeed;
+use wobble_core::logger::{CardLogger, FixedTime, LoggerConfig};
 use {defmt_rtt as _, panic_probe as _};
 
 use wobble_stm32f405::adapters::card::SdCard;
 use wobble_stm32f405::adapters::gps::GpsAdapter;
-use wobble_stm32f405::adapters::imu::ImuAdapter;
-use wobble_stm32f405::adapters::rider::{AlertPins, MarkerButton, StatusLight};
-use wobble_stm32f405::adapters::steering::SteeringAdapter;
-use wobble_stm32f405::adapters::wheel::WheelAdapter;
-use wobble_stm32f405::pins::{Board, Irqs};
+use wobble_stm32f405::pins::Board;
 
 /// Records from the sampler and the GPS task to the SD writer.
 static QUEUE: RecordQueue = RecordQueue::new();
@@ -51,19 +46,6 @@ static SHARED: SharedStatus = SharedStatus::new();
 static EXECUTOR_HIGH: InterruptExecutor = InterruptExecutor::new();
 static EXECUTOR_MEDIUM: InterruptExecutor = InterruptExecutor::new();
 static EXECUTOR_THREAD: StaticCell<Executor> = StaticCell::new();
-
-/// The configuration in force as text, and its lines for the log header.
-static CONFIG_TEXT: StaticCell<heapless::String<MAX_TEXT_LEN>> = StaticCell::new();
-static CONFIG_LINES: StaticCell<heapless::Vec<&'static str, KEY_COUNT>> = StaticCell::new();
-
-const FIRMWARE: &str = concat!(env!("CARGO_PKG_NAME"), " ", env!("CARGO_PKG_VERSION"));
-/// 100 Hz, from the sampler's period.
-const FRAME_RATE_HZ: u16 = (1_000_000 / sampler::FRAME_PERIOD_US) as u16;
-/// Room for `CONFIG.TXT` (on the stack, at boot only): about 100 lines.
-const CONFIG_FILE_BYTES: usize = 4096;
-
-type Ports =
-    SamplerPorts<ImuAdapter, SteeringAdapter, WheelAdapter, MarkerButton, AlertPins, StatusLight>;
 
 #[interrupt]
 unsafe fn UART4() {
@@ -193,107 +175,6 @@ fn main() -> ! {
         thread.spawn(defmt::unwrap!(writer_task(logger)));
         thread.spawn(defmt::unwrap!(watchdog_task(watchdog)));
     })
-}
-
-/// Whether the marker button is held at power-on: the rider asks for the
-/// field self-test instead of a ride.
-fn marker_held(board: &mut Board) -> bool {
-    let button = Input::new(board.rider.marker.reborrow(), Pull::Up);
-    // Let the pull-up charge the line before reading it.
-    embassy_time::block_for(embassy_time::Duration::from_millis(20));
-    button.is_low()
-}
-
-/// Opens the card and reads `CONFIG.TXT` (defaults without a card).
-fn card_and_config(pins: pins::CardPins) -> (SdCard, Loaded) {
-    let bus = Spi::new_blocking(
-        pins.spi,
-        pins.sck,
-        pins.mosi,
-        pins.miso,
-        adapters::card::spi_config(wobble_core::drivers::sdcard::IDENTIFICATION_CLOCK_HZ),
-    );
-    let cs = Output::new(pins.cs, Level::High, Speed::VeryHigh);
-    let volumes = Volumes::new_with_limits(adapters::card::card(bus, cs), FixedTime::EPOCH, 0);
-    let mut file = [0u8; CONFIG_FILE_BYTES];
-    let (loaded, source) = config::load(&volumes, &mut file);
-    defmt::info!("config: {}, {} faults", source, loaded.faults.first().len());
-    for fault in loaded.faults.first() {
-        defmt::warn!("CONFIG.TXT line {}: fault {}", fault.line, fault.code);
-    }
-    let (card, _) = volumes.free();
-    (card, loaded)
-}
-
-/// The header of every log file: identity and the configuration in force.
-fn header(config: &Config) -> HeaderSpec<'static> {
-    let text = CONFIG_TEXT.init(heapless::String::new());
-    if config.write_lines(text).is_err() {
-        defmt::warn!("config text cut at {} bytes", MAX_TEXT_LEN);
-    }
-    let text: &'static heapless::String<MAX_TEXT_LEN> = text;
-    let lines = CONFIG_LINES.init(text.lines().take(KEY_COUNT).collect());
-    HeaderSpec {
-        firmware: FIRMWARE,
-        device_id: embassy_stm32::uid::uid(),
-        sample_rate_hz: FRAME_RATE_HZ,
-        config: lines,
-    }
-}
-
-/// The sensors, rider I/O and the sampler's state.
-fn sampler_parts(
-    imu: pins::ImuPins,
-    steering: pins::SteeringPins,
-    rider: pins::RiderPins,
-    config: &Config,
-) -> (Sampler, Ports) {
-    let imu = adapters::imu::port(imu, config.imu);
-
-    let steering = SteeringAdapter::new(
-        steering_adc(steering.adc, steering.wiper, steering.dma),
-        defmt::unwrap!(Steering::try_new(config.steering).ok()),
-    );
-
-    let ports = SamplerPorts {
-        imu,
-        steering,
-        wheel: WheelAdapter::default(),
-        marker: MarkerButton(Input::new(rider.marker, Pull::Up)),
-        alert: AlertPins {
-            buzzer: Output::new(rider.buzzer, Level::Low, Speed::Low),
-            led: Output::new(rider.alert_led, Level::Low, Speed::Low),
-            enabled: config.alert.enabled,
-        },
-        status_led: StatusLight {
-            led: Output::new(rider.status_led, Level::Low, Speed::Low),
-            frames: 0,
-        },
-    };
-    let sampler = Sampler::new(
-        defmt::unwrap!(WheelSpeed::try_new(config.wheel).ok()),
-        FrameConfig::DEFAULT,
-        defmt::unwrap!(config.detector().ok()),
-        config.alert,
-    );
-    (sampler, ports)
-}
-
-/// ADC1 converting the wiper continuously into a DMA ring, the slowest
-/// sample time (480 cycles) for the pot's source impedance.
-fn steering_adc(
-    adc: Peri<'static, ADC1>,
-    wiper: Peri<'static, embassy_stm32::peripherals::PC0>,
-    dma: Peri<'static, embassy_stm32::peripherals::DMA2_CH4>,
-) -> RingBufferedAdc<'static, ADC1> {
-    Adc::new(adc).into_ring_buffered(
-        dma,
-        adapters::steering::ring(),
-        Irqs,
-        [(wiper.degrade_adc(), SampleTime::CYCLES480)].into_iter(),
-        CONTINUOUS,
-        Exten::DISABLED,
-    )
 }
 
 #[embassy_executor::task]

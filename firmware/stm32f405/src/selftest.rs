@@ -7,7 +7,8 @@
 //! the wheel (10 s); the GPS bring-up runs meanwhile. Then: all passed,
 //! green LED on and one long beep; a failure, the red LED and the buzzer
 //! repeat the failing check's number (1 IMU, 2 steering, 3 wheel, 4 GPS,
-//! 5 card, 6 clock, 7 reset, 8 brown-out level, 9 stack) until power-off.
+//! 5 card, 6 clock, 7 reset, 8 brown-out level, 9 stack, 10 IMU data-ready
+//! line) until power-off.
 //! The brown-out level is programmed here when it is below 2.7 V (never at
 //! boot): the check fails until a power cycle and a second self-test show
 //! the stored level.
@@ -17,17 +18,18 @@ use embassy_stm32::gpio::Output;
 use embassy_time::{Duration, Instant, Ticker, Timer};
 use embedded_sdmmc::{Mode, VolumeIdx};
 use wobble_core::app::gps_setup;
-use wobble_core::app::ports::{ImuPort, SteeringPort, WheelPort};
+use wobble_core::app::ports::{DataReadyPort, ImuPort, SteeringPort, WheelPort};
 use wobble_core::boot::ResetCause;
 use wobble_core::detector::math::sqrtf;
 use wobble_core::logger::{FixedTime, Volumes};
 use wobble_core::selftest::{
-    failure_code, fat32_free_mib, write_report, Measurements, TEST_WINDOW_US,
+    failure_code, fat32_free_mib, write_report, Measurements, PulseTrain, DATA_READY_WINDOW_US,
+    TEST_WINDOW_US,
 };
 
 use crate::adapters::card::SdCard;
 use crate::adapters::gps::GpsAdapter;
-use crate::adapters::imu::ImuAdapter;
+use crate::adapters::imu::{DataReadyAdapter, ImuAdapter};
 use crate::adapters::steering::SteeringAdapter;
 use crate::adapters::wheel::WheelAdapter;
 
@@ -73,6 +75,28 @@ async fn imu_at_rest(imu: &mut ImuAdapter) -> Option<f32> {
         }
     }
     (n > 0).then(|| sum / n as f32)
+}
+
+/// The IMU's data-ready pulses (INT1, captured by TIM5 channel 2) over
+/// [`DATA_READY_WINDOW_US`], after the port has set the sensor up. The port
+/// does not read meanwhile, so a second adapter on the same capture queue
+/// sees every pulse; the pass/fail rule is the core's
+/// (`PulseTrain::at_rate`).
+async fn data_ready_pulses() -> PulseTrain {
+    let mut line = DataReadyAdapter::default();
+    // What the port left in the queue is older than the window.
+    line.drain_pulses(&mut |_| true);
+    let mut train = PulseTrain::default();
+    let mut ticker = Ticker::every(Duration::from_millis(10));
+    let end = Instant::now() + Duration::from_micros(DATA_READY_WINDOW_US);
+    while Instant::now() < end {
+        ticker.next().await;
+        line.drain_pulses(&mut |t| {
+            train.pulse(t);
+            true
+        });
+    }
+    train
 }
 
 /// Steering range and wheel edges over the test window, status LED
@@ -187,6 +211,7 @@ pub async fn run(p: Parts) -> ! {
     // Raw, so the report names a wrong part by its identity.
     m.imu_id = imu.identity().await;
     m.accel_g = imu_at_rest(&mut imu).await;
+    m.imu_data_ready = Some(data_ready_pulses().await);
     let (outcome, ()) = join(
         gps_setup::run(&mut gps, &mut |step| defmt::info!("GPS set-up: {}", step)),
         sensors(&mut steering, &mut wheel, &mut status_led, &mut m),
@@ -201,7 +226,7 @@ pub async fn run(p: Parts) -> ! {
     let volumes = Volumes::new_with_limits(card, FixedTime::EPOCH, 0);
     m.card_free_mib = volumes.device(|card| fat32_free_mib(card)).unwrap_or(0);
     m.card_kib_s = card_speed(&volumes);
-    let mut text = heapless::String::<512>::new();
+    let mut text = heapless::String::<640>::new();
     if write_report(&m, &mut text).is_err() {
         defmt::warn!("self-test report cut short");
     }
