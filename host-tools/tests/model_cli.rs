@@ -163,6 +163,92 @@ fn plot_and_sweep_draw_figures_and_print_critical_speeds() {
         .contains("front_tyre.no_such: no such parameter"));
 }
 
+/// Every two-point `<polyline>` of `svg` drawn level at one height, as
+/// (height, stroke width, left end, right end).
+fn level_segments(svg: &str) -> Vec<(i32, u32, i32, i32)> {
+    let attr = |el: &str, name: &str| -> Option<String> {
+        let from = el.find(&format!("{name}=\""))? + name.len() + 2;
+        Some(el[from..from + el[from..].find('"')?].to_string())
+    };
+    svg.split("<polyline")
+        .skip(1)
+        .filter_map(|el| {
+            let width = attr(el, "stroke-width")?.parse().ok()?;
+            let points: Vec<(i32, i32)> = attr(el, "points")?
+                .split_whitespace()
+                .map(|p| {
+                    let (x, y) = p.split_once(',').unwrap();
+                    (x.parse().unwrap(), y.parse().unwrap())
+                })
+                .collect();
+            match points[..] {
+                [(x0, y0), (x1, y1)] if y0 == y1 => Some((y0, width, x0, x1)),
+                _ => None,
+            }
+        })
+        .collect()
+}
+
+#[test]
+fn sweep_key_draws_each_factors_swatch_as_its_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let fig = dir.path().join("fig7.svg");
+    model("sweep", "test-bicycle.toml")
+        .args([
+            "--param",
+            "front_tyre.cornering_stiffness",
+            "--factors",
+            "0.5,1,2",
+            "--speeds",
+            "0:8:0.5",
+            "-o",
+        ])
+        .arg(&fig)
+        .assert()
+        .success();
+    let svg = std::fs::read_to_string(&fig).unwrap();
+    // The key's frame is the last rectangle before its first entry; the
+    // swatches are the level segments inside it.
+    let first = svg.find("wobble (x 0.5)").expect("the key");
+    let frame = &svg[svg[..first].rfind("<rect").unwrap()..first];
+    let number = |name: &str| -> i32 {
+        let at = frame.find(&format!(" {name}=\"")).unwrap() + name.len() + 3;
+        frame[at..at + frame[at..].find('"').unwrap()]
+            .parse()
+            .unwrap()
+    };
+    let (left, top) = (number("x"), number("y"));
+    let (right, bottom) = (left + number("width"), top + number("height"));
+    let mut rows: Vec<(i32, Vec<(u32, i32)>)> = Vec::new();
+    for (y, width, x0, x1) in level_segments(&svg[first..]) {
+        if x0 < left || x1 > right || y < top || y > bottom {
+            continue;
+        }
+        match rows.iter_mut().find(|(row, _)| *row == y) {
+            Some((_, segs)) => segs.push((width, x1 - x0)),
+            None => rows.push((y, vec![(width, x1 - x0)])),
+        }
+    }
+    rows.sort_by_key(|(y, _)| *y);
+    let swatches: Vec<_> = rows.into_iter().map(|(_, segs)| segs).collect();
+    assert_eq!(swatches.len(), 6, "{swatches:?}");
+    // Entries in the order of the factors, wobble then weave for each:
+    // x 0.5 thin and solid, x 1 thick and solid, x 2 dotted.
+    for pair in &swatches[0..2] {
+        assert_eq!(pair, &vec![(1, 24)], "{swatches:?}");
+    }
+    for pair in &swatches[2..4] {
+        assert_eq!(pair, &vec![(3, 24)], "{swatches:?}");
+    }
+    for dots in &swatches[4..6] {
+        assert!(dots.len() >= 4, "{swatches:?}");
+        assert!(
+            dots.iter().all(|&(w, len)| w == 2 && len <= 3),
+            "{swatches:?}"
+        );
+    }
+}
+
 #[test]
 fn compare_prints_residuals_and_fit_writes_the_fitted_file() {
     let dir = tempfile::tempdir().unwrap();
