@@ -3,6 +3,7 @@
 
 use std::io::{Read, Seek, SeekFrom, Write};
 
+use embedded_sdmmc::{Mode, VolumeIdx, VolumeManager};
 use proptest::prelude::*;
 use wobble_core::format::{
     Decoder, Dropout, DropoutReason, Event, FaultSource, Frame, FrameStatus, Record,
@@ -168,6 +169,28 @@ fn fresh_card_gets_run_one_with_header_then_every_frame() {
     assert_eq!(d.frames, expected);
     assert!(d.dropouts.is_empty() && d.card_faults.is_empty());
     assert_eq!(log.stats().frames_lost, 0);
+}
+
+#[test]
+fn a_closed_log_reads_back_through_a_new_file_system_on_the_same_card() {
+    let mut log = logger(MockCard::new(fat32_image()));
+    run(&mut log, 0, 700);
+    log.close(700 * FRAME_PERIOD_US).expect("close");
+    let volumes = VolumeManager::new(log.into_device(), FixedTime::EPOCH);
+    let volume = volumes.open_volume(VolumeIdx(0)).expect("volume");
+    let root = volume.open_root_dir().expect("root");
+    let file = root
+        .open_file_in_dir("RUN00001.WBL", Mode::ReadOnly)
+        .expect("log file");
+    let mut data = vec![0u8; file.length() as usize];
+    let mut read = 0;
+    while read < data.len() {
+        read += file.read(&mut data[read..]).expect("read");
+    }
+    let d = decode(&data);
+    assert!(d.first_is_info);
+    let expected: Vec<u64> = (0..700).map(|i| i * FRAME_PERIOD_US).collect();
+    assert_eq!(d.frames, expected);
 }
 
 #[test]

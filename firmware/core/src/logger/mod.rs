@@ -247,6 +247,12 @@ impl<'a, D: BlockDevice, T: TimeSource> CardLogger<'a, D, T> {
         self.fs.device(f)
     }
 
+    /// The block device back, for a new file system on the same card once
+    /// the log is closed (the on-target smoke test reads its log this way).
+    pub fn into_device(self) -> D {
+        self.fs.free().0
+    }
+
     /// Logs one record at local time `now_us`. Without a card, frames are
     /// counted as lost, and so are the frames a dropout record (the queue's)
     /// reports; other records are dropped.

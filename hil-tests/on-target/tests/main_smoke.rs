@@ -1,0 +1,218 @@
+//! A smoke test of the assembled logger: the board brought up and the
+//! card, `CONFIG.TXT`, log header, sampler and GPS built by the library's
+//! `assembly` exactly as `main.rs` builds them, the sampler on an interrupt
+//! executor above the card writer in thread mode, as in `main.rs`. After
+//! 5 s of frames the writer closes the log through its own close path; the
+//! card is then opened again through a new file system on the same device
+//! (`CardLogger::into_device`) and the log is decoded with the core's
+//! decoder: a header naming this firmware and board, the configuration in
+//! force, and every frame of the run, 10 ms apart, in blocks with no gap.
+//!
+//! Run: `cargo test -p wobble-on-target --target thumbv7em-none-eabihf
+//! --test main_smoke` with a FAT32 card in the socket (it gets a new
+//! `RUNnnnnn.WBL`, as a ride would) and the IMU fitted; a GPS receiver is
+//! not needed.
+#![no_std]
+#![no_main]
+
+use defmt_rtt as _;
+
+#[cfg(test)]
+#[embedded_test::tests]
+mod tests {
+    use core::fmt::Write;
+
+    use embassy_executor::InterruptExecutor;
+    use embassy_stm32::interrupt;
+    use embassy_stm32::interrupt::{InterruptExt, Priority};
+    use embassy_time::Instant;
+    use embedded_sdmmc::{Mode, VolumeIdx};
+    use wobble_core::app::sampler::{self, Sampler, FRAME_PERIOD_US};
+    use wobble_core::app::{gps, writer};
+    use wobble_core::channels::{RecordQueue, SharedStatus};
+    use wobble_core::format::{Decoder, Event, Record, BLOCK_LEN};
+    use wobble_core::logger::{
+        CardLogger, FixedTime, HeaderSpec, LoggerConfig, LoggerState, Volumes,
+    };
+    use wobble_stm32f405::adapters;
+    use wobble_stm32f405::adapters::gps::GpsAdapter;
+    use wobble_stm32f405::assembly::{card_and_config, header, sampler_parts, Ports};
+
+    /// 5 s of frames at 100 Hz.
+    const FRAMES: u32 = 500;
+
+    static QUEUE: RecordQueue = RecordQueue::new();
+    static SHARED: SharedStatus = SharedStatus::new();
+    static EXECUTOR_HIGH: InterruptExecutor = InterruptExecutor::new();
+    static EXECUTOR_MEDIUM: InterruptExecutor = InterruptExecutor::new();
+
+    #[interrupt]
+    unsafe fn UART4() {
+        // SAFETY: the vector belongs to this executor alone, as in main.
+        unsafe { EXECUTOR_HIGH.on_interrupt() }
+    }
+
+    #[interrupt]
+    unsafe fn UART5() {
+        // SAFETY: the vector belongs to this executor alone, as in main.
+        unsafe { EXECUTOR_MEDIUM.on_interrupt() }
+    }
+
+    /// The sampler for `FRAMES` frames, then the end of the ride.
+    #[embassy_executor::task]
+    async fn sampler_task(mut sampler: Sampler, mut ports: Ports) {
+        ports.imu.start().await;
+        sampler::run(
+            &mut sampler,
+            &mut ports,
+            &QUEUE,
+            &SHARED,
+            FRAMES,
+            &mut |_, _| {},
+        )
+        .await;
+        SHARED.request_stop();
+    }
+
+    #[embassy_executor::task]
+    async fn gps_task(mut port: GpsAdapter) {
+        gps::run_link(&mut port, &QUEUE, &SHARED, &mut |_| {}).await;
+    }
+
+    /// What the log holds, as the decoder reads it.
+    #[derive(Default)]
+    struct Log {
+        records: u32,
+        /// Whether the first record is the log info, and whether it names
+        /// this firmware, board, rate and run.
+        info: Option<(bool, bool)>,
+        channels: u32,
+        config_lines: usize,
+        config_wrong: u32,
+        frames: u32,
+        /// Frames not 10 ms after the one before.
+        frame_steps_off: u32,
+        last_frame_us: Option<u64>,
+        dropouts: u32,
+        /// Gaps, skipped bytes, bad records, impossible values, time jumps.
+        anomalies: u32,
+    }
+
+    impl Log {
+        fn see(&mut self, event: Event<'_>, spec: &HeaderSpec<'_>, run: u32) {
+            let Event::Record(record) = event else {
+                self.anomalies += 1;
+                return;
+            };
+            let first = self.records == 0;
+            self.records += 1;
+            match record {
+                Record::LogInfo(info) => {
+                    let names_us = info.firmware == spec.firmware
+                        && info.device_id == spec.device_id
+                        && info.sample_rate_hz == spec.sample_rate_hz
+                        && info.run == run;
+                    self.info = Some((first, names_us));
+                }
+                Record::Channel(_) => self.channels += 1,
+                Record::Config(line) => {
+                    if spec.config.get(self.config_lines) != Some(&line.text) {
+                        self.config_wrong += 1;
+                    }
+                    self.config_lines += 1;
+                }
+                Record::Frame(frame) => {
+                    if self
+                        .last_frame_us
+                        .is_some_and(|last| frame.t_us != last + FRAME_PERIOD_US)
+                    {
+                        self.frame_steps_off += 1;
+                    }
+                    self.last_frame_us = Some(frame.t_us);
+                    self.frames += 1;
+                }
+                Record::Dropout(_) => self.dropouts += 1,
+                _ => {}
+            }
+        }
+    }
+
+    #[test]
+    #[timeout(60)]
+    async fn the_assembled_logger_writes_a_log_that_closes_and_decodes() {
+        let (board, _) = wobble_on_target::board();
+        let (card, loaded) = card_and_config(board.card);
+        let config = loaded.config;
+        for fault in loaded.faults.records(Instant::now().as_micros()) {
+            QUEUE.push(Record::Fault(fault));
+        }
+        let spec = header(&config);
+        let mut logger = CardLogger::new(card, FixedTime::EPOCH, spec, LoggerConfig::DEFAULT);
+        // The writer's first poll, here, to learn the run number it opens.
+        logger.poll(Instant::now().as_micros());
+        let LoggerState::Logging { run } = logger.state() else {
+            defmt::panic!("no log file opened: is a FAT32 card in the socket?");
+        };
+        let _wheel_timer = adapters::wheel::start(board.wheel);
+        let (sampler, ports) = sampler_parts(board.imu, board.steering, board.rider, &config);
+
+        interrupt::UART4.set_priority(Priority::P6);
+        let high = EXECUTOR_HIGH.start(interrupt::UART4);
+        high.spawn(defmt::unwrap!(sampler_task(sampler, ports)));
+        interrupt::UART5.set_priority(Priority::P7);
+        let medium = EXECUTOR_MEDIUM.start(interrupt::UART5);
+        medium.spawn(defmt::unwrap!(gps_task(GpsAdapter::new(board.gps))));
+
+        // Returns once the sampler has asked it to stop and the log is closed.
+        defmt::unwrap!(writer::run(&mut logger, &QUEUE, &SHARED).await);
+        let stats = logger.stats();
+        defmt::info!("run {}: {}", run, stats);
+        defmt::assert_eq!(stats.files_opened, 1);
+        defmt::assert_eq!(stats.frames_lost, 0);
+        defmt::assert_eq!(stats.frames_on_card, FRAMES);
+
+        let volumes = Volumes::new_with_limits(logger.into_device(), FixedTime::EPOCH, 0);
+        let volume = defmt::unwrap!(volumes.open_volume(VolumeIdx(0)).ok());
+        let root = defmt::unwrap!(volume.open_root_dir().ok());
+        let mut name: heapless::String<12> = heapless::String::new();
+        defmt::unwrap!(write!(name, "RUN{run:05}.WBL").ok());
+        let file = defmt::unwrap!(root.open_file_in_dir(name.as_str(), Mode::ReadOnly).ok());
+        defmt::assert_eq!(file.length() % BLOCK_LEN as u32, 0, "whole blocks");
+
+        let mut log = Log::default();
+        let mut decoder = Decoder::new();
+        let mut buf = [0u8; 2 * BLOCK_LEN];
+        let mut held = 0;
+        loop {
+            held += defmt::unwrap!(file.read(&mut buf[held..]).ok());
+            let at_end = file.is_eof();
+            let used = decoder.feed(&buf[..held], at_end, &mut |event| {
+                log.see(event, &spec, run);
+            });
+            buf.copy_within(used..held, 0);
+            held -= used;
+            if at_end {
+                break;
+            }
+            defmt::assert!(held < buf.len(), "the decoder consumed nothing");
+        }
+        let decoded = decoder.stats();
+        defmt::info!("{}: {}", name.as_str(), decoded);
+
+        defmt::assert_eq!(
+            log.info,
+            Some((true, true)),
+            "log info first, naming this run"
+        );
+        defmt::assert!(log.channels > 0, "no channel definitions");
+        defmt::assert_eq!(log.config_lines, spec.config.len());
+        defmt::assert_eq!(log.config_wrong, 0);
+        defmt::assert_eq!(log.frames, FRAMES);
+        defmt::assert_eq!(log.frame_steps_off, 0);
+        defmt::assert_eq!(log.dropouts, 0);
+        defmt::assert_eq!(log.anomalies, 0);
+        defmt::assert_eq!(decoded.blocks_lost, 0);
+        defmt::assert_eq!(decoded.out_of_order_blocks, 0);
+        defmt::assert_eq!(decoded.damaged_blocks, 0);
+    }
+}
