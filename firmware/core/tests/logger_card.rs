@@ -176,6 +176,7 @@ fn a_closed_log_reads_back_through_a_new_file_system_on_the_same_card() {
     let mut log = logger(MockCard::new(fat32_image()));
     run(&mut log, 0, 700);
     log.close(700 * FRAME_PERIOD_US).expect("close");
+    assert_eq!(log.stats().frames_on_card, 700);
     let volumes = VolumeManager::new(log.into_device(), FixedTime::EPOCH);
     let volume = volumes.open_volume(VolumeIdx(0)).expect("volume");
     let root = volume.open_root_dir().expect("root");
