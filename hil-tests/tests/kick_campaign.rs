@@ -199,12 +199,7 @@ fn points(l: &Loaded) -> Vec<KickPoint> {
     l.runs
         .iter()
         .flat_map(|run| campaign_kicks(run, WHEEL_CIRCUMFERENCE_M, Prefer::Best))
-        .map(|k| KickPoint {
-            speed_mps: k.speed_mps,
-            sigma_per_s: k.sigma_per_s,
-            sigma_sd_per_s: k.sigma_sd_per_s,
-            freq_hz: k.freq_hz,
-        })
+        .map(|k| KickPoint::from(&k))
         .collect()
 }
 
@@ -249,12 +244,7 @@ fn host_points(c: &Campaign) -> Vec<KickPoint> {
             };
             find_kicks(&run, WHEEL_CIRCUMFERENCE_M)
         })
-        .map(|k| KickPoint {
-            speed_mps: k.speed_mps,
-            sigma_per_s: k.sigma_per_s,
-            sigma_sd_per_s: k.sigma_sd_per_s,
-            freq_hz: k.freq_hz,
-        })
+        .map(|k| KickPoint::from(&k))
         .collect()
 }
 

@@ -121,6 +121,21 @@ fn corpus_log(dir: &Path, name: &str) -> PathBuf {
     log
 }
 
+/// `model sweep` of the test bicycle's front cornering stiffness at x 0.5,
+/// 1 and 2, over `speeds`.
+fn cornering_sweep(speeds: &str) -> Command {
+    let mut cmd = model("sweep", "test-bicycle.toml");
+    cmd.args([
+        "--param",
+        "front_tyre.cornering_stiffness",
+        "--factors",
+        "0.5,1,2",
+        "--speeds",
+        speeds,
+    ]);
+    cmd
+}
+
 #[test]
 fn plot_and_sweep_draw_figures_and_print_critical_speeds() {
     let dir = tempfile::tempdir().unwrap();
@@ -131,17 +146,7 @@ fn plot_and_sweep_draw_figures_and_print_critical_speeds() {
         .assert()
         .success();
     assert!(std::fs::read(&fig).unwrap().starts_with(b"\x89PNG"));
-    let out = model("sweep", "test-bicycle.toml")
-        .args([
-            "--param",
-            "front_tyre.cornering_stiffness",
-            "--factors",
-            "0.5,1,2",
-            "--speeds",
-            "0:8:0.25",
-        ])
-        .output()
-        .unwrap();
+    let out = cornering_sweep("0:8:0.25").output().unwrap();
     assert!(out.status.success());
     let text = String::from_utf8(out.stdout).unwrap();
     assert_eq!(
@@ -193,16 +198,8 @@ fn level_segments(svg: &str) -> Vec<(i32, u32, i32, i32)> {
 fn sweep_key_draws_each_factors_swatch_as_its_line() {
     let dir = tempfile::tempdir().unwrap();
     let fig = dir.path().join("fig7.svg");
-    model("sweep", "test-bicycle.toml")
-        .args([
-            "--param",
-            "front_tyre.cornering_stiffness",
-            "--factors",
-            "0.5,1,2",
-            "--speeds",
-            "0:8:0.5",
-            "-o",
-        ])
+    cornering_sweep("0:8:0.5")
+        .arg("-o")
         .arg(&fig)
         .assert()
         .success();

@@ -8,7 +8,7 @@ use wobble_core::format::block::VERSION_MINOR;
 use wobble_core::format::*;
 
 mod format_support;
-use format_support::{decode, encode, frame, reseal};
+use format_support::{assert_round_trips, decode, encode, frame, reseal};
 
 const MARGIN: MarginRecord = MarginRecord {
     t_us: 2_003_000,
@@ -98,9 +98,7 @@ fn margin_records_round_trip_among_frames_and_kicks() {
         frame(2_010_000),
         Record::Margin(later),
     ];
-    let (decoded, stats) = decode(&encode(&records));
-    assert_eq!(decoded, records);
-    assert_eq!(stats.unknown_records, 0);
+    assert_round_trips(&records);
 }
 
 #[test]

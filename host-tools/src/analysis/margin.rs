@@ -59,6 +59,28 @@ pub struct KickPoint {
     pub freq_hz: f64,
 }
 
+impl From<&super::kicks::Kick> for KickPoint {
+    fn from(k: &super::kicks::Kick) -> Self {
+        Self {
+            speed_mps: k.speed_mps,
+            sigma_per_s: k.sigma_per_s,
+            sigma_sd_per_s: k.sigma_sd_per_s,
+            freq_hz: k.freq_hz,
+        }
+    }
+}
+
+impl From<&super::campaign_kicks::CampaignKick> for KickPoint {
+    fn from(k: &super::campaign_kicks::CampaignKick) -> Self {
+        Self {
+            speed_mps: k.speed_mps,
+            sigma_per_s: k.sigma_per_s,
+            sigma_sd_per_s: k.sigma_sd_per_s,
+            freq_hz: k.freq_hz,
+        }
+    }
+}
+
 /// The shape of sigma against speed the regression fits.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, clap::ValueEnum)]
 #[serde(rename_all = "lowercase")]

@@ -154,15 +154,7 @@ fn gather(logs: &[PathBuf], prefer: Prefer) -> (Vec<KickRow>, Result<(), CliErro
 /// The report of `rows` and the prediction made from them.
 #[must_use]
 pub fn report(mut rows: Vec<KickRow>, trend: Trend) -> (Report, Margin) {
-    let points: Vec<KickPoint> = rows
-        .iter()
-        .map(|r| KickPoint {
-            speed_mps: r.kick.speed_mps,
-            sigma_per_s: r.kick.sigma_per_s,
-            sigma_sd_per_s: r.kick.sigma_sd_per_s,
-            freq_hz: r.kick.freq_hz,
-        })
-        .collect();
+    let points: Vec<KickPoint> = rows.iter().map(|r| KickPoint::from(&r.kick)).collect();
     let margin = predict_with(&points, trend);
     for (row, w) in rows.iter_mut().zip(&margin.weights) {
         row.used = *w > 0.0;

@@ -54,6 +54,14 @@ pub fn decode(file: &[u8]) -> (Vec<Record<'static>>, DecodeStats) {
     (out, *dec.stats())
 }
 
+/// Asserts that `records` come back from their encoded log exactly, with
+/// no record left unknown.
+pub fn assert_round_trips(records: &[Record<'static>]) {
+    let (decoded, stats) = decode(&encode(records));
+    assert_eq!(decoded, records);
+    assert_eq!(stats.unknown_records, 0);
+}
+
 /// Rewrites block 0 of `file`: `edit` gets its header and bytes (CRC
 /// checked first), then the block is resealed.
 pub fn reseal(file: &mut [u8], edit: impl FnOnce(&mut BlockHeader, &mut [u8])) {
