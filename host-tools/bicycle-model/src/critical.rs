@@ -62,7 +62,10 @@ const BRACKET_STEPS: usize = 16;
 
 /// The sign of a real part, `0` within round-off of zero.
 fn sign(v: Complex<f64>) -> i8 {
-    if v.re.abs() <= 1e-10 * v.norm().max(1.0) {
+    let re = v.re.abs();
+    // `|v| <= |re| + |im|`: a real part above the bound's share is signed
+    // without the square root, which every value of a sweep would cost.
+    if re <= 1e-10 * (re + v.im.abs()).max(1.0) && re <= 1e-10 * v.norm().max(1.0) {
         0
     } else if v.re > 0.0 {
         1

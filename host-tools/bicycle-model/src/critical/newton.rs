@@ -14,7 +14,7 @@ use nalgebra::{Complex, DMatrix, DVector};
 
 use super::SPEED_TOL_MPS;
 
-/// Newton steps before giving up (a crossing takes 3-5).
+/// Newton steps before giving up (the test bicycle's crossings take 3).
 const MAX_STEPS: usize = 12;
 /// Below this step, m/s, a step that no longer halves is round-off in the
 /// real part (its noise over its slope), not a failing iteration.
