@@ -8,7 +8,7 @@ use std::fmt;
 use nalgebra::{Complex, DMatrix};
 
 use crate::critical::{Brackets, CriticalSpeed};
-use crate::eig::eigenvalues;
+use crate::eig::eigenvalues_near;
 use crate::model::{Model, StateRole};
 use crate::naming::Stats;
 use crate::track::Tracker;
@@ -167,7 +167,7 @@ fn each_speed(
     if speeds_mps.is_empty() {
         return Err(SweepError::NoSpeeds);
     }
-    let eigen = |u: f64| eigenvalues(&state_matrix(u));
+    let eigen = |u: f64, guesses: &[Complex<f64>]| eigenvalues_near(&state_matrix(u), guesses);
     let mut tracker = Tracker::new(&eigen);
     for (k, &u) in speeds_mps.iter().enumerate() {
         visit(k, u, tracker.step(u)?);
