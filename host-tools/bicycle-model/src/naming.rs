@@ -13,15 +13,17 @@
 //! A mode's participation is the mean over its branches and those speeds.
 //!
 //! - the mode with the largest torso share (at least [`LEAN_MIN_TORSO`]) is
-//!   `lean`: a tense rider's lean oscillation carries much steer, but it is
-//!   not the wobble;
+//!   `lean`, the upper body rolling on the hip: a tense rider's lean
+//!   oscillation carries much steer, but it is not the wobble; on a rigid
+//!   rider (a hip of 12 000 N m/rad and more on the first test bicycle) it
+//!   is the upper body against the frame at 19-31 Hz, mostly tyre lags;
 //! - beside that lean, any other oscillation at 2 Hz or more on average with
-//!   roll or torso its largest angle and the tyre lags at least
-//!   [`SWAY_MIN_TYRE`] of it is the `sway`: the main frame rolling and
-//!   sliding sideways on the tyres' lateral compliance (mostly the rear
-//!   tyre's, whose cornering stiffness sets its frequency), the upper body
-//!   rolling against it on the hip (with no lean, a hip so stiff that no
-//!   mode has that torso share, the pair keeps the name `lean` below);
+//!   the tyre lags at least [`SWAY_MIN_TYRE`] of it and the twist not its
+//!   largest angle is the `sway`: the main frame rolling and sliding
+//!   sideways on the tyres' lateral compliance (mostly the rear tyre's,
+//!   whose cornering stiffness sets its frequency), under an upper body the
+//!   hip holds, or, on a rigid rider, with the upper body rolling along
+//!   (its steer then more than its roll);
 //! - tyre lags more than [`TYRE_DOMINANCE`] times its largest angle: `other`;
 //! - torso the largest angle: `lean`; twist: `twist`;
 //! - roll or steer the largest, oscillating somewhere, with at least
@@ -53,8 +55,9 @@ use crate::sweep::{Mode, REAL_TOL};
 /// Share of the speeds over which two branches are conjugate to be one
 /// mode, and over which a mode is complex to oscillate.
 pub const OSCILLATING_SHARE: f64 = 0.25;
-/// The mode with the largest torso share is the lean if it has this much.
-pub const LEAN_MIN_TORSO: f64 = 0.1;
+/// The mode with the largest torso share is the lean if it has this much
+/// (a rigid rider's lean: 0.02 at 5 m/s at 50 000 N m/rad).
+pub const LEAN_MIN_TORSO: f64 = 0.01;
 /// Speeds at which eigenvectors are computed.
 pub const SAMPLES: usize = 16;
 /// A mode whose tyre lags are this many times its largest angle is a tyre mode.
@@ -177,13 +180,14 @@ impl Group {
             && roll >= WEAVE_MIN_ROLL_PER_STEER * WEAVE_MIN_ROLL_PER_STEER * steer
     }
 
-    /// The frame swaying on the tyres: an oscillation of roll or torso
-    /// carried mostly by the tyre lags.
+    /// The frame swaying on the tyres: an oscillation carried mostly by the
+    /// tyre lags, of any angle but the twist (the steer's, under the roll's
+    /// and the torso's on a tense rider, takes over on a rigid one).
     fn sway_like(&self) -> bool {
         self.oscillates
             && self.freq >= WOBBLE_MIN_RAD_S
             && self.shares.0[4] >= SWAY_MIN_TYRE
-            && matches!(self.largest_angle().0, StateRole::Roll | StateRole::Torso)
+            && self.largest_angle().0 != StateRole::Twist
     }
 
     fn wobble_like(&self) -> bool {
@@ -389,7 +393,7 @@ impl Stats {
 fn classify(groups: &[Group], branches: usize) -> Vec<Mode> {
     let lean = pick(
         groups,
-        |g| !g.tyre_only() && g.share(StateRole::Torso) >= LEAN_MIN_TORSO,
+        |g| g.share(StateRole::Torso) >= LEAN_MIN_TORSO,
         |g| g.share(StateRole::Torso),
     );
     // The lean is neither weave nor wobble.
@@ -419,10 +423,10 @@ fn classify(groups: &[Group], branches: usize) -> Vec<Mode> {
     let mut modes = vec![Mode::Other; branches];
     for (i, g) in groups.iter().enumerate() {
         let mode = match g.largest_angle().0 {
-            _ if lean.is_some_and(|l| l != i) && g.sway_like() => Mode::Sway,
+            _ if Some(i) == lean => Mode::Lean,
+            _ if lean.is_some() && g.sway_like() => Mode::Sway,
             _ if g.tyre_only() => Mode::Other,
             StateRole::Torso => Mode::Lean,
-            _ if Some(i) == lean => Mode::Lean,
             StateRole::Twist => Mode::Twist,
             _ if Some(i) == weave => Mode::Weave,
             _ if Some(i) == wobble => Mode::Wobble,
