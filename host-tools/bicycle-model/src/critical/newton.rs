@@ -95,8 +95,9 @@ fn local(
 
 /// The speed in `[lo, hi]` where the eigenvalue starting as `guess` at
 /// speed `start` has a zero real part, by Newton's method on
-/// `Re lambda(u)`; with the eigenvalue there. `None` if an iterate leaves
-/// the interval, a slope is flat or the steps do not converge.
+/// `Re lambda(u)`; with the eigenvalue there (as the last step predicts it).
+/// `None` if an iterate leaves the interval, a slope is flat or the steps
+/// do not converge.
 pub(super) fn crossing(
     matrix: &dyn Fn(f64) -> DMatrix<f64>,
     slope: &dyn Fn(f64) -> DMatrix<f64>,
@@ -117,12 +118,13 @@ pub(super) fn crossing(
         if !(lo..=hi).contains(&next) {
             return None;
         }
+        // The next iterate and its eigenvalue predicted along the slope.
+        (u, shift) = (next, at.value + at.slope * step);
         let size = step.abs();
         if size <= SPEED_TOL_MPS || (size <= ROUND_OFF_MPS && size > 0.5 * last_step) {
-            return Some((u, at.value));
+            return Some((u, shift));
         }
         last_step = size;
-        (u, shift) = (next, at.value + at.slope * step);
         a = matrix(u);
     }
     None
