@@ -315,7 +315,8 @@ mod tests {
 
     /// On the test bicycle's 1000-speed sweep every crossing is refined by
     /// Newton's method, to the speed the branch followed in small steps and
-    /// Brent's method give.
+    /// Brent's method give, in at most 4 steps (each evaluates `A(u)` three
+    /// times, for itself and the central difference; the check once more).
     #[test]
     fn the_test_bicycles_crossings_take_newtons_method() {
         let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("params/test-bicycle.toml");
@@ -330,7 +331,17 @@ mod tests {
             .collect();
         assert!(named.len() >= 2, "{named:?}");
         for b in &named {
-            let (u, value) = by_newton(&*matrix, b).expect("refined by Newton's method");
+            let evaluations = std::cell::Cell::new(0);
+            let counted = |u: f64| {
+                evaluations.set(evaluations.get() + 1);
+                matrix(u)
+            };
+            let (u, value) = by_newton(&counted, b).expect("refined by Newton's method");
+            assert!(
+                evaluations.get() <= 4 * 3 + 1,
+                "{} evaluations",
+                evaluations.get()
+            );
             let (ub, vb) = by_brent(&*matrix, b).unwrap();
             assert!((u - ub).abs() < 1e-11, "{u} against Brent's {ub}");
             assert!((value - vb).norm() < 1e-9, "{value} against Brent's {vb}");
