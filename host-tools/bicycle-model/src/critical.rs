@@ -296,6 +296,25 @@ mod tests {
         }
     }
 
+    /// A real part has no sign within 1e-10 of the eigenvalue's size (or of
+    /// 1, for an eigenvalue smaller than 1), by hand at and around the bound.
+    #[test]
+    fn a_real_part_within_round_off_of_zero_has_no_sign() {
+        for (re, im, want) in [
+            (0.0, 0.0, 0),
+            (1e-12, 0.0, 0),
+            (-1e-12, 0.0, 0),
+            (-2e-10, 0.0, -1),
+            (0.5, 0.0, 1),
+            (1e-11, 50.0, 0),
+            (-3e-9, 40.0, 0),
+            (5e-9, 40.0, 1),
+            (-5e-9, 40.0, -1),
+        ] {
+            assert_eq!(sign(Complex::new(re, im)), want, "{re} + {im} i");
+        }
+    }
+
     /// Two real roots through zero, `u^2 - 1` and `u^2 - 0.98`, on a grid
     /// too coarse for a straight line between them: at the first one's
     /// crossing the line points at the second, so Newton's result is
