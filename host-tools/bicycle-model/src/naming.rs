@@ -472,3 +472,40 @@ fn pick(
         .max_by(|a, b| score(a.1).total_cmp(&score(b.1)))
         .map(|(i, _)| i)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A 0.1 m/s grid from 0 holds the reference speeds up to round-off
+    /// (`15.0 * 0.1` is 1.5000000000000002): every fifth speed is both, and
+    /// nothing is evaluated twice.
+    #[test]
+    fn reference_speeds_on_an_asked_grid_are_the_asked_ones() {
+        let asked: Vec<f64> = (0..=140).map(|i| f64::from(i) * 0.1).collect();
+        let got: Vec<Speed> = speeds(&asked).collect();
+        assert_eq!(got.len(), 141);
+        for (k, s) in got.iter().enumerate() {
+            assert_eq!((s.u, s.asked), (asked[k], Some(k)));
+            assert_eq!(s.reference, k % 5 == 0, "{} m/s", s.u);
+        }
+    }
+
+    /// Asked speeds off the reference grid and beyond it come in order
+    /// between the 29 reference speeds (0, 0.5, ..., 14 m/s).
+    #[test]
+    fn asked_speeds_off_the_reference_grid_are_merged_in_order() {
+        let got: Vec<Speed> = speeds(&[3.3, 20.0]).collect();
+        assert_eq!(got.len(), 31);
+        assert!(got.windows(2).all(|w| w[0].u < w[1].u));
+        let asked: Vec<(usize, f64)> = got
+            .iter()
+            .filter_map(|s| s.asked.map(|k| (k, s.u)))
+            .collect();
+        assert_eq!(asked, [(0, 3.3), (1, 20.0)]);
+        let reference: Vec<f64> = got.iter().filter(|s| s.reference).map(|s| s.u).collect();
+        assert_eq!(reference.len(), 29);
+        assert_eq!((reference[7], reference[28]), (3.5, 14.0));
+        assert!(got.iter().all(|s| s.reference != s.asked.is_some()));
+    }
+}
