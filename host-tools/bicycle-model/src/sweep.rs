@@ -9,7 +9,7 @@ use std::fmt;
 use nalgebra::{Complex, DMatrix};
 
 use crate::critical::{Brackets, CriticalSpeed};
-use crate::eig::eigenvalues;
+use crate::eig::eigenvalues_near;
 use crate::model::{Model, StateRole};
 use crate::naming::{self, Speed, Stats};
 use crate::track::Tracker;
@@ -172,7 +172,7 @@ fn each_speed(
     if speeds_mps.is_empty() {
         return Err(SweepError::NoSpeeds);
     }
-    let eigen = |u: f64| eigenvalues(&state_matrix(u));
+    let eigen = |u: f64, guesses: &[Complex<f64>]| eigenvalues_near(&state_matrix(u), guesses);
     let mut tracker = Tracker::new(&eigen);
     for at in naming::speeds(speeds_mps) {
         visit(at, tracker.step(at.u)?);
