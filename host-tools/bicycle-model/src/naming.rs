@@ -242,6 +242,19 @@ fn shares_of(vector: &nalgebra::DVector<Complex<f64>>, roles: &[StateRole]) -> S
     Shares(s)
 }
 
+/// The branch whose value is the conjugate of branch `i`'s, to 1e-9 of its
+/// size, if any.
+fn conjugate_partner(values: &[Complex<f64>], i: usize) -> Option<usize> {
+    let v = values[i];
+    let tol = (1e-9 * v.norm().max(1.0)).powi(2);
+    (0..values.len())
+        .filter(|&j| j != i)
+        .map(|j| (j, (values[j] - v.conj()).norm_sqr()))
+        .min_by(|a, b| a.1.total_cmp(&b.1))
+        .filter(|&(_, d)| d <= tol)
+        .map(|(j, _)| j)
+}
+
 /// What naming needs of a sweep, gathered one speed at a time (so that a
 /// sweep need not be held whole): per branch its mean participation at the
 /// sample speeds and sums of its values, per pair of branches the speeds
@@ -301,9 +314,20 @@ impl Stats {
         if self.samples.binary_search(&self.k).is_ok() {
             let a = state_matrix(u);
             let weight = 1.0 / self.samples.len() as f64;
-            for (v, s) in values.iter().zip(self.shares.iter_mut()) {
-                let got = shares_of(&eigenvector(&a, *v), &self.roles);
-                for (x, y) in s.0.iter_mut().zip(got.0) {
+            // The lower member of a pair has its partner's shares (its
+            // eigenvector is the conjugate): one inverse iteration per pair.
+            let mut got: Vec<Option<Shares>> = vec![None; n];
+            for i in (0..n).filter(|&i| values[i].im >= 0.0) {
+                got[i] = Some(shares_of(&eigenvector(&a, values[i]), &self.roles));
+            }
+            for i in 0..n {
+                let shares = match got[i] {
+                    Some(shares) => shares,
+                    None => conjugate_partner(values, i)
+                        .and_then(|j| got[j])
+                        .unwrap_or_else(|| shares_of(&eigenvector(&a, values[i]), &self.roles)),
+                };
+                for (x, y) in self.shares[i].0.iter_mut().zip(shares.0) {
                     *x += y * weight;
                 }
             }
@@ -318,13 +342,7 @@ impl Stats {
             if v.im <= REAL_TOL {
                 continue;
             }
-            let tol = (1e-9 * v.norm().max(1.0)).powi(2);
-            let partner = (0..n)
-                .filter(|&j| j != i)
-                .map(|j| (j, (values[j] - v.conj()).norm_sqr()))
-                .min_by(|a, b| a.1.total_cmp(&b.1))
-                .filter(|&(_, d)| d <= tol);
-            if let Some((j, _)) = partner {
+            if let Some(j) = conjugate_partner(values, i) {
                 self.conjugate[i * n + j] += 1;
             }
         }
