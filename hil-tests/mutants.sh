@@ -64,6 +64,8 @@ targets=(
   "line-writer|wobblog|host-tools/src/export/lines.rs|.|--lib --test broken_pipe"
   "event-order|wobblog|host-tools/src/events.rs|TimeOrder|--lib --test events_config"
   "gpx-track|wobblog|host-tools/src/cmd/gpx.rs|.|--test gpx_track --test log_semantics --test broken_pipe"
+  "critical|wobble-model|host-tools/bicycle-model/src/critical.rs|sign,by_newton|--lib"
+  "critical-newton|wobble-model|host-tools/bicycle-model/src/critical/newton.rs|.|--lib"
   "margin-regression|wobblog|host-tools/src/analysis/margin.rs|.|--lib|analysis::margin::"
   "margin-warning|wobble-core|firmware/core/src/detector/margin.rs|MarginWarning,fieller,estimate,robust_line,weighted_line,median,t_975|--lib|detector::margin::"
 )

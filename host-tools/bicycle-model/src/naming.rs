@@ -13,15 +13,17 @@
 //! A mode's participation is the mean over its branches and those speeds.
 //!
 //! - the mode with the largest torso share (at least [`LEAN_MIN_TORSO`]) is
-//!   `lean`: a tense rider's lean oscillation carries much steer, but it is
-//!   not the wobble;
+//!   `lean`, the upper body rolling on the hip: a tense rider's lean
+//!   oscillation carries much steer, but it is not the wobble; on a rigid
+//!   rider (a hip of 12 000 N m/rad and more on the first test bicycle) it
+//!   is the upper body against the frame at 19-31 Hz, mostly tyre lags;
 //! - beside that lean, any other oscillation at 2 Hz or more on average with
-//!   roll or torso its largest angle and the tyre lags at least
-//!   [`SWAY_MIN_TYRE`] of it is the `sway`: the main frame rolling and
-//!   sliding sideways on the tyres' lateral compliance (mostly the rear
-//!   tyre's, whose cornering stiffness sets its frequency), the upper body
-//!   rolling against it on the hip (with no lean, a hip so stiff that no
-//!   mode has that torso share, the pair keeps the name `lean` below);
+//!   the tyre lags at least [`SWAY_MIN_TYRE`] of it and the twist not its
+//!   largest angle is the `sway`: the main frame rolling and sliding
+//!   sideways on the tyres' lateral compliance (mostly the rear tyre's,
+//!   whose cornering stiffness sets its frequency), under an upper body the
+//!   hip holds, or, on a rigid rider, with the upper body rolling along
+//!   (its steer then more than its roll);
 //! - tyre lags more than [`TYRE_DOMINANCE`] times its largest angle: `other`;
 //! - torso the largest angle: `lean`; twist: `twist`;
 //! - roll or steer the largest, oscillating somewhere, with at least
@@ -35,6 +37,14 @@
 //! - steer the largest and below 2 Hz, not the weave: the fastest decaying is
 //!   `castering`;
 //! - anything else `other`.
+//!
+//! The names are taken on a reference sweep, [`REFERENCE_STEP_MPS`] apart
+//! from 0 to [`REFERENCE_TOP_MPS`] (the model's natural range, where the
+//! weave still has its low-speed form), whatever speeds were asked for:
+//! the reference speeds are followed together with the asked ones
+//! ([`speeds`]), so each branch at the asked speeds is a branch of the
+//! reference sweep and carries its name. A single speed, a short or high
+//! range or a coarse grid names each eigenvalue as the 0-14 m/s sweep does.
 
 use nalgebra::{Complex, DMatrix};
 
@@ -45,8 +55,9 @@ use crate::sweep::{Mode, REAL_TOL};
 /// Share of the speeds over which two branches are conjugate to be one
 /// mode, and over which a mode is complex to oscillate.
 pub const OSCILLATING_SHARE: f64 = 0.25;
-/// The mode with the largest torso share is the lean if it has this much.
-pub const LEAN_MIN_TORSO: f64 = 0.1;
+/// The mode with the largest torso share is the lean if it has this much
+/// (a rigid rider's lean: 0.02 at 5 m/s at 50 000 N m/rad).
+pub const LEAN_MIN_TORSO: f64 = 0.01;
 /// Speeds at which eigenvectors are computed.
 pub const SAMPLES: usize = 16;
 /// A mode whose tyre lags are this many times its largest angle is a tyre mode.
@@ -57,6 +68,60 @@ pub const SWAY_MIN_TYRE: f64 = 0.5;
 pub const WEAVE_MIN_ROLL_PER_STEER: f64 = 0.2;
 /// Wobble is faster than this on average, rad/s (2 Hz).
 pub const WOBBLE_MIN_RAD_S: f64 = 4.0 * std::f64::consts::PI;
+/// The reference sweep names are taken on: 0 to this, m/s.
+pub const REFERENCE_TOP_MPS: f64 = 14.0;
+/// The reference sweep's step, m/s (the tracking halves it where in doubt).
+pub const REFERENCE_STEP_MPS: f64 = 0.5;
+/// The reference sweep's number of speeds.
+const REFERENCE_SPEEDS: usize = 1 + (REFERENCE_TOP_MPS / REFERENCE_STEP_MPS) as usize;
+
+/// One speed a sweep evaluates.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Speed {
+    /// m/s.
+    pub(crate) u: f64,
+    /// Its index among the asked speeds, if asked.
+    pub(crate) asked: Option<usize>,
+    /// Whether it is a speed of the reference sweep.
+    pub(crate) reference: bool,
+}
+
+/// The speeds a sweep over `asked` (increasing) evaluates, increasing: the
+/// asked ones and the reference sweep's, a reference speed within 1e-9 m/s
+/// of an asked one being that one (lazily: memory does not grow with the
+/// number of speeds).
+pub(crate) fn speeds(asked: &[f64]) -> impl Iterator<Item = Speed> + '_ {
+    let reference = |i: usize| (i < REFERENCE_SPEEDS).then_some(i as f64 * REFERENCE_STEP_MPS);
+    let (mut a, mut r) = (0, 0);
+    std::iter::from_fn(move || {
+        let next = match (asked.get(a), reference(r)) {
+            (None, None) => return None,
+            (Some(&u), Some(ur)) if (u - ur).abs() <= 1e-9 => Speed {
+                u,
+                asked: Some(a),
+                reference: true,
+            },
+            (Some(&u), Some(ur)) if ur < u => Speed {
+                u: ur,
+                asked: None,
+                reference: true,
+            },
+            (Some(&u), _) => Speed {
+                u,
+                asked: Some(a),
+                reference: false,
+            },
+            (None, Some(ur)) => Speed {
+                u: ur,
+                asked: None,
+                reference: true,
+            },
+        };
+        a += usize::from(next.asked.is_some());
+        r += usize::from(next.reference);
+        Some(next)
+    })
+}
 
 /// Shares of the angles in a mode: roll, steer, torso, twist, tyre.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -115,13 +180,14 @@ impl Group {
             && roll >= WEAVE_MIN_ROLL_PER_STEER * WEAVE_MIN_ROLL_PER_STEER * steer
     }
 
-    /// The frame swaying on the tyres: an oscillation of roll or torso
-    /// carried mostly by the tyre lags.
+    /// The frame swaying on the tyres: an oscillation carried mostly by the
+    /// tyre lags, of any angle but the twist (the steer's, under the roll's
+    /// and the torso's on a tense rider, takes over on a rigid one).
     fn sway_like(&self) -> bool {
         self.oscillates
             && self.freq >= WOBBLE_MIN_RAD_S
             && self.shares.0[4] >= SWAY_MIN_TYRE
-            && matches!(self.largest_angle().0, StateRole::Roll | StateRole::Torso)
+            && self.largest_angle().0 != StateRole::Twist
     }
 
     fn wobble_like(&self) -> bool {
@@ -182,7 +248,6 @@ fn shares_of(vector: &nalgebra::DVector<Complex<f64>>, roles: &[StateRole]) -> S
 /// at which they are conjugates.
 pub(crate) struct Stats {
     roles: Vec<StateRole>,
-    speeds: usize,
     samples: Vec<usize>,
     /// Speeds added so far.
     k: usize,
@@ -199,13 +264,11 @@ pub(crate) struct Stats {
 }
 
 impl Stats {
-    /// Statistics of a sweep of `speeds` speeds, of a model with states of
-    /// `roles`.
-    pub(crate) fn new(speeds: usize, roles: &[StateRole]) -> Self {
+    /// Statistics of the reference sweep of a model with states of `roles`.
+    pub(crate) fn new(roles: &[StateRole]) -> Self {
         Self {
             roles: roles.to_vec(),
-            speeds,
-            samples: sample_indices(speeds),
+            samples: sample_indices(REFERENCE_SPEEDS),
             k: 0,
             branches: 0,
             shares: Vec::new(),
@@ -217,7 +280,7 @@ impl Stats {
         }
     }
 
-    /// Adds the branches' `values` at the next speed `u`; `state_matrix`
+    /// Adds the branches' `values` at the next reference speed `u`; `state_matrix`
     /// gives the matrix whose eigenvectors are taken at the sample speeds.
     pub(crate) fn add(
         &mut self,
@@ -275,7 +338,7 @@ impl Stats {
         let mut parent: Vec<usize> = (0..n).collect();
         for i in 0..n {
             for j in 0..n {
-                if self.conjugate[i * n + j] as f64 >= OSCILLATING_SHARE * self.speeds as f64 {
+                if self.conjugate[i * n + j] as f64 >= OSCILLATING_SHARE * REFERENCE_SPEEDS as f64 {
                     let (a, b) = (find(&mut parent, i), find(&mut parent, j));
                     parent[a] = b;
                 }
@@ -298,7 +361,7 @@ impl Stats {
 
     /// The mode of each branch.
     pub(crate) fn modes(&self) -> Vec<Mode> {
-        let n = self.speeds;
+        let n = REFERENCE_SPEEDS;
         let groups: Vec<Group> = self
             .conjugate_groups()
             .into_iter()
@@ -330,7 +393,7 @@ impl Stats {
 fn classify(groups: &[Group], branches: usize) -> Vec<Mode> {
     let lean = pick(
         groups,
-        |g| !g.tyre_only() && g.share(StateRole::Torso) >= LEAN_MIN_TORSO,
+        |g| g.share(StateRole::Torso) >= LEAN_MIN_TORSO,
         |g| g.share(StateRole::Torso),
     );
     // The lean is neither weave nor wobble.
@@ -360,10 +423,10 @@ fn classify(groups: &[Group], branches: usize) -> Vec<Mode> {
     let mut modes = vec![Mode::Other; branches];
     for (i, g) in groups.iter().enumerate() {
         let mode = match g.largest_angle().0 {
-            _ if lean.is_some_and(|l| l != i) && g.sway_like() => Mode::Sway,
+            _ if Some(i) == lean => Mode::Lean,
+            _ if lean.is_some() && g.sway_like() => Mode::Sway,
             _ if g.tyre_only() => Mode::Other,
             StateRole::Torso => Mode::Lean,
-            _ if Some(i) == lean => Mode::Lean,
             StateRole::Twist => Mode::Twist,
             _ if Some(i) == weave => Mode::Weave,
             _ if Some(i) == wobble => Mode::Wobble,
