@@ -469,9 +469,24 @@ mod tests {
             assert!((lhs - rhs).abs() < 1e-4, "{x}");
         }
         assert!(lo < 1.0 && hi.unwrap() > 1.0);
+        // With a covariance between intercept and slope (the estimate's
+        // line, centred on its mean speed, has none, but the interval is
+        // Fieller's for any): `(x - 1)^2 = t^2 (Vaa + 2 x Vab + x^2 Vbb)`.
+        let vab = -0.004;
+        let (lo, hi) = fieller(-1.0, 1.0, [vaa, vab, vbb], t).unwrap();
+        for x in [lo, hi.unwrap()] {
+            let lhs = (x - 1.0) * (x - 1.0);
+            let rhs = t * t * (vaa + 2.0 * x * vab + x * x * vbb);
+            assert!((lhs - rhs).abs() < 1e-4, "{x}");
+        }
         // A slope within its noise: a lower bound only.
         let (lo, hi) = fieller(-1.0, 0.05, [vaa, 0.0, vbb], t).unwrap();
         assert!(hi.is_none() && lo.is_finite(), "{lo}");
+        // And an intercept within its noise too: the quadratic
+        // `(0.0025 - 0.01) x^2 - 0.1 x + (1 - 4)` is negative everywhere
+        // (its discriminant 0.01 - 0.09 < 0), every speed is inside, no
+        // bound at all.
+        assert_eq!(fieller(-1.0, 0.05, [1.0, 0.0, vbb], t), None);
     }
 
     /// Each kick counts with its calibrated uncertainty
@@ -616,11 +631,23 @@ mod tests {
             .map(|i| (2.0 + 0.2 * i as f32, -0.5 - 0.3 * i as f32))
             .collect();
         assert_eq!(warning_after(&falling, 0.05).estimate(), None);
-        // Kicks without a speed are left out.
+        // Kicks without a speed, or with a speed that is no speed
+        // (negative, zero, infinite, NaN), are left out.
         let mut m = MarginWarning::new(0.5);
-        for i in 0..10 {
+        for (i, speed) in [
+            None,
+            Some(-3.0),
+            Some(0.0),
+            Some(f32::INFINITY),
+            Some(f32::NAN),
+        ]
+        .into_iter()
+        .cycle()
+        .take(10)
+        .enumerate()
+        {
             let mut k = kick(2.0 + 0.2 * i as f32, -1.0, 0.05);
-            k.speed_mps = None;
+            k.speed_mps = speed;
             assert_eq!(m.add_kick(&k), None);
         }
         assert_eq!(m.len, 0);
