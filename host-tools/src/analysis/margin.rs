@@ -960,6 +960,59 @@ mod tests {
         assert_eq!(m.speed_range_mps, Some([pts[0].0, pts[7].0]));
     }
 
+    /// The robust fit is a fixed point of its reweighting: from the final
+    /// line, each kick's residual in units of its SD, the MAD scale and
+    /// Tukey's weight give back the weights reported (a fit stopped after
+    /// a pass or two would report the weights of an earlier line). Kicks
+    /// scattered about a line, one of them 2 1/s off.
+    #[test]
+    fn the_robust_fit_is_a_fixed_point_of_its_weights() {
+        let mut normal = normals(0x1234_5678_9ABC_DEF1);
+        let sd = 0.05;
+        let mut pts: Vec<(f64, f64)> = (0..16)
+            .map(|i| {
+                let u = 2.0 + 0.12 * f64::from(i);
+                (u, 1.2 * (u - 4.5) + 1.5 * sd * normal())
+            })
+            .collect();
+        pts[5].1 += 2.0;
+        let none = BendPrior {
+            mean_per_s_mps2: 0.0,
+            sd_per_s_mps2: 0.0,
+        };
+        let m = predict_bent(&kicks(&pts, sd), Trend::Line, none);
+        let c = m.coefficients.as_ref().unwrap();
+        let z: Vec<f64> = pts
+            .iter()
+            .map(|(u, y)| (y - c[0] - c[1] * u) / sd)
+            .collect();
+        let scale = (1.482_6 * median(z.iter().map(|z| z.abs()).collect())).max(1.0);
+        for (z, got) in z.iter().zip(&m.weights) {
+            let want = bisquare(z / (BISQUARE_C * scale)) / (sd * sd);
+            assert!(
+                (got - want).abs() < 1e-6 * (1.0 / (sd * sd)),
+                "{got} {want}"
+            );
+        }
+        assert_eq!(m.weights[5], 0.0);
+    }
+
+    /// Huber's and Tukey's weight functions of the residual in units of
+    /// their constant (Huber 1964, `min(1, 1 / |r|)`; Beaton and Tukey
+    /// 1974, `(1 - r^2)^2` inside 1, 0 outside).
+    #[test]
+    fn the_weight_functions_are_huber_and_tukey() {
+        for (r, h, b) in [
+            (0.0, 1.0, 1.0),
+            (0.5, 1.0, 0.5625),
+            (-1.0, 1.0, 0.0),
+            (2.0, 0.5, 0.0),
+            (-4.0, 0.25, 0.0),
+        ] {
+            assert_eq!((huber(r), bisquare(r)), (h, b), "{r}");
+        }
+    }
+
     /// The bend allowance by hand: kicks of mean speed 3 m/s and speed
     /// variance 0.25 (m/s)^2, a curvature SD of 0.02: at 5 m/s the trend
     /// is uncertain by `0.01 * |4 - 0.25| = 0.0375` 1/s more, at the mean
