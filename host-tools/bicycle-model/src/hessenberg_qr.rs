@@ -81,6 +81,9 @@ impl Square {
             rest = tail;
             &mut row[cols.clone()][..len]
         });
+        if let ([top, middle, bottom], [_, v1, v2]) = (rows.as_mut_slice(), v.as_slice()) {
+            return reflect_three_rows(top, middle, bottom, *v1, *v2, tau);
+        }
         for j in 0..len {
             let mut s = 0.0;
             for (row, vk) in rows.iter().zip(v) {
@@ -106,6 +109,26 @@ impl Square {
                 *x -= s * y;
             }
         }
+    }
+}
+
+/// `I - tau v v^T`, `v = (1, v1, v2)`, applied to the columns of three rows.
+/// Not inlined: as a function's own arguments the rows are known not to
+/// overlap, so that the vectorised loop needs no overlap checks.
+#[inline(never)]
+fn reflect_three_rows(
+    top: &mut [f64],
+    middle: &mut [f64],
+    bottom: &mut [f64],
+    v1: f64,
+    v2: f64,
+    tau: f64,
+) {
+    for ((x, y), z) in top.iter_mut().zip(middle.iter_mut()).zip(bottom.iter_mut()) {
+        let s = tau * (*x + v1 * *y + v2 * *z);
+        *x -= s;
+        *y -= s * v1;
+        *z -= s * v2;
     }
 }
 

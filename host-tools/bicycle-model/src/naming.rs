@@ -242,6 +242,19 @@ fn shares_of(vector: &nalgebra::DVector<Complex<f64>>, roles: &[StateRole]) -> S
     Shares(s)
 }
 
+/// The branch whose value is the conjugate of branch `i`'s, to 1e-9 of its
+/// size, if any.
+fn conjugate_partner(values: &[Complex<f64>], i: usize) -> Option<usize> {
+    let v = values[i];
+    let tol = (1e-9 * v.norm().max(1.0)).powi(2);
+    (0..values.len())
+        .filter(|&j| j != i)
+        .map(|j| (j, (values[j] - v.conj()).norm_sqr()))
+        .min_by(|a, b| a.1.total_cmp(&b.1))
+        .filter(|&(_, d)| d <= tol)
+        .map(|(j, _)| j)
+}
+
 /// What naming needs of a sweep, gathered one speed at a time (so that a
 /// sweep need not be held whole): per branch its mean participation at the
 /// sample speeds and sums of its values, per pair of branches the speeds
@@ -301,9 +314,20 @@ impl Stats {
         if self.samples.binary_search(&self.k).is_ok() {
             let a = state_matrix(u);
             let weight = 1.0 / self.samples.len() as f64;
-            for (v, s) in values.iter().zip(self.shares.iter_mut()) {
-                let got = shares_of(&eigenvector(&a, *v), &self.roles);
-                for (x, y) in s.0.iter_mut().zip(got.0) {
+            // The lower member of a pair has its partner's shares (its
+            // eigenvector is the conjugate): one inverse iteration per pair.
+            let mut got: Vec<Option<Shares>> = vec![None; n];
+            for i in (0..n).filter(|&i| values[i].im >= 0.0) {
+                got[i] = Some(shares_of(&eigenvector(&a, values[i]), &self.roles));
+            }
+            for i in 0..n {
+                let shares = match got[i] {
+                    Some(shares) => shares,
+                    None => conjugate_partner(values, i)
+                        .and_then(|j| got[j])
+                        .unwrap_or_else(|| shares_of(&eigenvector(&a, values[i]), &self.roles)),
+                };
+                for (x, y) in self.shares[i].0.iter_mut().zip(shares.0) {
                     *x += y * weight;
                 }
             }
@@ -318,13 +342,7 @@ impl Stats {
             if v.im <= REAL_TOL {
                 continue;
             }
-            let tol = (1e-9 * v.norm().max(1.0)).powi(2);
-            let partner = (0..n)
-                .filter(|&j| j != i)
-                .map(|j| (j, (values[j] - v.conj()).norm_sqr()))
-                .min_by(|a, b| a.1.total_cmp(&b.1))
-                .filter(|&(_, d)| d <= tol);
-            if let Some((j, _)) = partner {
+            if let Some(j) = conjugate_partner(values, i) {
                 self.conjugate[i * n + j] += 1;
             }
         }
@@ -453,4 +471,41 @@ fn pick(
         .filter(|(_, g)| keep(g))
         .max_by(|a, b| score(a.1).total_cmp(&score(b.1)))
         .map(|(i, _)| i)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A 0.1 m/s grid from 0 holds the reference speeds up to round-off
+    /// (`15.0 * 0.1` is 1.5000000000000002): every fifth speed is both, and
+    /// nothing is evaluated twice.
+    #[test]
+    fn reference_speeds_on_an_asked_grid_are_the_asked_ones() {
+        let asked: Vec<f64> = (0..=140).map(|i| f64::from(i) * 0.1).collect();
+        let got: Vec<Speed> = speeds(&asked).collect();
+        assert_eq!(got.len(), 141);
+        for (k, s) in got.iter().enumerate() {
+            assert_eq!((s.u, s.asked), (asked[k], Some(k)));
+            assert_eq!(s.reference, k % 5 == 0, "{} m/s", s.u);
+        }
+    }
+
+    /// Asked speeds off the reference grid and beyond it come in order
+    /// between the 29 reference speeds (0, 0.5, ..., 14 m/s).
+    #[test]
+    fn asked_speeds_off_the_reference_grid_are_merged_in_order() {
+        let got: Vec<Speed> = speeds(&[3.3, 20.0]).collect();
+        assert_eq!(got.len(), 31);
+        assert!(got.windows(2).all(|w| w[0].u < w[1].u));
+        let asked: Vec<(usize, f64)> = got
+            .iter()
+            .filter_map(|s| s.asked.map(|k| (k, s.u)))
+            .collect();
+        assert_eq!(asked, [(0, 3.3), (1, 20.0)]);
+        let reference: Vec<f64> = got.iter().filter(|s| s.reference).map(|s| s.u).collect();
+        assert_eq!(reference.len(), 29);
+        assert_eq!((reference[7], reference[28]), (3.5, 14.0));
+        assert!(got.iter().all(|s| s.reference != s.asked.is_some()));
+    }
 }

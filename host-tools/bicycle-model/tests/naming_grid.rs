@@ -10,7 +10,7 @@ use std::path::Path;
 use proptest::prelude::*;
 use support::bundled;
 
-use wobble_model::{Complex, Mode, Model, ParamSet, Sweep};
+use wobble_model::{Complex, CriticalSpeed, Mode, Model, ParamSet, Survey, Sweep};
 
 /// Every bicycle: the bundled parameter files and BicycleParameters' files.
 fn bicycles() -> Vec<(String, Model)> {
@@ -139,6 +139,38 @@ fn names_at_single_speeds_and_short_ranges_are_the_full_sweeps() {
     );
 }
 
+/// Asked for a short range around one critical speed only (as `model eig
+/// --speeds 4:5:0.05` does), every bicycle finds and names it as on the
+/// whole range, to 1e-6 m/s, and nothing it does not find there.
+#[test]
+fn critical_speeds_on_short_ranges_are_the_full_sweeps() {
+    for (name, model) in bicycles() {
+        let whole = Survey::run(&model, &grid(0.0, 14.0, 0.1), |_| {})
+            .unwrap()
+            .critical;
+        assert!(!whole.is_empty(), "{name}");
+        let known = |c: &CriticalSpeed| {
+            whole
+                .iter()
+                .any(|w| w.mode == c.mode && (w.speed_mps - c.speed_mps).abs() < 1e-6)
+        };
+        for c in &whole {
+            let from = (c.speed_mps - 0.5).max(0.0);
+            let found = Survey::run(&model, &grid(from, from + 1.0, 0.05), |_| {})
+                .unwrap()
+                .critical;
+            let what = format!("{name} around {c:?}: {found:?}");
+            assert!(found.iter().all(known), "{what}");
+            assert!(
+                found
+                    .iter()
+                    .any(|f| f.mode == c.mode && (f.speed_mps - c.speed_mps).abs() < 1e-6),
+                "{what}"
+            );
+        }
+    }
+}
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(24))]
 
@@ -155,5 +187,19 @@ proptest! {
         let asked = grid(from, (from + length).min(16.0), step);
         let d = differences(model, &asked);
         prop_assert!(d.is_empty(), "{} over {}..{} every {}: {}", name, from, from + length, step, d.join("; "));
+        // `model eig`'s two passes name and give the same.
+        let sweep = Sweep::run(model, &asked, |_| {}).unwrap();
+        let survey = Survey::run(model, &asked, |_| {}).unwrap();
+        prop_assert_eq!(&survey.modes, &sweep.branches.iter().map(|b| b.mode).collect::<Vec<_>>());
+        let mut k = 0;
+        survey.replay(model, &asked, |u, values| {
+            assert_eq!(u, asked[k]);
+            for (b, v) in sweep.branches.iter().zip(values) {
+                assert_eq!(b.values[k], *v, "{} at {} m/s", name, u);
+            }
+            k += 1;
+            Ok::<(), wobble_model::SweepError>(())
+        }).unwrap();
+        prop_assert_eq!(k, asked.len());
     }
 }
