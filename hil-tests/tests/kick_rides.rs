@@ -11,10 +11,16 @@ use wobble_hil::kick_metrics::{self, KickScore};
 /// The issue's threshold: a ring decaying faster than this never alerts.
 const DECAYING_PER_S: f64 = -0.3;
 
+/// Seeds of the signal-model rides (90 kicks each) and of the simulated
+/// bicycle's (48 each). Seeds 4 (signal) and 3 (simulated) hold slow rings
+/// that alerted on their tail before the envelope trend.
+const SIGNAL_SEEDS: core::ops::RangeInclusive<u64> = 1..=4;
+const SIMULATED_SEEDS: core::ops::RangeInclusive<u64> = 1..=3;
+
 fn signal() -> &'static [KickScore] {
     static S: OnceLock<Vec<KickScore>> = OnceLock::new();
     S.get_or_init(|| {
-        let rides: Vec<Fixture> = (1..=2)
+        let rides: Vec<Fixture> = SIGNAL_SEEDS
             .flat_map(|seed| kicks::signal_rides(seed, 9))
             .collect();
         kick_metrics::score(&rides, &Config::default()).expect("scores")
@@ -24,7 +30,11 @@ fn signal() -> &'static [KickScore] {
 fn simulated() -> &'static [KickScore] {
     static S: OnceLock<Vec<KickScore>> = OnceLock::new();
     S.get_or_init(|| {
-        let rides = kicks::simulated_rides(1, &kicks::SIMULATED_SPEEDS).expect("simulates");
+        let rides: Vec<Fixture> = SIMULATED_SEEDS
+            .flat_map(|seed| {
+                kicks::simulated_rides(seed, &kicks::SIMULATED_SPEEDS).expect("simulates")
+            })
+            .collect();
         kick_metrics::score(&rides, &Config::default()).expect("scores")
     })
 }
@@ -45,12 +55,12 @@ fn alerted(scores: &[KickScore]) -> Vec<String> {
 #[test]
 fn the_rides_hold_the_kicks_the_issue_describes() {
     let s = signal();
-    assert_eq!(s.len(), 180);
+    assert_eq!(s.len(), 90 * SIGNAL_SEEDS.count());
     assert!(s.iter().all(|k| (-3.0..=-0.3).contains(&k.sigma_per_s)));
     assert!(s.iter().all(|k| (1.2..=2.6).contains(&k.amp_deg)));
     assert!(s.iter().any(|k| k.speed_mps < 2.0) && s.iter().any(|k| k.speed_mps > 5.5));
     let m = simulated();
-    assert_eq!(m.len(), 48);
+    assert_eq!(m.len(), 48 * SIMULATED_SEEDS.count());
     // The model's wobble decays ever more slowly towards the wobble speed.
     assert!(m.iter().all(|k| k.sigma_per_s < 0.0
         && k.speed_mps < kicks::TEST_BIKE_WOBBLE_MPS
@@ -82,8 +92,8 @@ fn accurate_share(scores: &[KickScore]) -> f64 {
 #[test]
 fn at_least_80_percent_of_kicks_are_measured_within_the_goal() {
     // Measured (firmware/docs/detector.md): 83 % of the signal-model kicks
-    // of seeds 1-2 (rings down to -3 1/s, half of them behind a push) and
-    // 94 % of the simulated bicycle's.
+    // of seeds 1-4 (rings down to -3 1/s, half of them behind a push) and
+    // 92 % of the simulated bicycle's of seeds 1-3.
     for (family, scores) in [("signal", signal()), ("simulated", simulated())] {
         let share = accurate_share(scores);
         assert!(share >= 0.8, "{family}: {:.0} %", 100.0 * share);
