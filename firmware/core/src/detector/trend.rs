@@ -64,7 +64,10 @@ impl EnvelopeTrend {
         (self.w, self.k, self.kk, self.y, self.ky) = (0.0, 0.0, 0.0, 0.0, 0.0);
     }
 
-    /// Takes the amplitude of a new analysis, degrees.
+    /// Takes the amplitude of a new analysis, degrees. Out of line: inlined
+    /// into the analysis it moved the board's machine outliner to share
+    /// fragments across the SD driver that the stack bound reads as a cycle.
+    #[inline(never)]
     pub(crate) fn push(&mut self, amp_deg: f32) {
         let l = self.forget;
         let y = libm::logf(amp_deg.max(self.amp_floor_deg));
