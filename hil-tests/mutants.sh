@@ -63,6 +63,9 @@ targets=(
   "line-writer|wobblog|host-tools/src/export/lines.rs|.|--lib --test broken_pipe"
   "event-order|wobblog|host-tools/src/events.rs|TimeOrder|--lib --test events_config"
   "gpx-track|wobblog|host-tools/src/cmd/gpx.rs|.|--test gpx_track --test log_semantics --test broken_pipe"
+  "naming|wobble-model|host-tools/bicycle-model/src/naming.rs|speeds,sway_like,classify|--test naming_grid --test rigid_rider --test sway_mode --test wobble_model --test whipple_benchmark --test bicycleparameters_bicycles"
+  "critical|wobble-model|host-tools/bicycle-model/src/critical.rs|sign,by_newton|--lib"
+  "critical-newton|wobble-model|host-tools/bicycle-model/src/critical/newton.rs|.|--lib"
 )
 
 list=false

@@ -27,11 +27,14 @@ fn sweep_1000(c: &mut Criterion) {
         });
     });
     // The critical speeds alone: bracketed on the sweep and refined by
-    // Brent's method, against solving the pencil (bialternate sum, 91 x 91).
+    // Newton's method, against solving the pencil (bialternate sum, 91 x 91).
     let sweep = Sweep::run(&model, &speeds, |_| {}).unwrap();
-    c.bench_function("wobble model, critical speeds by Brent on the sweep", |b| {
-        b.iter(|| critical_speeds(&model, black_box(&sweep)));
-    });
+    c.bench_function(
+        "wobble model, critical speeds by Newton on the sweep",
+        |b| {
+            b.iter(|| critical_speeds(&model, black_box(&sweep)));
+        },
+    );
     let pencil = model.pencil().unwrap();
     c.bench_function("wobble model, critical speeds from the pencil", |b| {
         b.iter(|| neutral_speeds(black_box(&pencil), (0.0, 10.0)));

@@ -1,11 +1,17 @@
 //! Critical speeds: every sign change of a named mode's real part (weave
-//! speed, capsize speed, wobble speed, ...), bracketed on a sweep's grid,
-//! narrowed by following the branch through the bracket in small steps, and
-//! refined by Brent's method (`roots` crate) on the real part of that branch.
+//! speed, capsize speed, wobble speed, ...), bracketed on a sweep's grid and
+//! refined by Newton's method on the real part of that branch ([`newton`]:
+//! one eigenvalue and its derivative per step, no full solution), then
+//! checked by one full eigenvalue solution to be the same branch. Where
+//! Newton's method fails or the check is in doubt, the branch is followed
+//! through the bracket in small steps and refined by Brent's method
+//! (`roots` crate) instead.
 //!
 //! A real part within round-off of zero has no sign: the zero roots of a
 //! model at standstill (tyre lags, `v` and `r` at u = 0) never make a
 //! critical speed.
+
+mod newton;
 
 use nalgebra::{Complex, DMatrix};
 use roots::{find_root_brent, SimpleConvergency};
@@ -49,14 +55,17 @@ fn mode_name<S: serde::Serializer>(m: &Mode, s: S) -> Result<S::Ok, S::Error> {
     s.serialize_str(m.name())
 }
 
-/// Brent's tolerance on speed, m/s.
+/// Tolerance on a critical speed, m/s: Brent's, and Newton's last step.
 const SPEED_TOL_MPS: f64 = 1e-13;
 /// Steps a bracket is followed in before Brent's method.
 const BRACKET_STEPS: usize = 16;
 
 /// The sign of a real part, `0` within round-off of zero.
 fn sign(v: Complex<f64>) -> i8 {
-    if v.re.abs() <= 1e-10 * v.norm().max(1.0) {
+    let re = v.re.abs();
+    // `|v| <= |re| + |im|`: a real part above the bound's share is signed
+    // without the square root, which every value of a sweep would cost.
+    if re <= 1e-10 * (re + v.im.abs()).max(1.0) && re <= 1e-10 * v.norm().max(1.0) {
         0
     } else if v.re > 0.0 {
         1
@@ -168,8 +177,49 @@ impl Brackets {
     }
 }
 
-/// The bracketed sign change, narrowed and refined by Brent's method.
+/// The bracketed sign change, refined: the crossing's speed and eigenvalue.
 fn refine(matrix: &StateMatrix, mode: Mode, bracket: &Bracket) -> Option<CriticalSpeed> {
+    let (u, value) = by_newton(matrix, bracket).or_else(|| by_brent(matrix, bracket))?;
+    let im = value.im.abs();
+    Some(CriticalSpeed {
+        mode,
+        speed_mps: u,
+        unstable_above: bracket.above.1.re > 0.0,
+        im_rad_per_s: if im > REAL_TOL { im } else { 0.0 },
+    })
+}
+
+/// Relative step of the central difference for `dA/du`: exact but for
+/// round-off (about 1e-12 relative) where `A(u)` is at most quadratic in
+/// the speed (the affine pencil, the Whipple model).
+const SLOPE_STEP: f64 = 1e-4;
+
+/// The crossing by Newton's method from the bracket's straight line, kept
+/// only if one full eigenvalue solution there finds Newton's eigenvalue and
+/// finds it the one the line points to without doubt: every other
+/// eigenvalue at least twice as far from the line's value (as
+/// [`crate::track`] decides a step).
+fn by_newton(matrix: &StateMatrix, bracket: &Bracket) -> Option<(f64, Complex<f64>)> {
+    let ((ua, a), (ub, b)) = (bracket.below, bracket.above);
+    let line = |u: f64| a + (b - a) * ((u - ua) / (ub - ua));
+    let start = ua + (ub - ua) * (a.re / (a.re - b.re));
+    let slope = |u: f64| {
+        let h = SLOPE_STEP * u.abs().max(1.0);
+        (matrix(u + h) - matrix(u - h)) / (2.0 * h)
+    };
+    let (u, value) = newton::crossing(matrix, &slope, (ua, ub), (start, line(start)))?;
+    let mut values = eigenvalues(&matrix(u))?;
+    let on_line = line(u);
+    values.sort_by(|x, y| (x - on_line).norm().total_cmp(&(y - on_line).norm()));
+    let (nearest, next) = (*values.first()?, values.get(1).copied());
+    let same = (nearest - value).norm() <= 1e-6 * nearest.norm().max(1.0);
+    let clear = next.is_none_or(|n| (n - on_line).norm() >= 2.0 * (nearest - on_line).norm());
+    (same && clear).then_some((u, nearest))
+}
+
+/// The crossing by following the branch through the bracket in small steps
+/// and Brent's method on the step where its real part changes sign.
+fn by_brent(matrix: &StateMatrix, bracket: &Bracket) -> Option<(f64, Complex<f64>)> {
     let ((ua, a), (ub, b)) = narrow(matrix, bracket.below, bracket.above);
     let at = |u: f64| nearest(matrix, u, a + (b - a) * ((u - ua) / (ub - ua)));
     let mut conv = SimpleConvergency {
@@ -177,18 +227,18 @@ fn refine(matrix: &StateMatrix, mode: Mode, bracket: &Bracket) -> Option<Critica
         max_iter: 200,
     };
     let u = find_root_brent(ua, ub, |u| at(u).re, &mut conv).ok()?;
-    let im = at(u).im.abs();
-    Some(CriticalSpeed {
-        mode,
-        speed_mps: u,
-        unstable_above: b.re > 0.0,
-        im_rad_per_s: if im > REAL_TOL { im } else { 0.0 },
-    })
+    Some((u, at(u)))
 }
 
 /// Every sign change of the real part of a named mode within the sweep.
 #[must_use]
 pub fn critical_speeds(model: &Model, sweep: &Sweep) -> Vec<CriticalSpeed> {
+    let modes: Vec<Mode> = sweep.branches.iter().map(|b| b.mode).collect();
+    brackets_of(sweep).refine(model, &modes)
+}
+
+/// The sign changes of every branch of `sweep`.
+fn brackets_of(sweep: &Sweep) -> Brackets {
     let mut brackets = Brackets::default();
     let mut values = Vec::with_capacity(sweep.branches.len());
     for (k, &u) in sweep.speeds_mps.iter().enumerate() {
@@ -196,6 +246,94 @@ pub fn critical_speeds(model: &Model, sweep: &Sweep) -> Vec<CriticalSpeed> {
         values.extend(sweep.branches.iter().map(|b| b.values[k]));
         brackets.add(u, &values);
     }
-    let modes: Vec<Mode> = sweep.branches.iter().map(|b| b.mode).collect();
-    brackets.refine(model, &modes)
+    brackets
+}
+
+#[cfg(test)]
+mod tests {
+    use std::path::Path;
+
+    use nalgebra::DVector;
+    use proptest::prelude::*;
+
+    use super::*;
+    use crate::model::StateRole;
+    use crate::params::ParamSet;
+
+    /// The companion matrix of `l^3 + c2 l^2 + c1 l + c0`.
+    fn companion(c2: f64, c1: f64, c0: f64) -> DMatrix<f64> {
+        DMatrix::from_row_slice(3, 3, &[0.0, 1.0, 0.0, 0.0, 0.0, 1.0, -c0, -c1, -c2])
+    }
+
+    fn brackets(matrix: &StateMatrix, speeds: &[f64]) -> Vec<Bracket> {
+        let n = matrix(0.0).nrows();
+        let sweep = Sweep::run_matrices(matrix, &vec![StateRole::Rate; n], speeds, |_| {}).unwrap();
+        brackets_of(&sweep).found
+    }
+
+    proptest! {
+        /// `l^3 + c u l^2 + c1 l + c0` has its Hopf point where the Hurwitz
+        /// determinant `c u c1 - c0` is zero, at `u = c0 / (c c1)`, with
+        /// roots `+-i sqrt(c1)` (and `-c u`): Newton's method finds it on
+        /// any grid of 20 or more speeds, to round-off.
+        #[test]
+        fn newton_puts_a_cubics_hopf_point_where_hurwitz_does(
+            c in 0.5..2.0f64, c1 in 0.5..4.0f64, c0 in 0.5..4.0f64,
+            speeds in 20..400usize, offset in 0.0..1.0f64,
+        ) {
+            let hopf = c0 / (c * c1);
+            let step = 2.0 * hopf / speeds as f64;
+            let grid: Vec<f64> = (0..=speeds).map(|i| (i as f64 + offset) * step).collect();
+            let matrix = |u: f64| companion(c * u, c1, c0);
+            let found = brackets(&matrix, &grid);
+            prop_assert_eq!(found.len(), 1, "{:?}", found);
+            let (u, value) = by_newton(&matrix, &found[0]).expect("refined by Newton's method");
+            prop_assert!((u - hopf).abs() < 1e-12 * hopf.max(1.0), "{} against {}", u, hopf);
+            prop_assert!((value - Complex::new(0.0, c1.sqrt())).norm() < 1e-10, "{}", value);
+            let critical = refine(&matrix, Mode::Weave, &found[0]).unwrap();
+            prop_assert!(!critical.unstable_above);
+            prop_assert_eq!(critical.kind(), "oscillatory");
+        }
+    }
+
+    /// Two real roots through zero, `u^2 - 1` and `u^2 - 0.98`, on a grid
+    /// too coarse for a straight line between them: at the first one's
+    /// crossing the line points at the second, so Newton's result is
+    /// rejected and the branch is followed through the bracket instead.
+    #[test]
+    fn a_crossing_the_line_does_not_point_to_is_followed_through_the_bracket() {
+        let matrix =
+            |u: f64| DMatrix::from_diagonal(&DVector::from_vec(vec![u * u - 1.0, u * u - 0.98]));
+        let found = brackets(&matrix, &[0.5, 1.5]);
+        let first = found.iter().find(|b| b.below.1.re == -0.75).unwrap();
+        assert_eq!(by_newton(&matrix, first), None);
+        let critical = refine(&matrix, Mode::Capsize, first).unwrap();
+        assert!((critical.speed_mps - 1.0).abs() < 1e-13, "{critical:?}");
+        assert!(critical.unstable_above);
+        assert_eq!(critical.kind(), "real");
+    }
+
+    /// On the test bicycle's 1000-speed sweep every crossing is refined by
+    /// Newton's method, to the speed the branch followed in small steps and
+    /// Brent's method give.
+    #[test]
+    fn the_test_bicycles_crossings_take_newtons_method() {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("params/test-bicycle.toml");
+        let model = Model::from_set(&ParamSet::load(&path).unwrap()).unwrap();
+        let speeds: Vec<f64> = (0..1000).map(|i| f64::from(i) * 0.01).collect();
+        let sweep = Sweep::run(&model, &speeds, |_| {}).unwrap();
+        let matrix = matrix_of(&model);
+        let named: Vec<Bracket> = brackets_of(&sweep)
+            .found
+            .into_iter()
+            .filter(|b| sweep.branches[b.branch].mode != Mode::Other)
+            .collect();
+        assert!(named.len() >= 2, "{named:?}");
+        for b in &named {
+            let (u, value) = by_newton(&*matrix, b).expect("refined by Newton's method");
+            let (ub, vb) = by_brent(&*matrix, b).unwrap();
+            assert!((u - ub).abs() < 1e-11, "{u} against Brent's {ub}");
+            assert!((value - vb).norm() < 1e-9, "{value} against Brent's {vb}");
+        }
+    }
 }

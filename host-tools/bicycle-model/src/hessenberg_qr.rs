@@ -38,26 +38,12 @@ impl Square {
     }
 
     /// Applies `I - tau v v^T` (`v[0] = 1`, `v.len()` rows from `r0`) from
-    /// the left to columns `cols`. Inlined, so that a reflector of a length
-    /// known where it is called (the QR steps' 3 and 2) is unrolled and done
-    /// a column at a time; a long one (the reduction's) goes a row at a time
-    /// through `work`, contiguous, so that its loops vectorise.
-    #[inline(always)]
+    /// the left to columns `cols`, a row at a time through `work`,
+    /// contiguous, so that its loops vectorise (the reduction's long
+    /// reflectors; the QR steps' short ones go through
+    /// [`Square::reflect_short_rows`]).
     fn reflect_rows(&mut self, r0: usize, v: &[f64], tau: f64, cols: std::ops::Range<usize>) {
         let n = self.n;
-        if v.len() <= 3 {
-            for j in cols {
-                let mut s = 0.0;
-                for (k, vk) in v.iter().enumerate() {
-                    s += vk * self.a[(r0 + k) * n + j];
-                }
-                s *= tau;
-                for (k, vk) in v.iter().enumerate() {
-                    self.a[(r0 + k) * n + j] -= s * vk;
-                }
-            }
-            return;
-        }
         let w = &mut self.work[cols.clone()];
         w.fill(0.0);
         for (k, vk) in v.iter().enumerate() {
@@ -75,18 +61,74 @@ impl Square {
         }
     }
 
+    /// [`Square::reflect_rows`] for a reflector of `N` rows (the QR steps'
+    /// 3 and 2), in one pass over the columns: the rows are split off once,
+    /// each cut to the columns' length, so that the loop has no index
+    /// arithmetic and no bounds checks left.
+    #[inline(always)]
+    fn reflect_short_rows<const N: usize>(
+        &mut self,
+        r0: usize,
+        v: &[f64; N],
+        tau: f64,
+        cols: std::ops::Range<usize>,
+    ) {
+        let n = self.n;
+        let len = cols.len();
+        let mut rest = &mut self.a[r0 * n..];
+        let mut rows: [&mut [f64]; N] = std::array::from_fn(|_| {
+            let (row, tail) = std::mem::take(&mut rest).split_at_mut(n);
+            rest = tail;
+            &mut row[cols.clone()][..len]
+        });
+        if let ([top, middle, bottom], [_, v1, v2]) = (rows.as_mut_slice(), v.as_slice()) {
+            return reflect_three_rows(top, middle, bottom, *v1, *v2, tau);
+        }
+        for j in 0..len {
+            let mut s = 0.0;
+            for (row, vk) in rows.iter().zip(v) {
+                s += vk * row[j];
+            }
+            s *= tau;
+            for (row, vk) in rows.iter_mut().zip(v) {
+                row[j] -= s * vk;
+            }
+        }
+    }
+
     /// Applies `I - tau v v^T` from the right to rows `rows`, columns
     /// `c0..c0 + v.len()`.
     #[inline(always)]
     fn reflect_cols(&mut self, c0: usize, v: &[f64], tau: f64, rows: std::ops::Range<usize>) {
         let n = self.n;
-        for i in rows {
-            let row = &mut self.a[i * n + c0..i * n + c0 + v.len()];
+        let cols = c0..c0 + v.len();
+        for row in self.a[rows.start * n..rows.end * n].chunks_exact_mut(n) {
+            let row = &mut row[cols.clone()];
             let s = tau * row.iter().zip(v).map(|(x, y)| x * y).sum::<f64>();
             for (x, y) in row.iter_mut().zip(v) {
                 *x -= s * y;
             }
         }
+    }
+}
+
+/// `I - tau v v^T`, `v = (1, v1, v2)`, applied to the columns of three rows.
+/// Not inlined: as a function's own arguments the rows are known not to
+/// overlap, so that the vectorised loop needs no overlap checks.
+#[inline(never)]
+fn reflect_three_rows(
+    top: &mut [f64],
+    middle: &mut [f64],
+    bottom: &mut [f64],
+    v1: f64,
+    v2: f64,
+    tau: f64,
+) {
+    for ((x, y), z) in top.iter_mut().zip(middle.iter_mut()).zip(bottom.iter_mut()) {
+        let s = tau * (*x + v1 * *y + v2 * *z);
+        *x -= s;
+        *y -= s * v1;
+        *z -= s * v2;
     }
 }
 
@@ -205,15 +247,58 @@ fn chase<const N: usize>(h: &mut Square, l: usize, en: usize, k: usize, v: &mut 
         }
     }
     // Eigenvalues only: nothing outside the active block is needed.
-    h.reflect_rows(k, v, tau, k..en + 1);
+    h.reflect_short_rows(k, v, tau, k..en + 1);
     h.reflect_cols(k, v, tau, l..(k + 4).min(en + 1));
+}
+
+/// Approximate eigenvalues offered as shifts, each used at most once: the
+/// first step after a deflation shifts by the one nearest the bottom of the
+/// active block (with its conjugate, or with the nearest other real one),
+/// and each eigenvalue found takes its nearest out. A close guess (the
+/// previous speed's eigenvalue, extrapolated) makes that step converge at
+/// once, where the block's own shifts need a step or two to get close; any
+/// other guess is only a poorer shift, so the result does not depend on it.
+struct Guesses(Vec<Complex<f64>>);
+
+impl Guesses {
+    /// The index of the guess nearest `z` of those `keep` passes.
+    fn nearest(&self, z: Complex<f64>, keep: impl Fn(usize) -> bool) -> Option<usize> {
+        let d = |k: usize| (self.0[k] - z).norm_sqr();
+        (0..self.0.len())
+            .filter(|&k| keep(k))
+            .min_by(|&a, &b| d(a).total_cmp(&d(b)))
+    }
+
+    /// Takes out the guess of the eigenvalue `z`, found.
+    fn found(&mut self, z: Complex<f64>) {
+        if let Some(k) = self.nearest(z, |_| true) {
+            self.0.swap_remove(k);
+        }
+    }
+
+    /// The trace and determinant of the shifts for a block whose bottom
+    /// diagonal entry is `bottom` (not taken out: their eigenvalues are).
+    fn shifts(&self, bottom: f64) -> Option<(f64, f64)> {
+        let k = self.nearest(Complex::new(bottom, 0.0), |_| true)?;
+        let g = self.0[k];
+        if g.im != 0.0 {
+            return Some((2.0 * g.re, g.norm_sqr()));
+        }
+        // A real guess goes with the real guess nearest to it.
+        let other = self
+            .nearest(g, |j| j != k && self.0[j].im == 0.0)
+            .map_or(g.re, |j| self.0[j].re);
+        Some((g.re + other, g.re * other))
+    }
 }
 
 /// The eigenvalues of `a` (finite entries), in the order they appear on the
 /// diagonal of its real Schur form, a pair with the positive imaginary part
 /// first; `None` if the iteration did not converge within its bound.
+/// `guesses`, approximations of them (or none), serve as first shifts
+/// ([`Guesses`]): they change the number of steps, not the result.
 #[must_use]
-pub fn eigenvalues(a: &DMatrix<f64>) -> Option<Vec<Complex<f64>>> {
+pub fn eigenvalues(a: &DMatrix<f64>, guesses: &[Complex<f64>]) -> Option<Vec<Complex<f64>>> {
     let n = a.nrows();
     // A power of two near the largest entry: scaling by it is exact.
     let largest = a.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
@@ -224,9 +309,16 @@ pub fn eigenvalues(a: &DMatrix<f64>) -> Option<Vec<Complex<f64>>> {
     };
     let mut h = Square {
         n,
-        a: (0..n * n).map(|k| a[(k / n, k % n)] / scale).collect(),
+        a: vec![0.0; n * n],
         work: vec![0.0; n],
     };
+    // Row-major from nalgebra's columns.
+    for (j, column) in a.as_slice().chunks_exact(n.max(1)).enumerate() {
+        for (i, x) in column.iter().enumerate() {
+            h.a[i * n + j] = x / scale;
+        }
+    }
+    let mut guesses = Guesses(guesses.iter().map(|g| g / scale).collect());
     hessenberg(&mut h);
     let mut out = vec![Complex::new(0.0, 0.0); n];
     let mut budget = ITERATIONS_PER_ROW * n.max(10);
@@ -237,6 +329,7 @@ pub fn eigenvalues(a: &DMatrix<f64>) -> Option<Vec<Complex<f64>>> {
         let l = block_start(&mut h, en);
         if l == en {
             out[en] = Complex::new(h.at(en, en), 0.0);
+            guesses.found(out[en]);
             end -= 1;
             its = 0;
             continue;
@@ -245,6 +338,8 @@ pub fn eigenvalues(a: &DMatrix<f64>) -> Option<Vec<Complex<f64>>> {
             let pair = block_2x2(h.at(l, l), h.at(l, en), h.at(en, l), h.at(en, en));
             out[l] = pair[0];
             out[en] = pair[1];
+            guesses.found(pair[0]);
+            guesses.found(pair[1]);
             end -= 2;
             its = 0;
             continue;
@@ -254,7 +349,14 @@ pub fn eigenvalues(a: &DMatrix<f64>) -> Option<Vec<Complex<f64>>> {
         }
         budget -= 1;
         its += 1;
-        let (tr, det) = if its % EXCEPTIONAL_EVERY == 0 {
+        let guessed = if its == 1 {
+            guesses.shifts(h.at(en, en))
+        } else {
+            None
+        };
+        let (tr, det) = if let Some(shifts) = guessed {
+            shifts
+        } else if its % EXCEPTIONAL_EVERY == 0 {
             // An ad hoc shift (`dlahqr`'s) breaks a cycle of the standard one.
             let s = h.at(en, en - 1).abs() + h.at(en - 1, en - 2).abs();
             let d = 0.75 * s + h.at(en, en);
@@ -313,16 +415,16 @@ mod tests {
     fn small_matrices_with_known_eigenvalues() {
         // A rotation-and-scale block, a real pair, and a Jordan-free triangle.
         let a = DMatrix::from_row_slice(2, 2, &[1.0, -2.0, 2.0, 1.0]);
-        let mut e = eigenvalues(&a).unwrap();
+        let mut e = eigenvalues(&a, &[]).unwrap();
         e.sort_by(|x, y| x.im.total_cmp(&y.im));
         assert_eq!(e, [Complex::new(1.0, -2.0), Complex::new(1.0, 2.0)]);
         let b = DMatrix::from_row_slice(3, 3, &[2.0, 1.0, 5.0, 0.0, -3.0, 7.0, 0.0, 0.0, 0.5]);
-        let mut e: Vec<f64> = eigenvalues(&b).unwrap().iter().map(|c| c.re).collect();
+        let mut e: Vec<f64> = eigenvalues(&b, &[]).unwrap().iter().map(|c| c.re).collect();
         e.sort_by(f64::total_cmp);
         assert_eq!(e, [-3.0, 0.5, 2.0]);
-        assert_eq!(eigenvalues(&DMatrix::zeros(0, 0)).unwrap(), []);
+        assert_eq!(eigenvalues(&DMatrix::zeros(0, 0), &[]).unwrap(), []);
         assert_eq!(
-            eigenvalues(&DMatrix::zeros(4, 4)).unwrap(),
+            eigenvalues(&DMatrix::zeros(4, 4), &[]).unwrap(),
             [Complex::new(0.0, 0.0); 4]
         );
     }
@@ -351,7 +453,7 @@ mod tests {
                 0.0
             }
         });
-        let got = eigenvalues(&a).unwrap();
+        let got = eigenvalues(&a, &[]).unwrap();
         let want: Vec<Complex<f64>> = roots.iter().map(|&r| Complex::new(r, 0.0)).collect();
         assert!(worst_distance(&got, &want, 8.0) < 1e-9);
     }
@@ -362,7 +464,7 @@ mod tests {
     fn a_cyclic_permutation_converges_to_the_unit_roots() {
         let n = 6;
         let a = DMatrix::from_fn(n, n, |i, j| if (j + 1) % n == i { 1.0 } else { 0.0 });
-        let got = eigenvalues(&a).unwrap();
+        let got = eigenvalues(&a, &[]).unwrap();
         let want: Vec<Complex<f64>> = (0..n)
             .map(|k| Complex::from_polar(1.0, 2.0 * std::f64::consts::PI * k as f64 / n as f64))
             .collect();
@@ -381,14 +483,39 @@ mod tests {
             let s = 10f64.powi(scale_exp);
             let a = DMatrix::from_fn(n, n, |i, j| s * entries[i * 16 + j]);
             let norm = a.norm();
-            let got = eigenvalues(&a).unwrap();
+            let got = eigenvalues(&a, &[]).unwrap();
             let d = worst_distance(&got, &reference(&a), norm);
             prop_assert!(d < 1e-10, "n = {}: {:e}", n, d);
         }
 
+        /// Guesses change the steps, not the result: near ones (the true
+        /// eigenvalues moved by up to 1e-3 of the norm), far ones and too
+        /// few of them all give nalgebra's eigenvalues.
+        #[test]
+        fn any_guesses_give_the_same_eigenvalues(
+            n in 1..=16usize,
+            entries in proptest::collection::vec(-1.0e3..1.0e3f64, 256),
+            moves in proptest::collection::vec((-1.0..1.0f64, -1.0..1.0f64), 16),
+            kind in 0..3usize,
+        ) {
+            let a = DMatrix::from_fn(n, n, |i, j| entries[i * 16 + j]);
+            let norm = a.norm();
+            let want = reference(&a);
+            let guesses: Vec<Complex<f64>> = match kind {
+                0 => want.iter().zip(&moves).map(|(w, m)| w + Complex::new(m.0, m.1) * 1e-3 * norm).collect(),
+                1 => moves.iter().map(|m| Complex::new(m.0, m.1) * norm).collect(),
+                _ => want.iter().take(n / 2).copied().collect(),
+            };
+            let got = eigenvalues(&a, &guesses).unwrap();
+            let d = worst_distance(&got, &want, norm);
+            prop_assert!(d < 1e-10, "n = {}, guesses of kind {}: {:e}", n, kind, d);
+        }
+
         /// The wobble model's state matrices, with the tense and the passive
         /// rider and the light rider, at any speed: nalgebra's eigenvalues,
-        /// each to 1e-10 of its own size (or of 1/s near zero).
+        /// each to 1e-10 of its own size (or of 1/s near zero), with no
+        /// guesses and with the eigenvalues 0.01 m/s below as guesses (a
+        /// sweep's).
         #[test]
         fn model_matrices_match_nalgebra(
             file in proptest::sample::select(vec![
@@ -401,8 +528,10 @@ mod tests {
             let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("params").join(file);
             let model = crate::Model::from_set(&crate::ParamSet::load(&path).unwrap()).unwrap();
             let a = model.state_matrix(u);
-            let got = eigenvalues(&a).unwrap();
+            let below = eigenvalues(&model.state_matrix(u - 0.01), &[]).unwrap();
             let want = reference(&a);
+            let mut got = eigenvalues(&a, &[]).unwrap();
+            got.extend(eigenvalues(&a, &below).unwrap());
             for g in &got {
                 let d = want.iter().map(|w| (w - g).norm() / w.norm().max(1.0)).fold(f64::INFINITY, f64::min);
                 prop_assert!(d < 1e-10, "{} at {} m/s: {} off by {:e}", file, u, g, d);

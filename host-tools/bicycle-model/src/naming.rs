@@ -13,15 +13,17 @@
 //! A mode's participation is the mean over its branches and those speeds.
 //!
 //! - the mode with the largest torso share (at least [`LEAN_MIN_TORSO`]) is
-//!   `lean`: a tense rider's lean oscillation carries much steer, but it is
-//!   not the wobble;
+//!   `lean`, the upper body rolling on the hip: a tense rider's lean
+//!   oscillation carries much steer, but it is not the wobble; on a rigid
+//!   rider (a hip of 12 000 N m/rad and more on the first test bicycle) it
+//!   is the upper body against the frame at 19-31 Hz, mostly tyre lags;
 //! - beside that lean, any other oscillation at 2 Hz or more on average with
-//!   roll or torso its largest angle and the tyre lags at least
-//!   [`SWAY_MIN_TYRE`] of it is the `sway`: the main frame rolling and
-//!   sliding sideways on the tyres' lateral compliance (mostly the rear
-//!   tyre's, whose cornering stiffness sets its frequency), the upper body
-//!   rolling against it on the hip (with no lean, a hip so stiff that no
-//!   mode has that torso share, the pair keeps the name `lean` below);
+//!   the tyre lags at least [`SWAY_MIN_TYRE`] of it and the twist not its
+//!   largest angle is the `sway`: the main frame rolling and sliding
+//!   sideways on the tyres' lateral compliance (mostly the rear tyre's,
+//!   whose cornering stiffness sets its frequency), under an upper body the
+//!   hip holds, or, on a rigid rider, with the upper body rolling along
+//!   (its steer then more than its roll);
 //! - tyre lags more than [`TYRE_DOMINANCE`] times its largest angle: `other`;
 //! - torso the largest angle: `lean`; twist: `twist`;
 //! - roll or steer the largest, oscillating somewhere, with at least
@@ -35,6 +37,14 @@
 //! - steer the largest and below 2 Hz, not the weave: the fastest decaying is
 //!   `castering`;
 //! - anything else `other`.
+//!
+//! The names are taken on a reference sweep, [`REFERENCE_STEP_MPS`] apart
+//! from 0 to [`REFERENCE_TOP_MPS`] (the model's natural range, where the
+//! weave still has its low-speed form), whatever speeds were asked for:
+//! the reference speeds are followed together with the asked ones
+//! ([`speeds`]), so each branch at the asked speeds is a branch of the
+//! reference sweep and carries its name. A single speed, a short or high
+//! range or a coarse grid names each eigenvalue as the 0-14 m/s sweep does.
 
 use nalgebra::{Complex, DMatrix};
 
@@ -45,8 +55,9 @@ use crate::sweep::{Mode, REAL_TOL};
 /// Share of the speeds over which two branches are conjugate to be one
 /// mode, and over which a mode is complex to oscillate.
 pub const OSCILLATING_SHARE: f64 = 0.25;
-/// The mode with the largest torso share is the lean if it has this much.
-pub const LEAN_MIN_TORSO: f64 = 0.1;
+/// The mode with the largest torso share is the lean if it has this much
+/// (a rigid rider's lean: 0.02 at 5 m/s at 50 000 N m/rad).
+pub const LEAN_MIN_TORSO: f64 = 0.01;
 /// Speeds at which eigenvectors are computed.
 pub const SAMPLES: usize = 16;
 /// A mode whose tyre lags are this many times its largest angle is a tyre mode.
@@ -57,6 +68,60 @@ pub const SWAY_MIN_TYRE: f64 = 0.5;
 pub const WEAVE_MIN_ROLL_PER_STEER: f64 = 0.2;
 /// Wobble is faster than this on average, rad/s (2 Hz).
 pub const WOBBLE_MIN_RAD_S: f64 = 4.0 * std::f64::consts::PI;
+/// The reference sweep names are taken on: 0 to this, m/s.
+pub const REFERENCE_TOP_MPS: f64 = 14.0;
+/// The reference sweep's step, m/s (the tracking halves it where in doubt).
+pub const REFERENCE_STEP_MPS: f64 = 0.5;
+/// The reference sweep's number of speeds.
+const REFERENCE_SPEEDS: usize = 1 + (REFERENCE_TOP_MPS / REFERENCE_STEP_MPS) as usize;
+
+/// One speed a sweep evaluates.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Speed {
+    /// m/s.
+    pub(crate) u: f64,
+    /// Its index among the asked speeds, if asked.
+    pub(crate) asked: Option<usize>,
+    /// Whether it is a speed of the reference sweep.
+    pub(crate) reference: bool,
+}
+
+/// The speeds a sweep over `asked` (increasing) evaluates, increasing: the
+/// asked ones and the reference sweep's, a reference speed within 1e-9 m/s
+/// of an asked one being that one (lazily: memory does not grow with the
+/// number of speeds).
+pub(crate) fn speeds(asked: &[f64]) -> impl Iterator<Item = Speed> + '_ {
+    let reference = |i: usize| (i < REFERENCE_SPEEDS).then_some(i as f64 * REFERENCE_STEP_MPS);
+    let (mut a, mut r) = (0, 0);
+    std::iter::from_fn(move || {
+        let next = match (asked.get(a), reference(r)) {
+            (None, None) => return None,
+            (Some(&u), Some(ur)) if (u - ur).abs() <= 1e-9 => Speed {
+                u,
+                asked: Some(a),
+                reference: true,
+            },
+            (Some(&u), Some(ur)) if ur < u => Speed {
+                u: ur,
+                asked: None,
+                reference: true,
+            },
+            (Some(&u), _) => Speed {
+                u,
+                asked: Some(a),
+                reference: false,
+            },
+            (None, Some(ur)) => Speed {
+                u: ur,
+                asked: None,
+                reference: true,
+            },
+        };
+        a += usize::from(next.asked.is_some());
+        r += usize::from(next.reference);
+        Some(next)
+    })
+}
 
 /// Shares of the angles in a mode: roll, steer, torso, twist, tyre.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -115,13 +180,14 @@ impl Group {
             && roll >= WEAVE_MIN_ROLL_PER_STEER * WEAVE_MIN_ROLL_PER_STEER * steer
     }
 
-    /// The frame swaying on the tyres: an oscillation of roll or torso
-    /// carried mostly by the tyre lags.
+    /// The frame swaying on the tyres: an oscillation carried mostly by the
+    /// tyre lags, of any angle but the twist (the steer's, under the roll's
+    /// and the torso's on a tense rider, takes over on a rigid one).
     fn sway_like(&self) -> bool {
         self.oscillates
             && self.freq >= WOBBLE_MIN_RAD_S
             && self.shares.0[4] >= SWAY_MIN_TYRE
-            && matches!(self.largest_angle().0, StateRole::Roll | StateRole::Torso)
+            && self.largest_angle().0 != StateRole::Twist
     }
 
     fn wobble_like(&self) -> bool {
@@ -176,13 +242,25 @@ fn shares_of(vector: &nalgebra::DVector<Complex<f64>>, roles: &[StateRole]) -> S
     Shares(s)
 }
 
+/// The branch whose value is the conjugate of branch `i`'s, to 1e-9 of its
+/// size, if any.
+fn conjugate_partner(values: &[Complex<f64>], i: usize) -> Option<usize> {
+    let v = values[i];
+    let tol = (1e-9 * v.norm().max(1.0)).powi(2);
+    (0..values.len())
+        .filter(|&j| j != i)
+        .map(|j| (j, (values[j] - v.conj()).norm_sqr()))
+        .min_by(|a, b| a.1.total_cmp(&b.1))
+        .filter(|&(_, d)| d <= tol)
+        .map(|(j, _)| j)
+}
+
 /// What naming needs of a sweep, gathered one speed at a time (so that a
 /// sweep need not be held whole): per branch its mean participation at the
 /// sample speeds and sums of its values, per pair of branches the speeds
 /// at which they are conjugates.
 pub(crate) struct Stats {
     roles: Vec<StateRole>,
-    speeds: usize,
     samples: Vec<usize>,
     /// Speeds added so far.
     k: usize,
@@ -199,13 +277,11 @@ pub(crate) struct Stats {
 }
 
 impl Stats {
-    /// Statistics of a sweep of `speeds` speeds, of a model with states of
-    /// `roles`.
-    pub(crate) fn new(speeds: usize, roles: &[StateRole]) -> Self {
+    /// Statistics of the reference sweep of a model with states of `roles`.
+    pub(crate) fn new(roles: &[StateRole]) -> Self {
         Self {
             roles: roles.to_vec(),
-            speeds,
-            samples: sample_indices(speeds),
+            samples: sample_indices(REFERENCE_SPEEDS),
             k: 0,
             branches: 0,
             shares: Vec::new(),
@@ -217,7 +293,7 @@ impl Stats {
         }
     }
 
-    /// Adds the branches' `values` at the next speed `u`; `state_matrix`
+    /// Adds the branches' `values` at the next reference speed `u`; `state_matrix`
     /// gives the matrix whose eigenvectors are taken at the sample speeds.
     pub(crate) fn add(
         &mut self,
@@ -238,9 +314,20 @@ impl Stats {
         if self.samples.binary_search(&self.k).is_ok() {
             let a = state_matrix(u);
             let weight = 1.0 / self.samples.len() as f64;
-            for (v, s) in values.iter().zip(self.shares.iter_mut()) {
-                let got = shares_of(&eigenvector(&a, *v), &self.roles);
-                for (x, y) in s.0.iter_mut().zip(got.0) {
+            // The lower member of a pair has its partner's shares (its
+            // eigenvector is the conjugate): one inverse iteration per pair.
+            let mut got: Vec<Option<Shares>> = vec![None; n];
+            for i in (0..n).filter(|&i| values[i].im >= 0.0) {
+                got[i] = Some(shares_of(&eigenvector(&a, values[i]), &self.roles));
+            }
+            for i in 0..n {
+                let shares = match got[i] {
+                    Some(shares) => shares,
+                    None => conjugate_partner(values, i)
+                        .and_then(|j| got[j])
+                        .unwrap_or_else(|| shares_of(&eigenvector(&a, values[i]), &self.roles)),
+                };
+                for (x, y) in self.shares[i].0.iter_mut().zip(shares.0) {
                     *x += y * weight;
                 }
             }
@@ -255,13 +342,7 @@ impl Stats {
             if v.im <= REAL_TOL {
                 continue;
             }
-            let tol = (1e-9 * v.norm().max(1.0)).powi(2);
-            let partner = (0..n)
-                .filter(|&j| j != i)
-                .map(|j| (j, (values[j] - v.conj()).norm_sqr()))
-                .min_by(|a, b| a.1.total_cmp(&b.1))
-                .filter(|&(_, d)| d <= tol);
-            if let Some((j, _)) = partner {
+            if let Some(j) = conjugate_partner(values, i) {
                 self.conjugate[i * n + j] += 1;
             }
         }
@@ -275,7 +356,7 @@ impl Stats {
         let mut parent: Vec<usize> = (0..n).collect();
         for i in 0..n {
             for j in 0..n {
-                if self.conjugate[i * n + j] as f64 >= OSCILLATING_SHARE * self.speeds as f64 {
+                if self.conjugate[i * n + j] as f64 >= OSCILLATING_SHARE * REFERENCE_SPEEDS as f64 {
                     let (a, b) = (find(&mut parent, i), find(&mut parent, j));
                     parent[a] = b;
                 }
@@ -298,7 +379,7 @@ impl Stats {
 
     /// The mode of each branch.
     pub(crate) fn modes(&self) -> Vec<Mode> {
-        let n = self.speeds;
+        let n = REFERENCE_SPEEDS;
         let groups: Vec<Group> = self
             .conjugate_groups()
             .into_iter()
@@ -330,7 +411,7 @@ impl Stats {
 fn classify(groups: &[Group], branches: usize) -> Vec<Mode> {
     let lean = pick(
         groups,
-        |g| !g.tyre_only() && g.share(StateRole::Torso) >= LEAN_MIN_TORSO,
+        |g| g.share(StateRole::Torso) >= LEAN_MIN_TORSO,
         |g| g.share(StateRole::Torso),
     );
     // The lean is neither weave nor wobble.
@@ -360,10 +441,10 @@ fn classify(groups: &[Group], branches: usize) -> Vec<Mode> {
     let mut modes = vec![Mode::Other; branches];
     for (i, g) in groups.iter().enumerate() {
         let mode = match g.largest_angle().0 {
-            _ if lean.is_some_and(|l| l != i) && g.sway_like() => Mode::Sway,
+            _ if Some(i) == lean => Mode::Lean,
+            _ if lean.is_some() && g.sway_like() => Mode::Sway,
             _ if g.tyre_only() => Mode::Other,
             StateRole::Torso => Mode::Lean,
-            _ if Some(i) == lean => Mode::Lean,
             StateRole::Twist => Mode::Twist,
             _ if Some(i) == weave => Mode::Weave,
             _ if Some(i) == wobble => Mode::Wobble,
@@ -390,4 +471,41 @@ fn pick(
         .filter(|(_, g)| keep(g))
         .max_by(|a, b| score(a.1).total_cmp(&score(b.1)))
         .map(|(i, _)| i)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A 0.1 m/s grid from 0 holds the reference speeds up to round-off
+    /// (`15.0 * 0.1` is 1.5000000000000002): every fifth speed is both, and
+    /// nothing is evaluated twice.
+    #[test]
+    fn reference_speeds_on_an_asked_grid_are_the_asked_ones() {
+        let asked: Vec<f64> = (0..=140).map(|i| f64::from(i) * 0.1).collect();
+        let got: Vec<Speed> = speeds(&asked).collect();
+        assert_eq!(got.len(), 141);
+        for (k, s) in got.iter().enumerate() {
+            assert_eq!((s.u, s.asked), (asked[k], Some(k)));
+            assert_eq!(s.reference, k % 5 == 0, "{} m/s", s.u);
+        }
+    }
+
+    /// Asked speeds off the reference grid and beyond it come in order
+    /// between the 29 reference speeds (0, 0.5, ..., 14 m/s).
+    #[test]
+    fn asked_speeds_off_the_reference_grid_are_merged_in_order() {
+        let got: Vec<Speed> = speeds(&[3.3, 20.0]).collect();
+        assert_eq!(got.len(), 31);
+        assert!(got.windows(2).all(|w| w[0].u < w[1].u));
+        let asked: Vec<(usize, f64)> = got
+            .iter()
+            .filter_map(|s| s.asked.map(|k| (k, s.u)))
+            .collect();
+        assert_eq!(asked, [(0, 3.3), (1, 20.0)]);
+        let reference: Vec<f64> = got.iter().filter(|s| s.reference).map(|s| s.u).collect();
+        assert_eq!(reference.len(), 29);
+        assert_eq!((reference[7], reference[28]), (3.5, 14.0));
+        assert!(got.iter().all(|s| s.reference != s.asked.is_some()));
+    }
 }

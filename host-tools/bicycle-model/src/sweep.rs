@@ -1,16 +1,17 @@
 //! Eigenvalues against speed, followed continuously from one speed to the
 //! next ([`crate::track`]: eigenvalues only) and named by mode from their
-//! participation over the whole speed range ([`crate::naming`]: eigenvectors
-//! at a few speeds).
+//! participation over a reference sweep from 0 to 14 m/s followed with the
+//! asked speeds ([`crate::naming`]: eigenvectors at a few speeds), so the
+//! names do not depend on the speeds asked for.
 
 use std::fmt;
 
 use nalgebra::{Complex, DMatrix};
 
 use crate::critical::{Brackets, CriticalSpeed};
-use crate::eig::eigenvalues;
+use crate::eig::eigenvalues_near;
 use crate::model::{Model, StateRole};
-use crate::naming::Stats;
+use crate::naming::{self, Speed, Stats};
 use crate::track::Tracker;
 
 /// The name of a mode.
@@ -116,8 +117,12 @@ impl Sweep {
         mut progress: impl FnMut(usize),
     ) -> Result<Self, SweepError> {
         let mut values: Vec<Vec<Complex<f64>>> = Vec::new();
-        let mut stats = Stats::new(speeds_mps.len(), roles);
-        each_speed(&state_matrix, speeds_mps, |k, u, v| {
+        let mut stats = Stats::new(roles);
+        each_speed(&state_matrix, speeds_mps, |at, v| {
+            if at.reference {
+                stats.add(at.u, v, &state_matrix);
+            }
+            let Some(k) = at.asked else { return };
             if values.is_empty() {
                 values = v
                     .iter()
@@ -127,7 +132,6 @@ impl Sweep {
             for (b, x) in values.iter_mut().zip(v) {
                 b.push(*x);
             }
-            stats.add(u, v, &state_matrix);
             progress(k);
         })?;
         Ok(Self {
@@ -157,20 +161,21 @@ impl Sweep {
     }
 }
 
-/// Tracks the eigenvalues of `state_matrix` over `speeds_mps` (increasing),
+/// Tracks the eigenvalues of `state_matrix` over `speeds_mps` (increasing)
+/// and the reference sweep naming takes its names on ([`naming::speeds`]),
 /// handing each speed's values (always in the same branch order) to `visit`.
 fn each_speed(
     state_matrix: &dyn Fn(f64) -> DMatrix<f64>,
     speeds_mps: &[f64],
-    mut visit: impl FnMut(usize, f64, &[Complex<f64>]),
+    mut visit: impl FnMut(Speed, &[Complex<f64>]),
 ) -> Result<(), SweepError> {
     if speeds_mps.is_empty() {
         return Err(SweepError::NoSpeeds);
     }
-    let eigen = |u: f64| eigenvalues(&state_matrix(u));
+    let eigen = |u: f64, guesses: &[Complex<f64>]| eigenvalues_near(&state_matrix(u), guesses);
     let mut tracker = Tracker::new(&eigen);
-    for (k, &u) in speeds_mps.iter().enumerate() {
-        visit(k, u, tracker.step(u)?);
+    for at in naming::speeds(speeds_mps) {
+        visit(at, tracker.step(at.u)?);
     }
     Ok(())
 }
@@ -202,12 +207,16 @@ impl Survey {
     ) -> Result<Self, SweepError> {
         let roles = model.state_roles();
         let matrix = matrix_of(model);
-        let mut stats = Stats::new(speeds_mps.len(), &roles);
+        let mut stats = Stats::new(&roles);
         let mut brackets = Brackets::default();
-        each_speed(&matrix, speeds_mps, |k, u, v| {
-            stats.add(u, v, &matrix);
-            brackets.add(u, v);
-            progress(k);
+        each_speed(&matrix, speeds_mps, |at, v| {
+            if at.reference {
+                stats.add(at.u, v, &matrix);
+            }
+            if let Some(k) = at.asked {
+                brackets.add(at.u, v);
+                progress(k);
+            }
         })?;
         let modes = stats.modes();
         let critical = brackets.refine(model, &modes);
@@ -229,9 +238,9 @@ impl Survey {
     ) -> Result<(), E> {
         let matrix = matrix_of(model);
         let mut failed = None;
-        each_speed(&matrix, speeds_mps, |_, u, v| {
-            if failed.is_none() {
-                failed = visit(u, v).err();
+        each_speed(&matrix, speeds_mps, |at, v| {
+            if failed.is_none() && at.asked.is_some() {
+                failed = visit(at.u, v).err();
             }
         })?;
         failed.map_or(Ok(()), Err)

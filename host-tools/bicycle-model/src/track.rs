@@ -61,18 +61,23 @@ struct Scratch {
     taken: Vec<bool>,
 }
 
+/// The eigenvalues at a speed, given the branches' predicted values there
+/// (none at the first speed) as the solver's guesses.
+pub(crate) type EigenvaluesAt<'a> = &'a dyn Fn(f64, &[Complex<f64>]) -> Option<Vec<Complex<f64>>>;
+
 /// Eigenvalues followed from speed to speed: [`Tracker::step`] gives the
 /// branches' values at each next speed, always in the same branch order.
 pub(crate) struct Tracker<'a> {
-    eigenvalues: &'a dyn Fn(f64) -> Option<Vec<Complex<f64>>>,
+    eigenvalues: EigenvaluesAt<'a>,
     state: Option<State>,
     scratch: Scratch,
 }
 
 impl<'a> Tracker<'a> {
-    /// A tracker of the eigenvalues `eigenvalues(u)` gives (unordered,
-    /// `None` where they cannot be computed).
-    pub(crate) fn new(eigenvalues: &'a dyn Fn(f64) -> Option<Vec<Complex<f64>>>) -> Self {
+    /// A tracker of the eigenvalues `eigenvalues(u, guesses)` gives
+    /// (unordered, `None` where they cannot be computed; `guesses` are the
+    /// branches' predicted values at `u`, none at the first speed).
+    pub(crate) fn new(eigenvalues: EigenvaluesAt<'a>) -> Self {
         Self {
             eigenvalues,
             state: None,
@@ -80,22 +85,21 @@ impl<'a> Tracker<'a> {
         }
     }
 
-    fn at(&self, u: f64) -> Result<Vec<Complex<f64>>, SweepError> {
-        (self.eigenvalues)(u).ok_or(SweepError::Eigen(u))
+    fn at(&self, u: f64, guesses: &[Complex<f64>]) -> Result<Vec<Complex<f64>>, SweepError> {
+        (self.eigenvalues)(u, guesses).ok_or(SweepError::Eigen(u))
     }
 
     /// The branches' values at `u`, above every speed stepped to before.
     pub(crate) fn step(&mut self, u: f64) -> Result<&[Complex<f64>], SweepError> {
-        let found = self.at(u)?;
         match self.state.take() {
             None => {
                 self.state = Some(State {
                     prev: None,
-                    last: (u, found),
+                    last: (u, self.at(u, &[])?),
                 });
             }
             Some(mut state) => {
-                let done = self.advance(&mut state, u, found, MAX_HALVINGS);
+                let done = self.advance(&mut state, u, None, MAX_HALVINGS);
                 self.state = Some(state);
                 done?;
             }
@@ -103,24 +107,28 @@ impl<'a> Tracker<'a> {
         Ok(self.state.as_ref().map_or(&[], |s| &s.last.1))
     }
 
-    /// Moves `state` to `u`, where the eigenvalues are `found`, halving the
-    /// step while the assignment is in doubt.
+    /// Moves `state` to `u`, where the eigenvalues are `found` (computed
+    /// here, from the predictions, if `None`), halving the step while the
+    /// assignment is in doubt.
     fn advance(
         &mut self,
         state: &mut State,
         u: f64,
-        found: Vec<Complex<f64>>,
+        found: Option<Vec<Complex<f64>>>,
         halvings: u32,
     ) -> Result<(), SweepError> {
         let mut predicted = std::mem::take(&mut self.scratch.predicted);
         state.predict(u, &mut predicted);
+        let found = match found {
+            Some(found) => found,
+            None => self.at(u, &predicted)?,
+        };
         let doubtful = assign(&predicted, &found, &mut self.scratch);
         self.scratch.predicted = predicted;
         if doubtful && halvings > 0 {
             let mid = 0.5 * (state.last.0 + u);
-            let at_mid = self.at(mid)?;
-            self.advance(state, mid, at_mid, halvings - 1)?;
-            return self.advance(state, u, found, halvings - 1);
+            self.advance(state, mid, None, halvings - 1)?;
+            return self.advance(state, u, Some(found), halvings - 1);
         }
         state.push(u, &mut self.scratch.assigned);
         Ok(())

@@ -169,7 +169,7 @@ fn steering_head_damping_stabilises_wobble() {
 fn wobble_keeps_its_name_whatever_the_hip_stiffness() {
     let mut set = bundled("test-bicycle.toml");
     for hip in [
-        500.0, 1000.0, 2000.0, 3000.0, 5000.0, 8000.0, 12000.0, 20000.0,
+        500.0, 1000.0, 2000.0, 3000.0, 5000.0, 8000.0, 12000.0, 20000.0, 30000.0, 50000.0,
     ] {
         set.set_value("hip.stiffness", hip, "test").unwrap();
         let model = Model::from_set(&set).unwrap();
