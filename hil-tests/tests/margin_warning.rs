@@ -14,12 +14,15 @@ use wobble_core::detector::AlertEvent;
 use wobble_core::format::MarginState;
 use wobble_hil::corpus::simulated::campaign::{self, SpeedUp};
 use wobble_hil::corpus::simulated::Simulation;
+use wobble_hil::kick_metrics;
 use wobblog::cmd::detect::Replay;
 
-/// The speed-up ride of bicycle `name` with `seed`, its wobble speed, and
-/// its replay through the board's code.
+/// The speed-up ride of bicycle `name` (of `campaign::variants` or
+/// `campaign::unseen_variants`) with `seed`, its wobble speed, and its
+/// replay through the board's code.
 fn ride(name: &str, seed: u64, config: &Config) -> (Simulation, f64, Replay) {
-    let variants = campaign::variants().expect("variants");
+    let mut variants = campaign::variants().expect("variants");
+    variants.extend(campaign::unseen_variants());
     let variant = variants.iter().find(|v| v.name == name).expect(name);
     let (sim, wobble_speed) =
         campaign::speed_up_ride(variant, &SpeedUp::default(), seed).expect("ride");
@@ -28,57 +31,100 @@ fn ride(name: &str, seed: u64, config: &Config) -> (Simulation, f64, Replay) {
     (sim, wobble_speed, r)
 }
 
-#[test]
-fn the_warning_comes_before_the_wobble_speed() {
+/// Bicycle `name`'s speed-up ride from `seed` warns once, in time, from a
+/// sound lower bound, and ends with an estimate within 15 %.
+fn assert_warned_in_time(name: &str, seed: u64) {
     let config = Config::default();
     let margin = f64::from(config.alert.margin_mps);
-    // The loaded-rack bicycle gets the wobble alert instead (below).
+    let (_, wobble_speed, r) = ride(name, seed, &config);
+    let mps = |v: Option<u16>| f64::from(v.expect("a speed")) / 1000.0;
+    let first_estimate = r
+        .margins
+        .iter()
+        .position(|m| m.record.state == MarginState::Estimate)
+        .unwrap_or_else(|| panic!("{name} {seed}: no estimate"));
+    let warnings: Vec<_> = r
+        .margins
+        .iter()
+        .enumerate()
+        .filter(|(_, m)| m.record.state != MarginState::Estimate)
+        .collect();
+    assert_eq!(warnings.len(), 1, "{name} {seed}: {:?}", r.margins);
+    let (at, warned) = warnings[0];
+    assert_eq!(warned.record.state, MarginState::Approaching);
+    assert!(
+        at > first_estimate,
+        "{name} {seed}: warned before an estimate"
+    );
+    let (speed, lower) = (mps(warned.record.speed_mm_s), mps(warned.record.lower_mm_s));
+    let last = r.margins.last().expect("a record").record;
+    let final_estimate = mps(last.estimate_mm_s.or(last.lower_mm_s));
+    println!(
+        "FIGURES margin warning {name} seed {seed}: warned at {:.1} s, {speed:.2} m/s \
+         ({:.2} of the wobble speed {wobble_speed:.2} m/s, {:.2} m/s before it), lower \
+         bound {lower:.2} m/s; last estimate {final_estimate:.2} m/s ({:+.1} %) from {} \
+         kicks",
+        warned.t_s,
+        speed / wobble_speed,
+        wobble_speed - speed,
+        100.0 * (final_estimate / wobble_speed - 1.0),
+        last.kicks
+    );
+    assert!(lower <= wobble_speed, "{name} {seed}: lower bound {lower}");
+    assert!(
+        speed <= wobble_speed - margin,
+        "{name} {seed}: warned at {speed} m/s"
+    );
+    assert!(
+        (final_estimate / wobble_speed - 1.0).abs() < 0.15,
+        "{name} {seed}: {final_estimate}"
+    );
+}
+
+#[test]
+fn the_warning_comes_before_the_wobble_speed() {
     for name in ["test-bicycle", "light-rider", "head-damping", "rack-load"] {
         for seed in [1, 2] {
-            let (_, wobble_speed, r) = ride(name, seed, &config);
-            let mps = |v: Option<u16>| f64::from(v.expect("a speed")) / 1000.0;
-            let first_estimate = r
-                .margins
-                .iter()
-                .position(|m| m.record.state == MarginState::Estimate)
-                .unwrap_or_else(|| panic!("{name} {seed}: no estimate"));
-            let warnings: Vec<_> = r
-                .margins
-                .iter()
-                .enumerate()
-                .filter(|(_, m)| m.record.state != MarginState::Estimate)
-                .collect();
-            assert_eq!(warnings.len(), 1, "{name} {seed}: {:?}", r.margins);
-            let (at, warned) = warnings[0];
-            assert_eq!(warned.record.state, MarginState::Approaching);
-            assert!(
-                at > first_estimate,
-                "{name} {seed}: warned before an estimate"
-            );
-            let (speed, lower) = (mps(warned.record.speed_mm_s), mps(warned.record.lower_mm_s));
-            let last = r.margins.last().expect("a record").record;
-            let final_estimate = mps(last.estimate_mm_s.or(last.lower_mm_s));
-            println!(
-                "FIGURES margin warning {name} seed {seed}: warned at {:.1} s, {speed:.2} m/s \
-                 ({:.2} of the wobble speed {wobble_speed:.2} m/s, {:.2} m/s before it), lower \
-                 bound {lower:.2} m/s; last estimate {final_estimate:.2} m/s ({:+.1} %) from {} \
-                 kicks",
-                warned.t_s,
-                speed / wobble_speed,
-                wobble_speed - speed,
-                100.0 * (final_estimate / wobble_speed - 1.0),
-                last.kicks
-            );
-            assert!(lower <= wobble_speed, "{name} {seed}: lower bound {lower}");
-            assert!(
-                speed <= wobble_speed - margin,
-                "{name} {seed}: warned at {speed} m/s"
-            );
-            assert!(
-                (final_estimate / wobble_speed - 1.0).abs() < 0.15,
-                "{name} {seed}: {final_estimate}"
-            );
+            assert_warned_in_time(name, seed);
         }
+    }
+}
+
+/// The paper's test bicycle with its light rider, which nothing was tuned
+/// on, rings at 5.35-5.42 Hz, below the Goertzel bins (5.5-9.5 Hz): the
+/// board measures its kicks all the same, within the issue's accuracy. On
+/// its speed-up ride the wobble alert comes on at about 0.7 of the wobble
+/// speed (the road rings a mode at 6.7 Hz above 0.4 deg) and stays on, so
+/// the kicks before it span too little for a margin estimate: the rider is
+/// warned by the alert, more than the margin before the wobble speed.
+#[test]
+fn a_bicycle_ringing_below_the_bins_has_its_kicks_measured() {
+    let config = Config::default();
+    let margin = f64::from(config.alert.margin_mps);
+    for seed in [1, 2] {
+        let (sim, wobble_speed, r) = ride("paper-light-rider", seed, &config);
+        let on = r.changes.first().expect("the wobble alert");
+        let scores =
+            kick_metrics::score(std::slice::from_ref(&sim.fixture), &config).expect("scores");
+        let before: Vec<_> = scores.iter().filter(|k| k.t_s < on.t_s - 2.0).collect();
+        let measured = before.iter().filter(|k| k.measured.is_some()).count();
+        let within = before.iter().filter(|k| k.within(0.3, 0.2)).count();
+        println!(
+            "FIGURES paper light rider seed {seed}: {measured} of the {} kicks before the alert \
+             measured, {within} within the goal; the alert on at {:.1} s",
+            before.len(),
+            on.t_s
+        );
+        assert!(
+            measured >= 4 && within == measured,
+            "seed {seed}: {measured} {within}"
+        );
+        let rows = sim.fixture.rows().expect("rows");
+        let at = rows.iter().find(|row| row.t_s >= on.t_s).expect("a row");
+        assert!(
+            f64::from(at.speed_mps) <= wobble_speed - margin,
+            "seed {seed}"
+        );
     }
 }
 

@@ -275,11 +275,11 @@ mod tests {
         /// `l^3 + c u l^2 + c1 l + c0` has its Hopf point where the Hurwitz
         /// determinant `c u c1 - c0` is zero, at `u = c0 / (c c1)`, with
         /// roots `+-i sqrt(c1)` (and `-c u`): Newton's method finds it on
-        /// any grid of 20 or more speeds, to round-off.
+        /// any grid of 6 or more speeds, to round-off.
         #[test]
         fn newton_puts_a_cubics_hopf_point_where_hurwitz_does(
             c in 0.5..2.0f64, c1 in 0.5..4.0f64, c0 in 0.5..4.0f64,
-            speeds in 20..400usize, offset in 0.0..1.0f64,
+            speeds in 6..400usize, offset in 0.0..1.0f64,
         ) {
             let hopf = c0 / (c * c1);
             let step = 2.0 * hopf / speeds as f64;
@@ -293,6 +293,25 @@ mod tests {
             let critical = refine(&matrix, Mode::Weave, &found[0]).unwrap();
             prop_assert!(!critical.unstable_above);
             prop_assert_eq!(critical.kind(), "oscillatory");
+        }
+    }
+
+    /// A real part has no sign within 1e-10 of the eigenvalue's size (or of
+    /// 1, for an eigenvalue smaller than 1), by hand at and around the bound.
+    #[test]
+    fn a_real_part_within_round_off_of_zero_has_no_sign() {
+        for (re, im, want) in [
+            (0.0, 0.0, 0),
+            (1e-12, 0.0, 0),
+            (-1e-12, 0.0, 0),
+            (-2e-10, 0.0, -1),
+            (0.5, 0.0, 1),
+            (1e-11, 50.0, 0),
+            (-3e-9, 40.0, 0),
+            (5e-9, 40.0, 1),
+            (-5e-9, 40.0, -1),
+        ] {
+            assert_eq!(sign(Complex::new(re, im)), want, "{re} + {im} i");
         }
     }
 
@@ -313,9 +332,47 @@ mod tests {
         assert_eq!(critical.kind(), "real");
     }
 
+    /// The benchmark bicycle's weave and capsize speeds (Meijaard et al.
+    /// 2007; 14 digits from independent implementations, as in
+    /// `tests/whipple_benchmark.rs`) by Newton's method from brackets as
+    /// wide as 0.5 and 2 m/s, to 1e-10 m/s.
+    #[test]
+    fn the_benchmarks_critical_speeds_by_newton_on_coarse_grids() {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("params/benchmark.toml");
+        let model = Model::from_set(&ParamSet::load(&path).unwrap()).unwrap();
+        let matrix = matrix_of(&model);
+        for step in [0.5, 2.0] {
+            let speeds: Vec<f64> = (0..=(10.0 / step) as usize)
+                .map(|i| i as f64 * step)
+                .collect();
+            let sweep = Sweep::run(&model, &speeds, |_| {}).unwrap();
+            let mut found: Vec<f64> = brackets_of(&sweep)
+                .found
+                .iter()
+                .filter(|b| [Mode::Weave, Mode::Capsize].contains(&sweep.branches[b.branch].mode))
+                .map(|b| {
+                    by_newton(&*matrix, b)
+                        .expect("refined by Newton's method")
+                        .0
+                })
+                .collect();
+            found.sort_by(f64::total_cmp);
+            assert_eq!(found.len(), 2, "step {step}: {found:?}");
+            assert!(
+                (found[0] - 4.29238253634111).abs() < 1e-10,
+                "step {step}: {found:?}"
+            );
+            assert!(
+                (found[1] - 6.02426201538837).abs() < 1e-10,
+                "step {step}: {found:?}"
+            );
+        }
+    }
+
     /// On the test bicycle's 1000-speed sweep every crossing is refined by
     /// Newton's method, to the speed the branch followed in small steps and
-    /// Brent's method give.
+    /// Brent's method give, in at most 4 steps (each evaluates `A(u)` three
+    /// times, for itself and the central difference; the check once more).
     #[test]
     fn the_test_bicycles_crossings_take_newtons_method() {
         let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("params/test-bicycle.toml");
@@ -330,7 +387,17 @@ mod tests {
             .collect();
         assert!(named.len() >= 2, "{named:?}");
         for b in &named {
-            let (u, value) = by_newton(&*matrix, b).expect("refined by Newton's method");
+            let evaluations = std::cell::Cell::new(0);
+            let counted = |u: f64| {
+                evaluations.set(evaluations.get() + 1);
+                matrix(u)
+            };
+            let (u, value) = by_newton(&counted, b).expect("refined by Newton's method");
+            assert!(
+                evaluations.get() <= 4 * 3 + 1,
+                "{} evaluations",
+                evaluations.get()
+            );
             let (ub, vb) = by_brent(&*matrix, b).unwrap();
             assert!((u - ub).abs() < 1e-11, "{u} against Brent's {ub}");
             assert!((value - vb).norm() < 1e-9, "{value} against Brent's {vb}");

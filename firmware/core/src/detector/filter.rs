@@ -97,6 +97,18 @@ impl HighPass4 {
         self.sections[0].settle(x);
         self.sections[1].settle(0.0);
     }
+
+    /// The pole (upper half-plane, per sample: `z = re + j im`) of the
+    /// slower-decaying section, the high-Q one: what a transient such as a
+    /// push leaves in the output once its input is over is this pole's
+    /// ringing, and the other section's, which decays 2.4 times faster.
+    #[must_use]
+    pub fn slow_pole(&self) -> (f32, f32) {
+        // z^2 + a1 z + a2 = 0 with a1^2 < 4 a2 (a complex pair at Q > 1/2).
+        let s = &self.sections[1];
+        let re = -0.5 * s.a1;
+        (re, math::sqrtf((s.a2 - re * re).max(0.0)))
+    }
 }
 
 #[cfg(test)]
@@ -123,6 +135,34 @@ mod tests {
         assert!(gain(9.0) > 0.99 && gain(9.0) < 1.01);
         assert!(gain(0.65) < 1e-3, "{}", gain(0.65));
         assert!(gain(2.5) < 0.2, "{}", gain(2.5));
+    }
+
+    /// The output after an impulse is, from the fourth sample on, the sum of
+    /// two damped sinusoids; the slow pole's is the analog Butterworth's
+    /// (4 Hz x e^(j 112.5 deg): 3.70 Hz, decaying at 9.62 1/s) through the
+    /// bilinear transform, and it is what is left after 0.3 s.
+    #[test]
+    fn the_slow_pole_is_the_butterworth_pole_that_rings_longest() {
+        let hp = HighPass4::new(4.0, 100.0);
+        let (re, im) = hp.slow_pole();
+        let (r, turns) = (re.hypot(im), im.atan2(re) / core::f32::consts::TAU);
+        // The bilinear transform moves it a little (0.1 1/s, 0.01 Hz here).
+        let sigma = -r.ln() * 100.0;
+        let f = turns * 100.0;
+        assert!((sigma - 9.62).abs() < 0.3, "{sigma}");
+        assert!((f - 3.70).abs() < 0.1, "{f}");
+        // Late in the impulse response (the other pole's share is below
+        // 0.5 % from the 40th sample) the slow pole's recursion
+        // y(n+2) = 2 re y(n+1) - |z|^2 y(n) holds.
+        let mut hp = HighPass4::new(4.0, 100.0);
+        let y: Vec<f32> = (0..80)
+            .map(|n| hp.process(if n == 0 { 1.0 } else { 0.0 }))
+            .collect();
+        for w in y[40..].windows(3) {
+            let residual = w[2] - 2.0 * re * w[1] + r * r * w[0];
+            let size = w.iter().fold(0.0_f32, |m, v| m.max(v.abs()));
+            assert!(residual.abs() < 0.02 * size, "{w:?}: {residual}");
+        }
     }
 
     #[test]

@@ -252,7 +252,11 @@ impl Detector {
             last_input: None,
             estimate: Estimate::default(),
             state: State::Quiet { confirm: 0 },
-            ringdown: RingDown::new(cfg.sample_rate_hz, (cfg.bin_lo_hz, cfg.bin_hi_hz)),
+            ringdown: RingDown::new(
+                cfg.sample_rate_hz,
+                (cfg.bin_lo_hz, cfg.bin_hi_hz),
+                cfg.highpass_hz,
+            ),
             kick: None,
         })
     }
