@@ -23,7 +23,7 @@ use wobblog::cmd::detect::Replay;
 /// replay through the board's code.
 fn ride(name: &str, seed: u64, config: &Config) -> (Simulation, f64, Replay) {
     let mut variants = campaign::variants().expect("variants");
-    variants.extend(campaign::unseen_variants());
+    variants.extend(campaign::unseen_variants().expect("unseen variants"));
     let variant = variants.iter().find(|v| v.name == name).expect(name);
     let (sim, wobble_speed) =
         campaign::speed_up_ride(variant, &SpeedUp::default(), seed).expect("ride");

@@ -330,7 +330,7 @@ pub struct Cost {
     pub canceller: Cost1,
     /// Goertzel recursion steps per hop (bins x window).
     pub goertzel_steps_per_hop: u32,
-    /// More per sample while a kick's ring-down is measured (at most 1.95 s
+    /// More per sample while a kick's ring-down is measured (at most 1.88 s
     /// after each kick).
     pub ringdown: Cost1,
     /// Once per kick, on the sample that reports it: the ring-down fit and

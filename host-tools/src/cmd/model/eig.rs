@@ -39,7 +39,9 @@ pub struct Args {
     /// Parameter file: TOML (`params/*.toml`) or a BicycleParameters
     /// `*Benchmark.txt`.
     pub params: PathBuf,
-    /// Speeds FROM:TO:STEP, m/s.
+    /// Speeds FROM:TO:STEP, m/s. The modes are named on a 0-14 m/s
+    /// reference sweep followed into these speeds: a single speed (`5:5:1`)
+    /// or any range names each mode as the full sweep does.
     #[arg(long, default_value = "0:10:0.1")]
     pub speeds: Speeds,
     /// Output format.
