@@ -45,6 +45,7 @@ export PROPTEST_DISABLE_FAILURE_PERSISTENCE=1
 timeout_s="${MUTANTS_TIMEOUT_S:-60}"
 
 # name | package | file | name filters (comma-separated) | test targets (built and run)
+#   [| test name filter (the tests run of those targets)]
 targets=(
   "detector|wobble-core|firmware/core/src/detector/machine.rs|analyse|--test detector_machine --test detector_props --test sampler_detector"
   "loss-accounting|wobble-core|firmware/core/src/logger/mod.rs|.|--lib --test logger_card"
@@ -66,6 +67,8 @@ targets=(
   "naming|wobble-model|host-tools/bicycle-model/src/naming.rs|speeds,sway_like,classify|--test naming_grid --test rigid_rider --test sway_mode --test wobble_model --test whipple_benchmark --test bicycleparameters_bicycles"
   "critical|wobble-model|host-tools/bicycle-model/src/critical.rs|sign,by_newton|--lib"
   "critical-newton|wobble-model|host-tools/bicycle-model/src/critical/newton.rs|.|--lib"
+  "margin-regression|wobblog|host-tools/src/analysis/margin.rs|.|--lib|analysis::margin::"
+  "margin-warning|wobble-core|firmware/core/src/detector/margin.rs|MarginWarning,fieller,estimate,robust_line,weighted_line,median,t_975|--lib|detector::margin::"
 )
 
 list=false
@@ -88,7 +91,7 @@ if ! $list && ! git diff --quiet HEAD; then
 fi
 
 for t in "${targets[@]}"; do
-  IFS='|' read -r name package file filter tests <<<"$t"
+  IFS='|' read -r name package file filter tests test_filter <<<"$t"
   if ((${#wanted[@]})) && [[ ! " ${wanted[*]} " =~ " $name " ]]; then
     continue
   fi
@@ -102,10 +105,10 @@ for t in "${targets[@]}"; do
   filters=(-p "$package" -f "$file")
   for re in ${filter//,/ }; do filters+=(-F "$re"); done
   if $list; then
-    echo "$name: $(cargo mutants --list "${filters[@]}" | wc -l) mutants ($file, $filter; $tests)"
+    echo "$name: $(cargo mutants --list "${filters[@]}" | wc -l) mutants ($file, $filter; $tests $test_filter)"
     continue
   fi
-  echo "== $name: $file ($filter), tests $tests"
+  echo "== $name: $file ($filter), tests $tests $test_filter"
   out="mutants.out/$name"
   mkdir -p "$out"
   start=$(date +%s)
@@ -113,7 +116,7 @@ for t in "${targets[@]}"; do
   # mutants) or 3 (timeouts) is the result; anything else is a failed run.
   status=0
   cargo mutants --no-shuffle --in-place --timeout "$timeout_s" "${filters[@]}" \
-    "${cargo_args[@]}" "${iterate[@]}" --output "$out" || status=$?
+    "${cargo_args[@]}" "${iterate[@]}" --output "$out" -- ${test_filter:+"$test_filter"} || status=$?
   if ((status != 0 && status != 2 && status != 3)); then
     echo "mutants.sh: cargo mutants failed on $name (status $status)" >&2
     exit 1

@@ -8,7 +8,8 @@
 //! ```
 //! `PUSH=1` rides the campaigns with pushes instead of knocks;
 //! `VARIANTS=unseen` rides the bicycles no calibration was tuned on
-//! (`campaign::unseen_variants`) instead of the four usual ones.
+//! (`campaign::unseen_variants`) instead of the four usual ones;
+//! `VARIANTS=paper-bar-bag,paper-balloon-tyres` the bicycles so named.
 
 use wobble_core::config::Config;
 use wobble_hil::corpus::signal::WHEEL_CIRCUMFERENCE_M;
@@ -32,11 +33,23 @@ fn main() -> Result<(), String> {
          host_speed_mps,host_sigma_per_s,host_sd_per_s,host_freq_hz,\
          card_speed_mps,card_sigma_per_s,card_se_per_s,card_freq_hz,card_segments"
     );
-    // VARIANTS=unseen rides the bicycles nothing was tuned on.
-    let variants = if std::env::var("VARIANTS").is_ok_and(|v| v == "unseen") {
-        campaign::unseen_variants()
-    } else {
-        campaign::variants()?
+    // VARIANTS=unseen rides the bicycles nothing was tuned on; a list of
+    // names, those bicycles of either set.
+    let variants = match std::env::var("VARIANTS").ok().as_deref() {
+        None => campaign::variants()?,
+        Some("unseen") => campaign::unseen_variants()?,
+        Some(names) => {
+            let mut all = campaign::variants()?;
+            all.extend(campaign::unseen_variants()?);
+            let wanted: Vec<&str> = names.split(',').collect();
+            all.retain(|v| wanted.contains(&v.name));
+            if all.len() != wanted.len() {
+                return Err(format!(
+                    "VARIANTS={names}: a name is not a campaign bicycle"
+                ));
+            }
+            all
+        }
     };
     for v in &variants {
         for seed in from..to {

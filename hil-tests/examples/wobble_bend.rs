@@ -11,9 +11,9 @@ use wobble_hil::corpus::simulated::bike::Bike;
 use wobble_hil::corpus::simulated::campaign::{self, wobble_speed_mps};
 
 fn main() -> Result<(), String> {
-    // The campaigns' four bicycles, then the two nothing was tuned on.
+    // The campaigns' four bicycles, then those nothing was tuned on.
     let mut variants = campaign::variants()?;
-    variants.extend(campaign::unseen_variants());
+    variants.extend(campaign::unseen_variants()?);
     for v in &variants {
         let mut bike = Bike::from_set(&v.params()?, 1.0 / FS_HZ)?;
         let w = wobble_speed_mps(&mut bike).ok_or("no wobble speed")?;

@@ -45,18 +45,20 @@ pub struct AlertChange {
 }
 
 /// Header of the per-hop trace that `trace_line` writes.
-pub const TRACE_HEADER: &str = "t_s,amp_deg,freq_hz,in_band,growth_ratio,holdoff,harmonic,alert";
+pub const TRACE_HEADER: &str =
+    "t_s,amp_deg,freq_hz,in_band,growth_ratio,trend_per_s,holdoff,harmonic,alert";
 
 /// One CSV line of the detector's state at `t_s` (see [`TRACE_HEADER`]),
 /// for looking into a single ride with `detector-metrics --trace`.
 #[must_use]
 pub fn trace_line(t_s: f64, e: &Estimate, alert: bool) -> String {
     format!(
-        "{t_s:.2},{:.3},{:.2},{},{:.3},{},{},{}",
+        "{t_s:.2},{:.3},{:.2},{},{:.3},{:.3},{},{},{}",
         e.amp_deg,
         e.freq_hz,
         u8::from(e.in_band),
         e.growth_ratio,
+        e.trend_per_s,
         u8::from(e.impulse_holdoff),
         u8::from(e.at_wheel_harmonic),
         u8::from(alert)

@@ -583,6 +583,8 @@ const KEYS: &[Key] = &[
     key!(Detector: detector.harmonic_growth_ratio),
     key!(Detector: detector.decay_span_s),
     key!(Detector: detector.decay_span_ratio),
+    key!(Detector: detector.decay_trend_s),
+    key!(Detector: detector.decay_trend_per_s),
     key!(Alert: alert.enabled),
     key!(Alert: alert.pattern.beep_on_us),
     key!(Alert: alert.pattern.beep_off_us),

@@ -15,6 +15,9 @@ const TAU: f32 = core::f32::consts::TAU;
 /// below this many times `amp_on_deg`, an oscillation on a wheel harmonic
 /// must grow by `harmonic_growth_ratio` to count.
 const RIPPLE_CEILING: f32 = 2.0;
+/// The envelope trend's floor (`TREND_FLOOR` in `detector::machine`): smaller
+/// amplitudes count as this many times `amp_on_deg`.
+const TREND_FLOOR: f32 = 0.25;
 
 fn detector(cfg: DetectorConfig) -> Detector {
     Detector::new(cfg, WheelConfig::DEFAULT.circumference_m).expect("valid config")
@@ -31,6 +34,8 @@ struct Model {
     decay_span: usize,
     /// The dominant amplitude of every analysis so far.
     amps: Vec<f32>,
+    /// Where the envelope trend starts in `amps`.
+    trend_from: usize,
     confirm: u8,
     /// `Some(hops below the off threshold)` while the alert is on.
     alerting: Option<usize>,
@@ -47,6 +52,7 @@ impl Model {
             off_hold: hops(cfg.off_hold_s).max(1),
             decay_span: hops(cfg.decay_span_s),
             amps: Vec::new(),
+            trend_from: 0,
             confirm: 0,
             alerting: None,
             longest_unconfirmed: 0,
@@ -58,6 +64,32 @@ impl Model {
     /// bin_hi_hz`), so a peak on one is out of band by its frequency alone.
     fn in_band(&self, freq_hz: f32) -> bool {
         freq_hz >= self.cfg.band_lo_hz && freq_hz <= self.cfg.band_hi_hz
+    }
+
+    /// The slope (1/s) of the weighted least-squares line through the
+    /// logarithms of the amplitudes since the latest analysis held off by an
+    /// impulse (that one included), the one `k` hops old weighted by
+    /// `(1 - hop_s / decay_trend_s)^k`; 0 without a line.
+    fn trend_per_s(&self) -> f32 {
+        let c = &self.cfg;
+        let span = c.decay_trend_s / c.hop_s;
+        let forget = if span > 1.0 { 1.0 - 1.0 / span } else { 0.0 };
+        let (mut w, mut k, mut kk, mut y, mut ky) = (0.0_f64, 0.0, 0.0, 0.0, 0.0);
+        for (age, a) in self.amps[self.trend_from..].iter().rev().enumerate() {
+            let wt = f64::from(forget).powi(age as i32);
+            let ln = f64::from(a.max(TREND_FLOOR * c.amp_on_deg)).ln();
+            let age = age as f64;
+            w += wt;
+            k += wt * age;
+            kk += wt * age * age;
+            y += wt * ln;
+            ky += wt * age * ln;
+        }
+        let sxx = w * kk - k * k;
+        if sxx <= 1e-9 * w * kk {
+            return 0.0;
+        }
+        (-(w * ky - k * y) / sxx / f64::from(c.hop_s)) as f32
     }
 
     /// Amplitude now over amplitude `lookback_s` ago, 1 until known.
@@ -83,7 +115,16 @@ impl Model {
         let c = &self.cfg;
         assert!(c.bin_lo_hz < c.band_lo_hz && c.band_hi_hz < c.bin_hi_hz);
         let has_lookback = self.amps.len() >= self.lookback;
+        if e.impulse_holdoff {
+            self.trend_from = self.amps.len();
+        }
         self.amps.push(e.amp_deg);
+        let trend = self.trend_per_s();
+        assert!(
+            (e.trend_per_s - trend).abs() <= 1e-3 * (1.0 + trend.abs()),
+            "trend {} against {trend}",
+            e.trend_per_s
+        );
         if let Some(below) = self.alerting {
             let below = if e.amp_deg < c.amp_off_deg {
                 below + 1
@@ -108,6 +149,7 @@ impl Model {
             .fold(0.0_f32, |m, &a| m.max(a));
         let on = has_lookback
             && e.amp_deg >= c.decay_span_ratio * span_peak
+            && e.trend_per_s >= c.decay_trend_per_s
             && e.amp_deg >= c.amp_on_deg
             && self.in_band(e.freq_hz)
             && !e.impulse_holdoff

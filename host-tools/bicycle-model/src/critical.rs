@@ -369,6 +369,29 @@ mod tests {
         }
     }
 
+    /// Roots `u - 1` and `u - 0.95`, the first one's bracket [0.5, 1.5] with
+    /// a line lifted off the real axis by `lift`: Newton's method finds the
+    /// crossing at 1 m/s either way, and the check keeps it only if the
+    /// other root (0.05 from it) is at least twice as far from the line's
+    /// value there as the crossing is.
+    #[test]
+    fn newtons_crossing_is_kept_only_if_the_line_points_at_it_without_doubt() {
+        let matrix = |u: f64| DMatrix::from_diagonal(&DVector::from_vec(vec![u - 1.0, u - 0.95]));
+        let bracket = |lift: f64| Bracket {
+            branch: 0,
+            below: (0.5, Complex::new(-0.5, lift)),
+            above: (1.5, Complex::new(0.5, lift)),
+        };
+        // 0.01 from the crossing, 0.051 from the other root: clear.
+        let (u, value) = by_newton(&matrix, &bracket(0.01)).expect("clear");
+        assert!(
+            (u - 1.0).abs() < 1e-13 && value.norm() < 1e-13,
+            "{u} {value}"
+        );
+        // 0.04 from the crossing, 0.064 from the other root: in doubt.
+        assert_eq!(by_newton(&matrix, &bracket(0.04)), None);
+    }
+
     /// On the test bicycle's 1000-speed sweep every crossing is refined by
     /// Newton's method, to the speed the branch followed in small steps and
     /// Brent's method give, in at most 4 steps (each evaluates `A(u)` three

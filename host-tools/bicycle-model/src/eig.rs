@@ -8,6 +8,8 @@
 
 use nalgebra::{Complex, DMatrix, DVector};
 
+use crate::model::Pencil;
+
 /// One eigenvalue with its (unit-norm) eigenvector.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Eigen {
@@ -29,10 +31,19 @@ pub fn eigenvalues(a: &DMatrix<f64>) -> Option<Vec<Complex<f64>>> {
 /// guesses are close.
 #[must_use]
 pub fn eigenvalues_near(a: &DMatrix<f64>, guesses: &[Complex<f64>]) -> Option<Vec<Complex<f64>>> {
-    if a.iter().any(|v| !v.is_finite()) {
-        return None;
-    }
     crate::hessenberg_qr::eigenvalues(a, guesses)
+}
+
+/// [`eigenvalues_near`] of `pencil` at `speed_mps`, evaluated straight into
+/// the solver's storage.
+#[must_use]
+pub fn pencil_eigenvalues_near(
+    pencil: &Pencil,
+    speed_mps: f64,
+    guesses: &[Complex<f64>],
+) -> Option<Vec<Complex<f64>>> {
+    let fill = |rows: &mut [f64]| pencil.write_rows(speed_mps, rows);
+    crate::hessenberg_qr::eigenvalues_of(pencil.a0.nrows(), fill, guesses)
 }
 
 /// Every eigenvalue of `a` with its eigenvector.

@@ -292,31 +292,52 @@ impl Guesses {
     }
 }
 
-/// The eigenvalues of `a` (finite entries), in the order they appear on the
-/// diagonal of its real Schur form, a pair with the positive imaginary part
-/// first; `None` if the iteration did not converge within its bound.
-/// `guesses`, approximations of them (or none), serve as first shifts
+/// The eigenvalues of `a`, in the order they appear on the diagonal of its
+/// real Schur form, a pair with the positive imaginary part first; `None`
+/// if an entry is not finite or the iteration did not converge within its
+/// bound. `guesses`, approximations of them (or none), serve as first shifts
 /// ([`Guesses`]): they change the number of steps, not the result.
 #[must_use]
 pub fn eigenvalues(a: &DMatrix<f64>, guesses: &[Complex<f64>]) -> Option<Vec<Complex<f64>>> {
     let n = a.nrows();
-    // A power of two near the largest entry: scaling by it is exact.
-    let largest = a.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
-    let scale = if largest > 0.0 {
-        2.0_f64.powi(largest.log2().round() as i32)
-    } else {
-        1.0
+    let rows_of = |h: &mut [f64]| {
+        // Row-major from nalgebra's columns.
+        for (j, column) in a.as_slice().chunks_exact(n.max(1)).enumerate() {
+            for (i, x) in column.iter().enumerate() {
+                h[i * n + j] = *x;
+            }
+        }
     };
+    eigenvalues_of(n, rows_of, guesses)
+}
+
+/// [`eigenvalues`] of the `n x n` matrix that `fill` writes, row by row,
+/// into the slice it is given (the solver's own storage: no matrix is built
+/// to be copied).
+#[must_use]
+pub fn eigenvalues_of(
+    n: usize,
+    fill: impl FnOnce(&mut [f64]),
+    guesses: &[Complex<f64>],
+) -> Option<Vec<Complex<f64>>> {
     let mut h = Square {
         n,
         a: vec![0.0; n * n],
         work: vec![0.0; n],
     };
-    // Row-major from nalgebra's columns.
-    for (j, column) in a.as_slice().chunks_exact(n.max(1)).enumerate() {
-        for (i, x) in column.iter().enumerate() {
-            h.a[i * n + j] = x / scale;
-        }
+    fill(&mut h.a);
+    if h.a.iter().any(|v| !v.is_finite()) {
+        return None;
+    }
+    // A power of two near the largest entry: scaling by it is exact.
+    let largest = h.a.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+    let scale = if largest > 0.0 {
+        2.0_f64.powi(largest.log2().round() as i32)
+    } else {
+        1.0
+    };
+    for x in &mut h.a {
+        *x /= scale;
     }
     let mut guesses = Guesses(guesses.iter().map(|g| g / scale).collect());
     hessenberg(&mut h);

@@ -42,6 +42,21 @@ impl Pencil {
         a.zip_apply(&self.a1, |x, y| *x += speed_mps * y);
         a
     }
+
+    /// `A(u)` written row by row into `rows` (`n x n` entries), the same
+    /// entries as [`Pencil::at`].
+    pub fn write_rows(&self, speed_mps: f64, rows: &mut [f64]) {
+        let n = self.a0.nrows();
+        let columns = self.a0.as_slice().chunks_exact(n.max(1));
+        for (j, (c0, c1)) in columns
+            .zip(self.a1.as_slice().chunks_exact(n.max(1)))
+            .enumerate()
+        {
+            for (i, (x, y)) in c0.iter().zip(c1).enumerate() {
+                rows[i * n + j] = x + speed_mps * y;
+            }
+        }
+    }
 }
 
 /// A linear model ready to evaluate at any speed.

@@ -9,10 +9,10 @@ use std::fmt;
 use nalgebra::{Complex, DMatrix};
 
 use crate::critical::{Brackets, CriticalSpeed};
-use crate::eig::eigenvalues_near;
+use crate::eig::{eigenvalues_near, pencil_eigenvalues_near};
 use crate::model::{Model, StateRole};
 use crate::naming::{self, Speed, Stats};
-use crate::track::Tracker;
+use crate::track::{EigenvaluesAt, EigenvaluesFn, Tracker};
 
 /// The name of a mode.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
@@ -102,7 +102,13 @@ impl Sweep {
         progress: impl FnMut(usize),
     ) -> Result<Self, SweepError> {
         let roles = model.state_roles();
-        Self::run_matrices(matrix_of(model), &roles, speeds_mps, progress)
+        Self::run_with(
+            &matrix_of(model),
+            &eigenvalues_of(model),
+            &roles,
+            speeds_mps,
+            progress,
+        )
     }
 
     /// [`Self::run`] on any state matrix function with states of `roles`
@@ -114,13 +120,25 @@ impl Sweep {
         state_matrix: impl Fn(f64) -> DMatrix<f64>,
         roles: &[StateRole],
         speeds_mps: &[f64],
+        progress: impl FnMut(usize),
+    ) -> Result<Self, SweepError> {
+        let eigen = |u: f64, guesses: &[Complex<f64>]| eigenvalues_near(&state_matrix(u), guesses);
+        Self::run_with(&state_matrix, &eigen, roles, speeds_mps, progress)
+    }
+
+    /// [`Self::run_matrices`], the eigenvalues at each speed from `eigen`.
+    fn run_with(
+        state_matrix: &dyn Fn(f64) -> DMatrix<f64>,
+        eigen: EigenvaluesAt,
+        roles: &[StateRole],
+        speeds_mps: &[f64],
         mut progress: impl FnMut(usize),
     ) -> Result<Self, SweepError> {
         let mut values: Vec<Vec<Complex<f64>>> = Vec::new();
         let mut stats = Stats::new(roles);
-        each_speed(&state_matrix, speeds_mps, |at, v| {
+        each_speed(eigen, speeds_mps, |at, v| {
             if at.reference {
-                stats.add(at.u, v, &state_matrix);
+                stats.add(at.u, v, state_matrix);
             }
             let Some(k) = at.asked else { return };
             if values.is_empty() {
@@ -161,19 +179,18 @@ impl Sweep {
     }
 }
 
-/// Tracks the eigenvalues of `state_matrix` over `speeds_mps` (increasing)
+/// Tracks the eigenvalues `eigen` gives over `speeds_mps` (increasing)
 /// and the reference sweep naming takes its names on ([`naming::speeds`]),
 /// handing each speed's values (always in the same branch order) to `visit`.
 fn each_speed(
-    state_matrix: &dyn Fn(f64) -> DMatrix<f64>,
+    eigen: EigenvaluesAt,
     speeds_mps: &[f64],
     mut visit: impl FnMut(Speed, &[Complex<f64>]),
 ) -> Result<(), SweepError> {
     if speeds_mps.is_empty() {
         return Err(SweepError::NoSpeeds);
     }
-    let eigen = |u: f64, guesses: &[Complex<f64>]| eigenvalues_near(&state_matrix(u), guesses);
-    let mut tracker = Tracker::new(&eigen);
+    let mut tracker = Tracker::new(eigen);
     for at in naming::speeds(speeds_mps) {
         visit(at, tracker.step(at.u)?);
     }
@@ -209,7 +226,7 @@ impl Survey {
         let matrix = matrix_of(model);
         let mut stats = Stats::new(&roles);
         let mut brackets = Brackets::default();
-        each_speed(&matrix, speeds_mps, |at, v| {
+        each_speed(&eigenvalues_of(model), speeds_mps, |at, v| {
             if at.reference {
                 stats.add(at.u, v, &matrix);
             }
@@ -236,9 +253,8 @@ impl Survey {
         speeds_mps: &[f64],
         mut visit: impl FnMut(f64, &[Complex<f64>]) -> Result<(), E>,
     ) -> Result<(), E> {
-        let matrix = matrix_of(model);
         let mut failed = None;
-        each_speed(&matrix, speeds_mps, |at, v| {
+        each_speed(&eigenvalues_of(model), speeds_mps, |at, v| {
             if failed.is_none() && at.asked.is_some() {
                 failed = visit(at.u, v).err();
             }
@@ -252,6 +268,15 @@ pub(crate) fn matrix_of(model: &Model) -> Box<dyn Fn(f64) -> DMatrix<f64> + '_> 
     match model.pencil() {
         Some(pencil) => Box::new(move |u| pencil.at(u)),
         None => Box::new(|u| model.state_matrix(u)),
+    }
+}
+
+/// `model`'s eigenvalues at a speed, given guesses (from its pencil
+/// straight into the solver's storage if affine).
+fn eigenvalues_of(model: &Model) -> Box<EigenvaluesFn<'_>> {
+    match model.pencil() {
+        Some(pencil) => Box::new(move |u, guesses| pencil_eigenvalues_near(&pencil, u, guesses)),
+        None => Box::new(|u, guesses| eigenvalues_near(&model.state_matrix(u), guesses)),
     }
 }
 

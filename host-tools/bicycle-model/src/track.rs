@@ -63,7 +63,9 @@ struct Scratch {
 
 /// The eigenvalues at a speed, given the branches' predicted values there
 /// (none at the first speed) as the solver's guesses.
-pub(crate) type EigenvaluesAt<'a> = &'a dyn Fn(f64, &[Complex<f64>]) -> Option<Vec<Complex<f64>>>;
+pub(crate) type EigenvaluesFn<'a> = dyn Fn(f64, &[Complex<f64>]) -> Option<Vec<Complex<f64>>> + 'a;
+/// A borrowed [`EigenvaluesFn`].
+pub(crate) type EigenvaluesAt<'a> = &'a EigenvaluesFn<'a>;
 
 /// Eigenvalues followed from speed to speed: [`Tracker::step`] gives the
 /// branches' values at each next speed, always in the same branch order.

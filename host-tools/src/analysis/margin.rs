@@ -901,6 +901,200 @@ mod tests {
         assert!(bent < 0.5, "{bent}");
     }
 
+    /// A weighted line worked by hand. Eight kicks at 2.0-3.4 m/s off
+    /// `sigma = 0.8 (u - 4.5)` by `+e, -e, -e, +e, +e, -e, -e, +e` (a
+    /// pattern orthogonal to 1 and to u, so the least-squares line is the
+    /// true one), `e = 0.1` 1/s, stated SD 0.05 1/s, no bend assumed or
+    /// allowed for. Every residual is 2 SD, so the median absolute
+    /// deviation gives a scale of `1.4826 * 2`, Huber's weights are all 1
+    /// (`2 / (1.345 * 2.965) < 1`), and Tukey's are all
+    /// `q = (1 - (2 / (4.685 * 2.9652))^2)^2`: the fit stays on the line,
+    /// each kick's weight is `q / 0.05^2`, the unit variance is
+    /// `sum w e^2 / (n - 2) = 8 * 400 q * 0.01 / 6`, the covariance
+    /// `(X^T W X)^-1` times it, and the interval Fieller's closed form
+    /// with t of 6 degrees of freedom.
+    #[test]
+    fn a_weighted_line_worked_by_hand() {
+        let (e, sd, n) = (0.1, 0.05, 8);
+        let pattern = [1.0, -1.0, -1.0, 1.0, 1.0, -1.0, -1.0, 1.0];
+        let pts: Vec<(f64, f64)> = (0..n)
+            .map(|i| {
+                let u = 2.0 + 0.2 * f64::from(i as u8);
+                (u, 0.8 * (u - 4.5) + e * pattern[i])
+            })
+            .collect();
+        let none = BendPrior {
+            mean_per_s_mps2: 0.0,
+            sd_per_s_mps2: 0.0,
+        };
+        let m = predict_bent(&kicks(&pts, sd), Trend::Line, none);
+        let r = 2.0 / (BISQUARE_C * 1.482_6 * 2.0);
+        let q = (1.0 - r * r).powi(2);
+        let w = q / (sd * sd);
+        for got in &m.weights {
+            assert!((got - w).abs() < 1e-9 * w, "{got} {w}");
+        }
+        let s2 = 8.0 * w * e * e / 6.0;
+        assert!((m.unit_variance.unwrap() - s2).abs() < 1e-9, "{m:?}");
+        let c = m.coefficients.as_ref().unwrap();
+        assert!(
+            (c[0] + 3.6).abs() < 1e-9 && (c[1] - 0.8).abs() < 1e-9,
+            "{c:?}"
+        );
+        assert!((m.wobble_speed_mps.unwrap() - 4.5).abs() < 1e-6, "{m:?}");
+        // X^T W X = w [[n, S1], [S1, S2]], S1 = sum u, S2 = sum u^2.
+        let (s1, s2u) = pts
+            .iter()
+            .fold((0.0, 0.0), |(a, b), (u, _)| (a + u, b + u * u));
+        let det = w * w * (8.0 * s2u - s1 * s1);
+        let v = [w * s2u / det * s2, -w * s1 / det * s2, w * 8.0 / det * s2];
+        let cov = m.covariance.as_ref().unwrap();
+        for (got, want) in [cov[0][0], cov[0][1], cov[1][1]].iter().zip(v) {
+            assert!((got - want).abs() < 1e-9 * want.abs(), "{got} {want}");
+        }
+        let (lo, hi) = fieller_closed_form(-3.6, 0.8, v, t_975(6));
+        let [got_lo, got_hi] = m.ci95_mps;
+        assert!((got_lo.unwrap() - lo).abs() < 1e-6, "{m:?} {lo}");
+        assert!((got_hi.unwrap() - hi).abs() < 1e-6, "{m:?} {hi}");
+        assert_eq!((m.kicks_used, m.kicks_rejected, m.dof), (8, 0, 6));
+        assert_eq!(m.speed_range_mps, Some([pts[0].0, pts[7].0]));
+    }
+
+    /// The robust fit is a fixed point of its reweighting: from the final
+    /// line, each kick's residual in units of its SD, the MAD scale and
+    /// Tukey's weight give back the weights reported (a fit stopped after
+    /// a pass or two would report the weights of an earlier line). Kicks
+    /// scattered about a line, one of them 2 1/s off.
+    #[test]
+    fn the_robust_fit_is_a_fixed_point_of_its_weights() {
+        let mut normal = normals(0x1234_5678_9ABC_DEF1);
+        let sd = 0.05;
+        let mut pts: Vec<(f64, f64)> = (0..16)
+            .map(|i| {
+                let u = 2.0 + 0.12 * f64::from(i);
+                (u, 1.2 * (u - 4.5) + 1.5 * sd * normal())
+            })
+            .collect();
+        pts[5].1 += 2.0;
+        let none = BendPrior {
+            mean_per_s_mps2: 0.0,
+            sd_per_s_mps2: 0.0,
+        };
+        let m = predict_bent(&kicks(&pts, sd), Trend::Line, none);
+        let c = m.coefficients.as_ref().unwrap();
+        let z: Vec<f64> = pts
+            .iter()
+            .map(|(u, y)| (y - c[0] - c[1] * u) / sd)
+            .collect();
+        let scale = (1.482_6 * median(z.iter().map(|z| z.abs()).collect())).max(1.0);
+        for (z, got) in z.iter().zip(&m.weights) {
+            let want = bisquare(z / (BISQUARE_C * scale)) / (sd * sd);
+            assert!(
+                (got - want).abs() < 1e-6 * (1.0 / (sd * sd)),
+                "{got} {want}"
+            );
+        }
+        assert_eq!(m.weights[5], 0.0);
+    }
+
+    /// Huber's and Tukey's weight functions of the residual in units of
+    /// their constant (Huber 1964, `min(1, 1 / |r|)`; Beaton and Tukey
+    /// 1974, `(1 - r^2)^2` inside 1, 0 outside).
+    #[test]
+    fn the_weight_functions_are_huber_and_tukey() {
+        for (r, h, b) in [
+            (0.0, 1.0, 1.0),
+            (0.5, 1.0, 0.5625),
+            (-1.0, 1.0, 0.0),
+            (2.0, 0.5, 0.0),
+            (-4.0, 0.25, 0.0),
+        ] {
+            assert_eq!((huber(r), bisquare(r)), (h, b), "{r}");
+        }
+    }
+
+    /// The bend allowance by hand: kicks of mean speed 3 m/s and speed
+    /// variance 0.25 (m/s)^2, a curvature SD of 0.02: at 5 m/s the trend
+    /// is uncertain by `0.01 * |4 - 0.25| = 0.0375` 1/s more, at the mean
+    /// by `0.01 * 0.25`; and the band at `u` is the trend's value plus and
+    /// minus `t` times the square root of the fit's variance
+    /// `Vaa + 2 u Vab + u^2 Vbb` and the bend's.
+    #[test]
+    fn the_bend_allowance_and_the_band_by_hand() {
+        let bend = Bend {
+            mean_mps: 3.0,
+            variance_mps2: 0.25,
+            prior_per_s_mps2: -0.04,
+            sd_per_s_mps2: 0.02,
+        };
+        assert!((bend.sd_at(5.0) - 0.0375).abs() < 1e-12);
+        assert!((bend.sd_at(3.0) - 0.0025).abs() < 1e-12);
+        assert!((bend.sd_at(1.0) - 0.0375).abs() < 1e-12);
+        let mut m = predict(&[]);
+        m.coefficients = Some(vec![-2.0, 0.5, -0.02]);
+        m.covariance = Some(vec![vec![0.04, -0.01], vec![-0.01, 0.003]]);
+        m.bend = Some(bend);
+        m.dof = 10;
+        let (y, lo, hi) = m.band(5.0).unwrap();
+        // -2 + 2.5 - 0.5; 0.04 - 0.1 + 0.075 = 0.015; plus 0.0375^2.
+        let half = t_975(10) * (0.015_f64 + 0.0375 * 0.0375).sqrt();
+        assert!((y - 0.0).abs() < 1e-12, "{y}");
+        assert!(
+            (lo + half).abs() < 1e-12 && (hi - half).abs() < 1e-12,
+            "{lo} {hi}"
+        );
+        m.bend = None;
+        let (_, lo, _) = m.band(5.0).unwrap();
+        assert!((lo + t_975(10) * 0.015_f64.sqrt()).abs() < 1e-12, "{lo}");
+    }
+
+    /// Kicks it cannot use are left out and counted as rejected: a speed
+    /// of zero or less, a non-finite growth rate or uncertainty, a
+    /// negative uncertainty. What is left still gives the prediction.
+    #[test]
+    fn unusable_kicks_are_rejected() {
+        let pts: Vec<(f64, f64)> = (0..10)
+            .map(|i| {
+                let u = 2.0 + 0.2 * f64::from(i);
+                (u, 1.5 * (u - 4.2))
+            })
+            .collect();
+        let clean = predict(&kicks(&pts, 0.05));
+        let mut k = kicks(&pts, 0.05);
+        let bad = |speed: f64, sigma: f64, sd: f64| KickPoint {
+            speed_mps: speed,
+            sigma_per_s: sigma,
+            sigma_sd_per_s: sd,
+            freq_hz: 7.0,
+        };
+        k.extend([
+            bad(0.0, -6.0, 0.05),
+            bad(-3.0, -1.0, 0.05),
+            bad(f64::NAN, -1.0, 0.05),
+            bad(3.0, f64::INFINITY, 0.05),
+            bad(3.0, -1.0, f64::NAN),
+            bad(3.0, 5.0, -0.05),
+        ]);
+        let m = predict(&k);
+        assert_eq!((m.kicks_used, m.kicks_rejected), (10, 6), "{m:?}");
+        assert!(m.weights[10..].iter().all(|w| *w == 0.0), "{m:?}");
+        assert_eq!(m.wobble_speed_mps, clean.wobble_speed_mps);
+        assert_eq!(m.ci95_mps, clean.ci95_mps);
+        // Six kicks, one of them unusable: too few.
+        let few: Vec<KickPoint> = k[5..10].iter().chain(&k[15..]).cloned().collect();
+        let few = predict(&few);
+        assert!(few.warnings[0].contains("5 usable"), "{few:?}");
+        assert_eq!(few.kicks_rejected, 6);
+    }
+
+    /// The median of odd and even counts, in any order.
+    #[test]
+    fn the_median_of_odd_and_even_counts() {
+        assert_eq!(median(vec![3.0, 1.0, 2.0]), 2.0);
+        assert_eq!(median(vec![4.0, 1.0, 3.0, 2.0]), 2.5);
+        assert_eq!(median(Vec::new()), 0.0);
+    }
+
     #[test]
     fn refuses_too_few_kicks() {
         let m = predict(&kicks(&[(2.0, -2.0), (2.5, -1.5), (3.0, -1.0)], 0.1));

@@ -5,6 +5,7 @@ use super::filter::HighPass4;
 use super::goertzel::{GoertzelBank, MAX_BINS};
 use super::harmonics::HarmonicCanceller;
 use super::ringdown::{Kick, RingDown};
+use super::trend::EnvelopeTrend;
 use super::{math, ConfigError, DetectorConfig, Params, MAX_HISTORY, MAX_WINDOW};
 use crate::format::{quantise_u16, Alert};
 
@@ -60,6 +61,9 @@ pub struct Estimate {
     pub impulse_holdoff: bool,
     /// Whether the dominant frequency sits on a wheel-rotation harmonic.
     pub at_wheel_harmonic: bool,
+    /// The amplitude's trend over the last seconds (the slope of its
+    /// logarithm, `decay_trend_s`), 1/s: negative while it decays.
+    pub trend_per_s: f32,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -141,8 +145,9 @@ pub struct Detector {
     /// and per hop (the canceller's learning gate).
     input_block_max: f32,
     input_envelope: History,
-    /// Per-hop dominant amplitude.
+    /// Per-hop dominant amplitude, and its trend.
     amps: History,
+    trend: EnvelopeTrend,
     capture_left: usize,
     holdoff_left: usize,
     impulse_peak_deg: f32,
@@ -180,6 +185,11 @@ const RIPPLE_CEILING: f32 = 2.0;
 /// intermediate value far from overflow).
 const INPUT_LIMIT_DEG: f32 = 1000.0;
 
+/// The envelope trend takes amplitudes below this many times `amp_on_deg` as
+/// this (the noise floor: silence is flat, not a logarithm running to minus
+/// infinity).
+const TREND_FLOOR: f32 = 0.25;
+
 impl Detector {
     /// A detector with configuration `cfg` on a wheel of rolling
     /// circumference `wheel_circumference_m`, which places the wheel-rotation
@@ -196,6 +206,7 @@ impl Detector {
         }
         let (window, amp_scale) = hann(p.window_len);
         let (freq_window, freq_amp_scale) = hann(p.freq_window_len);
+        let hop_s = p.hop as f32 / cfg.sample_rate_hz;
         Ok(Self {
             cfg,
             wheel_circumference_m,
@@ -230,6 +241,11 @@ impl Detector {
             input_block_max: 0.0,
             input_envelope: History::new(),
             amps: History::new(),
+            trend: EnvelopeTrend::new(
+                cfg.decay_trend_s / hop_s,
+                hop_s,
+                TREND_FLOOR * cfg.amp_on_deg,
+            ),
             capture_left: 0,
             holdoff_left: 0,
             impulse_peak_deg: 0.0,
@@ -460,6 +476,14 @@ impl Detector {
         }
         let holdoff =
             self.holdoff_left > 0 && amp_deg < self.cfg.impulse_catchup * self.impulse_peak_deg;
+        // The trend of a ring starts where its impulse stops holding the
+        // alert off: the jump from the noise to the ring (and the ring
+        // filling the window) would read as growth for seconds.
+        if holdoff {
+            self.trend.restart();
+        }
+        self.trend.push(amp_deg);
+        let trend_per_s = self.trend.per_s();
 
         let at_wheel_harmonic = speed_mps.is_some_and(|v| {
             let f_wheel = v / self.wheel_circumference_m;
@@ -477,6 +501,7 @@ impl Detector {
             growth_ratio,
             impulse_holdoff: holdoff,
             at_wheel_harmonic,
+            trend_per_s,
         };
 
         match self.state {
@@ -491,8 +516,13 @@ impl Detector {
                 // ring-down outlasting the impulse hold-off): no alert.
                 let decayed =
                     amp_deg < self.cfg.decay_span_ratio * self.amps.max(0, self.p.decay_span);
+                // Decaying over the trend's longer span (a slow ring-down
+                // beating with the road noise after the span's peak): no
+                // alert either.
+                let decaying = trend_per_s < self.cfg.decay_trend_per_s;
                 let on = previous.is_some()
                     && !decayed
+                    && !decaying
                     && amp_deg >= self.cfg.amp_on_deg
                     && in_band
                     && !holdoff
@@ -673,6 +703,59 @@ mod tests {
         let k = kick.expect("the ring-down is measured");
         assert!((k.sigma_per_s + 0.4).abs() < 0.1, "{k:?}");
         assert!((k.freq_hz - 6.5).abs() < 0.05, "{k:?}");
+    }
+
+    /// A kick at 2 s ringing from 2.45 deg at 6 Hz, decaying at 0.31/s, on a
+    /// steady 0.13 deg tone at 6.5 Hz: once the ring has decayed to about
+    /// 0.3 deg the two beat every 2 s, and each beat's peak rises above
+    /// `amp_on_deg` and above 0.85 of the 1.5 s before it.
+    fn slow_ring_beating(t: f32, hold_from_s: f32) -> f32 {
+        let tau = t - 2.0;
+        let ring = if tau < 0.0 {
+            0.0
+        } else {
+            2.45 * (-0.31 * tau.min(hold_from_s)).exp() * (TAU * 6.0 * tau).sin()
+        };
+        ring + 0.13 * (TAU * 6.5 * t).sin()
+    }
+
+    fn alerts(cfg: DetectorConfig, secs: f32, signal: impl Fn(f32) -> f32) -> Vec<f32> {
+        let mut d =
+            Detector::new(cfg, crate::wheel::WheelConfig::DEFAULT.circumference_m).expect("valid");
+        (0..(secs * 100.0) as usize)
+            .filter_map(|i| {
+                let t = i as f32 / 100.0;
+                matches!(d.push(signal(t), None), Some(AlertEvent::On { .. })).then_some(t)
+            })
+            .collect()
+    }
+
+    #[test]
+    fn a_slow_ring_beating_with_the_noise_does_not_alert() {
+        let ring = |t| slow_ring_beating(t, f32::INFINITY);
+        let cfg = DetectorConfig::default();
+        assert_eq!(alerts(cfg, 12.0, ring), [] as [f32; 0]);
+        // Without the trend the decay check alone lets a beat's peak alert.
+        let no_trend = DetectorConfig {
+            decay_trend_s: 0.0,
+            ..cfg
+        };
+        assert!(!alerts(no_trend, 12.0, ring).is_empty());
+    }
+
+    #[test]
+    fn a_ring_that_stops_decaying_and_holds_alerts() {
+        // The same ring holding at 0.9 deg from 3.3 s after the kick.
+        let hold_s = 3.3;
+        let on = alerts(DetectorConfig::default(), 12.0, |t| {
+            slow_ring_beating(t, hold_s)
+        });
+        let hold_at = 2.0 + hold_s;
+        assert!(
+            on.first()
+                .is_some_and(|&t| t > hold_at && t < hold_at + 3.0),
+            "{on:?}"
+        );
     }
 
     #[test]

@@ -469,9 +469,24 @@ mod tests {
             assert!((lhs - rhs).abs() < 1e-4, "{x}");
         }
         assert!(lo < 1.0 && hi.unwrap() > 1.0);
+        // With a covariance between intercept and slope (the estimate's
+        // line, centred on its mean speed, has none, but the interval is
+        // Fieller's for any): `(x - 1)^2 = t^2 (Vaa + 2 x Vab + x^2 Vbb)`.
+        let vab = -0.004;
+        let (lo, hi) = fieller(-1.0, 1.0, [vaa, vab, vbb], t).unwrap();
+        for x in [lo, hi.unwrap()] {
+            let lhs = (x - 1.0) * (x - 1.0);
+            let rhs = t * t * (vaa + 2.0 * x * vab + x * x * vbb);
+            assert!((lhs - rhs).abs() < 1e-4, "{x}");
+        }
         // A slope within its noise: a lower bound only.
         let (lo, hi) = fieller(-1.0, 0.05, [vaa, 0.0, vbb], t).unwrap();
         assert!(hi.is_none() && lo.is_finite(), "{lo}");
+        // And an intercept within its noise too: the quadratic
+        // `(0.0025 - 0.01) x^2 - 0.1 x + (1 - 4)` is negative everywhere
+        // (its discriminant 0.01 - 0.09 < 0), every speed is inside, no
+        // bound at all.
+        assert_eq!(fieller(-1.0, 0.05, [1.0, 0.0, vbb], t), None);
     }
 
     /// Each kick counts with its calibrated uncertainty
@@ -511,6 +526,89 @@ mod tests {
         assert!((k.sigma_sd_per_s() - 0.165_925).abs() < 1e-5);
     }
 
+    /// A scattered line worked by hand in `f64`: eight kicks at 2.0-3.4
+    /// m/s off `sigma = 0.8 (u - 4.5)` by `+e, -e, -e, +e, +e, -e, -e, +e`
+    /// (orthogonal to 1 and to u: the weighted line is the true one),
+    /// `e` twice the kicks' calibrated SD. Every residual is 2 SD, so
+    /// every bisquare weight is the same `q / sd^2` and the residual
+    /// variance of unit weight `n q e^2 / ((n - 2) sd^2)` is above 1: it
+    /// scales the covariance, `q` cancels, and about the mean speed `m`
+    /// `Vaa = e^2 / (n - 2)`, `Vab = 0`, `Vbb = n e^2 / ((n - 2) Suu)`.
+    /// The bounds are the roots of Fieller's quadratic with t of 6
+    /// degrees of freedom.
+    #[test]
+    fn a_scattered_line_worked_by_hand() {
+        let se = 0.01_f64;
+        let sd = ((3.3 * se).powi(2) + 0.0175_f64.powi(2)).sqrt();
+        let e = 2.0 * sd;
+        let pattern = [1.0, -1.0, -1.0, 1.0, 1.0, -1.0, -1.0, 1.0];
+        let speeds: std::vec::Vec<f64> = (0..8).map(|i| 2.0 + 0.2 * f64::from(i)).collect();
+        let pts: std::vec::Vec<(f32, f32)> = speeds
+            .iter()
+            .zip(pattern)
+            .map(|(&u, p)| (u as f32, (0.8 * (u - 4.5) + e * p) as f32))
+            .collect();
+        let got = warning_after(&pts, se as f32).estimate().unwrap();
+        let n = 8.0;
+        let m = speeds.iter().sum::<f64>() / n;
+        let suu: f64 = speeds.iter().map(|u| (u - m).powi(2)).sum();
+        let (vaa, vbb) = (e * e / (n - 2.0), n * e * e / ((n - 2.0) * suu));
+        let (a, b) = (0.8 * (m - 4.5), 0.8);
+        let t2 = f64::from(t_975(6)).powi(2);
+        let (qa, qb, qc) = (b * b - t2 * vbb, 2.0 * a * b, a * a - t2 * vaa);
+        let r = (qb * qb - 4.0 * qa * qc).sqrt();
+        let (lo, hi) = (m + (-qb - r) / (2.0 * qa), m + (-qb + r) / (2.0 * qa));
+        assert_eq!(got.kicks, 8);
+        assert!(
+            (f64::from(got.estimate_mps.unwrap()) - 4.5).abs() < 1e-3,
+            "{got:?}"
+        );
+        assert!(
+            (f64::from(got.lower_mps) - lo).abs() < 2e-3,
+            "{got:?}, want {lo}"
+        );
+        let upper = f64::from(got.upper_mps.unwrap());
+        assert!((upper - hi).abs() < 2e-3, "{got:?}, want {hi}");
+        // The same kicks with no scatter: a narrower interval, the kicks'
+        // own uncertainty alone.
+        let exact: std::vec::Vec<(f32, f32)> = speeds
+            .iter()
+            .map(|&u| (u as f32, (0.8 * (u - 4.5)) as f32))
+            .collect();
+        let narrow = warning_after(&exact, se as f32).estimate().unwrap();
+        assert!(
+            narrow.lower_mps > got.lower_mps + 0.01,
+            "{narrow:?} {got:?}"
+        );
+    }
+
+    /// Kicks at 1.5-2.3 m/s of a line crossing at 4.5 m/s: the zero lies
+    /// 2.2 m/s beyond the fastest kick, more than the 0.8 m/s measured, so
+    /// the upper end is left open though the rise of sigma is clear; the
+    /// estimate and its lower bound stand.
+    #[test]
+    fn a_long_extrapolation_leaves_the_upper_end_open() {
+        let pts: std::vec::Vec<(f32, f32)> = (0..9)
+            .map(|i| {
+                let u = 1.5 + 0.1 * i as f32;
+                (u, 1.5 * (u - 4.5))
+            })
+            .collect();
+        let e = warning_after(&pts, 0.01).estimate().unwrap();
+        assert!((e.estimate_mps.unwrap() - 4.5).abs() < 1e-3, "{e:?}");
+        assert!(e.lower_mps < 4.5 && e.lower_mps > 2.3, "{e:?}");
+        assert_eq!(e.upper_mps, None, "{e:?}");
+    }
+
+    /// The median of odd and even counts, in any order.
+    #[test]
+    fn the_median_of_odd_and_even_counts() {
+        assert_eq!(median(&mut [3.0, 1.0, 2.0]), 2.0);
+        assert_eq!(median(&mut [4.0, 1.0, 3.0, 2.0]), 2.5);
+        assert_eq!(median(&mut [5.0, 4.0, 3.0, 2.0, 1.0, 0.0]), 2.5);
+        assert_eq!(median(&mut []), 0.0);
+    }
+
     #[test]
     fn too_few_kicks_or_too_narrow_a_range_give_no_estimate() {
         let line = |u: f32| 1.5 * (u - 4.2);
@@ -533,11 +631,23 @@ mod tests {
             .map(|i| (2.0 + 0.2 * i as f32, -0.5 - 0.3 * i as f32))
             .collect();
         assert_eq!(warning_after(&falling, 0.05).estimate(), None);
-        // Kicks without a speed are left out.
+        // Kicks without a speed, or with a speed that is no speed
+        // (negative, zero, infinite, NaN), are left out.
         let mut m = MarginWarning::new(0.5);
-        for i in 0..10 {
+        for (i, speed) in [
+            None,
+            Some(-3.0),
+            Some(0.0),
+            Some(f32::INFINITY),
+            Some(f32::NAN),
+        ]
+        .into_iter()
+        .cycle()
+        .take(10)
+        .enumerate()
+        {
             let mut k = kick(2.0 + 0.2 * i as f32, -1.0, 0.05);
-            k.speed_mps = None;
+            k.speed_mps = speed;
             assert_eq!(m.add_kick(&k), None);
         }
         assert_eq!(m.len, 0);

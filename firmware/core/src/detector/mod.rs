@@ -35,6 +35,7 @@ pub mod margin;
 pub mod math;
 mod pattern;
 mod ringdown;
+mod trend;
 
 pub use filter::{Biquad, HighPass4};
 pub use goertzel::{goertzel_power, GoertzelBank, MAX_BINS};
@@ -131,6 +132,14 @@ pub struct DetectorConfig {
     /// oscillation has died down since (a kick's ring-down once it is past
     /// the impulse hold-off) and never alerts; 0 switches the check off.
     pub decay_span_ratio: f32,
+    /// Time constant of the envelope trend: a line through the logarithm of
+    /// the analyses' amplitudes, weighted by `exp(-age / decay_trend_s)`
+    /// (0 switches the check off)...
+    pub decay_trend_s: f32,
+    /// ...whose slope (1/s) must not be below this: an envelope decaying
+    /// faster over the trend's span (a slow ring-down that has decayed into
+    /// the road noise and beats with it) never alerts.
+    pub decay_trend_per_s: f32,
 }
 
 impl DetectorConfig {
@@ -166,6 +175,8 @@ impl DetectorConfig {
         harmonic_tau_s: 3.0,
         decay_span_s: 1.5,
         decay_span_ratio: 0.85,
+        decay_trend_s: 2.0,
+        decay_trend_per_s: -0.15,
     };
 
     /// Worst-case and average arithmetic per sample for this configuration
@@ -196,8 +207,8 @@ impl DetectorConfig {
             add: 2 * k * len + 2 * k + 9 + 4,
             other: k + 3,
         };
-        // Per hop: one bank over the window, the impulse envelope maxima and
-        // the state machine (~20 compares / mul).
+        // Per hop: one bank over the window, the impulse envelope maxima,
+        // the envelope trend and the state machine (~20 compares / mul).
         let b = bank(n);
         let per_hop = Cost1 {
             mul: b.mul + 6,
@@ -205,7 +216,7 @@ impl DetectorConfig {
             other: b.other
                 + 2 * (p.impulse_fast + p.impulse_ref + p.window_len / p.hop) as u32
                 + 20,
-        };
+        } + trend::COST;
         // When the alert fires: one more bank over the frequency window.
         let on_alert = bank(m);
         let hop = p.hop as u32;
@@ -330,7 +341,7 @@ pub struct Cost {
     pub canceller: Cost1,
     /// Goertzel recursion steps per hop (bins x window).
     pub goertzel_steps_per_hop: u32,
-    /// More per sample while a kick's ring-down is measured (at most 1.95 s
+    /// More per sample while a kick's ring-down is measured (at most 1.88 s
     /// after each kick).
     pub ringdown: Cost1,
     /// Once per kick, on the sample that reports it: the ring-down fit and
@@ -442,6 +453,8 @@ impl Params {
             c.harmonic_tau_s,
             c.decay_span_s,
             c.decay_span_ratio,
+            c.decay_trend_s,
+            c.decay_trend_per_s,
         ];
         if all.iter().any(|v| !v.is_finite()) {
             return Err(ConfigError::NotFinite);
@@ -489,6 +502,7 @@ impl Params {
             c.harmonic_tau_s,
             c.decay_span_s,
             c.decay_span_ratio,
+            c.decay_trend_s,
         ];
         if c.amp_off_deg >= c.amp_on_deg || non_negative.iter().any(|&v| v < 0.0) {
             return Err(ConfigError::Thresholds);

@@ -16,9 +16,6 @@ use super::SPEED_TOL_MPS;
 
 /// Newton steps before giving up (the test bicycle's crossings take 3).
 const MAX_STEPS: usize = 12;
-/// Below this step, m/s, a step that no longer halves is round-off in the
-/// real part (its noise over its slope), not a failing iteration.
-const ROUND_OFF_MPS: f64 = 1e-10;
 
 /// One eigenvalue at one speed and its derivative in speed.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -107,7 +104,6 @@ pub(super) fn crossing(
     let a = matrix(start);
     let mut vectors = Vectors::generic(a.nrows());
     let (mut u, mut shift, mut a) = (start, guess, a);
-    let mut last_step = f64::INFINITY;
     for _ in 0..MAX_STEPS {
         let at = local(&a, &slope(u), shift, &mut vectors)?;
         let step = -at.value.re / at.slope.re;
@@ -120,11 +116,9 @@ pub(super) fn crossing(
         }
         // The next iterate and its eigenvalue predicted along the slope.
         (u, shift) = (next, at.value + at.slope * step);
-        let size = step.abs();
-        if size <= SPEED_TOL_MPS || (size <= ROUND_OFF_MPS && size > 0.5 * last_step) {
+        if step.abs() <= SPEED_TOL_MPS {
             return Some((u, shift));
         }
-        last_step = size;
         a = matrix(u);
     }
     None
