@@ -308,7 +308,10 @@ fn margin_holds_on_a_bicycle_never_tuned_on() {
             let m = predict(&host_points(&c));
             let truth = c.wobble_speed_mps;
             let w = m.wobble_speed_mps.expect("a prediction");
-            assert!((w / truth - 1.0).abs() <= 0.05, "{name} {seed}: {truth} {m:?}");
+            assert!(
+                (w / truth - 1.0).abs() <= 0.05,
+                "{name} {seed}: {truth} {m:?}"
+            );
             assert!(
                 matches!(m.ci95_mps, [Some(lo), Some(hi)] if lo <= truth && truth <= hi),
                 "{name} {seed}: {truth} {m:?}"
