@@ -68,6 +68,7 @@ targets=(
   "critical|wobble-model|host-tools/bicycle-model/src/critical.rs|sign,by_newton|--lib"
   "critical-newton|wobble-model|host-tools/bicycle-model/src/critical/newton.rs|.|--lib"
   "margin-regression|wobblog|host-tools/src/analysis/margin.rs|.|--lib|analysis::margin::"
+  "decay-trend|wobble-core|firmware/core/src/detector/trend.rs|.|--lib --test detector_machine --test detector_props"
   "margin-warning|wobble-core|firmware/core/src/detector/margin.rs|MarginWarning,fieller,estimate,robust_line,weighted_line,median,t_975|--lib|detector::margin::"
 )
 
