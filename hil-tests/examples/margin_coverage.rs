@@ -121,17 +121,44 @@ fn main() -> Result<(), String> {
         ),
         ("card", |l: &Line| l.card.clone()),
     ] {
-        let z: Vec<f64> = lines
+        // Each measured kick's stated SD and its error in those SDs, by SD.
+        let mut by_sd: Vec<(f64, f64)> = lines
             .iter()
-            .filter_map(|l| pick(l).map(|p| (p.sigma_per_s - l.true_sigma) / p.sigma_sd_per_s))
+            .filter_map(|l| {
+                pick(l).map(|p| {
+                    let sd = p.sigma_sd_per_s;
+                    (sd, (p.sigma_per_s - l.true_sigma) / sd)
+                })
+            })
             .collect();
-        let within = z.iter().filter(|z| z.abs() <= 2.0).count();
+        by_sd.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let z: Vec<f64> = by_sd.iter().map(|(_, z)| *z).collect();
+        let within = |k: f64| z.iter().filter(|z| z.abs() <= k).count();
         let rms = (z.iter().map(|z| z * z).sum::<f64>() / z.len().max(1) as f64).sqrt();
         println!(
-            "{name} kicks: {} of {} measured; error within 2 stated SD: {}; RMS of error/SD {rms:.2}",
+            "{name} kicks: {} of {} measured; error within 1 stated SD: {}; within 2: {}; \
+             RMS of error/SD {rms:.2}",
             z.len(),
             lines.len(),
-            rate(within, z.len())
+            rate(within(1.0), z.len()),
+            rate(within(2.0), z.len())
+        );
+        // The calibration's measure: the median |error| / SD is 0.674 in
+        // every fifth of the kicks by stated SD when the SDs are right.
+        let fifths: Vec<String> = (0..5)
+            .map(|q| {
+                let mut part: Vec<f64> = z[q * z.len() / 5..(q + 1) * z.len() / 5]
+                    .iter()
+                    .map(|z| z.abs())
+                    .collect();
+                part.sort_by(f64::total_cmp);
+                part.get(part.len() / 2)
+                    .map_or("-".into(), |m| format!("{m:.2}"))
+            })
+            .collect();
+        println!(
+            "{name} kicks: median |error| / SD by fifth of stated SD (0.674 if right): {}",
+            fifths.join(" ")
         );
     }
     let mut campaigns: BTreeMap<(String, u64), Vec<&Line>> = BTreeMap::new();
