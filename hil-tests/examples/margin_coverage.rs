@@ -133,6 +133,16 @@ fn main() -> Result<(), String> {
             .collect();
         by_sd.sort_by(|a, b| a.0.total_cmp(&b.0));
         let z: Vec<f64> = by_sd.iter().map(|(_, z)| *z).collect();
+        let errors: Vec<f64> = by_sd.iter().map(|(sd, z)| sd * z).collect();
+        let mut sizes: Vec<f64> = errors.iter().map(|e| e.abs()).collect();
+        sizes.sort_by(f64::total_cmp);
+        let at = |q: f64| sizes.get((q * sizes.len() as f64) as usize).copied();
+        println!(
+            "{name} kicks: sigma error mean {:+.3} 1/s; |error| median {:.3}, 90th percentile {:.3} 1/s",
+            errors.iter().sum::<f64>() / errors.len().max(1) as f64,
+            at(0.5).unwrap_or(f64::NAN),
+            at(0.9).unwrap_or(f64::NAN)
+        );
         let within = |k: f64| z.iter().filter(|z| z.abs() <= k).count();
         let rms = (z.iter().map(|z| z * z).sum::<f64>() / z.len().max(1) as f64).sqrt();
         println!(
