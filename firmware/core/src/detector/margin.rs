@@ -609,6 +609,26 @@ mod tests {
         assert_eq!(median(&mut []), 0.0);
     }
 
+    /// The limits are inclusive: six kicks spanning exactly 0.75 m/s
+    /// (`MIN_SPAN_MPS`) give an estimate, and its zero, exactly as far
+    /// beyond the fastest kick as the range measured (sigma = 1.5 (u - 3.5),
+    /// every figure a binary fraction), is bounded above.
+    #[test]
+    fn a_range_of_exactly_the_minimum_and_an_extrapolation_of_exactly_the_range_count() {
+        let pts: std::vec::Vec<(f32, f32)> = [2.0, 2.25, 2.5, 2.75, 2.0, 2.75]
+            .iter()
+            .map(|&u| (u, 1.5 * (u - 3.5)))
+            .collect();
+        let e = warning_after(&pts, 0.01).estimate().unwrap();
+        assert_eq!(e.estimate_mps, Some(3.5), "{e:?}");
+        assert!(e.upper_mps.is_some_and(|h| h > 3.5), "{e:?}");
+        // Closer than the range: bounded too (the distance, not the ratio
+        // of the zero to the fastest kick, is what counts).
+        let near: std::vec::Vec<(f32, f32)> = pts.iter().map(|&(u, s)| (u, s + 0.45)).collect();
+        let e = warning_after(&near, 0.01).estimate().unwrap();
+        assert!(e.upper_mps.is_some(), "{e:?}");
+    }
+
     #[test]
     fn too_few_kicks_or_too_narrow_a_range_give_no_estimate() {
         let line = |u: f32| 1.5 * (u - 4.2);
