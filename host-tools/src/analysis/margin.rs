@@ -915,14 +915,34 @@ mod tests {
     /// with t of 6 degrees of freedom.
     #[test]
     fn a_weighted_line_worked_by_hand() {
+        let m = hand_worked_line(&[]);
+        assert_eq!((m.kicks_used, m.kicks_rejected), (8, 0));
+    }
+
+    /// The same eight kicks and a ninth at 3.0 m/s, 40 SD above the line:
+    /// it leaves the MAD scale (the median residual is still 2 SD), gets no
+    /// weight and no degree of freedom (the unit variance stays
+    /// `sum w e^2 / 6` over the eight), so the fit and its interval are the
+    /// eight's.
+    #[test]
+    fn a_rejected_kick_leaves_the_hand_worked_line_as_it_was() {
+        let m = hand_worked_line(&[(3.0, 0.8 * (3.0 - 4.5) + 40.0 * 0.05)]);
+        assert_eq!((m.kicks_used, m.kicks_rejected), (8, 1));
+        assert_eq!(m.weights[8], 0.0);
+    }
+
+    /// The hand-worked line above with `extra` kicks after the eight, each
+    /// of them to be rejected; every figure of the eight checked.
+    fn hand_worked_line(extra: &[(f64, f64)]) -> Margin {
         let (e, sd, n) = (0.1, 0.05, 8);
         let pattern = [1.0, -1.0, -1.0, 1.0, 1.0, -1.0, -1.0, 1.0];
-        let pts: Vec<(f64, f64)> = (0..n)
+        let mut pts: Vec<(f64, f64)> = (0..n)
             .map(|i| {
                 let u = 2.0 + 0.2 * f64::from(i as u8);
                 (u, 0.8 * (u - 4.5) + e * pattern[i])
             })
             .collect();
+        pts.extend_from_slice(extra);
         let none = BendPrior {
             mean_per_s_mps2: 0.0,
             sd_per_s_mps2: 0.0,
@@ -931,9 +951,10 @@ mod tests {
         let r = 2.0 / (BISQUARE_C * 1.482_6 * 2.0);
         let q = (1.0 - r * r).powi(2);
         let w = q / (sd * sd);
-        for got in &m.weights {
+        for got in &m.weights[..n] {
             assert!((got - w).abs() < 1e-9 * w, "{got} {w}");
         }
+        let pts = &pts[..n];
         let s2 = 8.0 * w * e * e / 6.0;
         assert!((m.unit_variance.unwrap() - s2).abs() < 1e-9, "{m:?}");
         let c = m.coefficients.as_ref().unwrap();
@@ -956,8 +977,9 @@ mod tests {
         let [got_lo, got_hi] = m.ci95_mps;
         assert!((got_lo.unwrap() - lo).abs() < 1e-6, "{m:?} {lo}");
         assert!((got_hi.unwrap() - hi).abs() < 1e-6, "{m:?} {hi}");
-        assert_eq!((m.kicks_used, m.kicks_rejected, m.dof), (8, 0, 6));
+        assert_eq!(m.dof, 6);
         assert_eq!(m.speed_range_mps, Some([pts[0].0, pts[7].0]));
+        m
     }
 
     /// The robust fit is a fixed point of its reweighting: from the final
