@@ -839,6 +839,15 @@ mod tests {
             (0.01, 50.0),
         );
         assert!(lo.is_some() && hi.is_none(), "{lo:?} {hi:?}");
+        // An intercept within its noise: Fieller's lower root is at
+        // -0.100 m/s, no speed, so the search stops at 0 with no lower end;
+        // the upper is the closed form's.
+        let v = [0.01, 0.0, 0.0025];
+        let (lo, hi) =
+            profile_interval(&[-0.1, 1.0], |u| variance(&cov, u), 2.0, 0.1, (0.01, 50.0));
+        let (want_lo, want_hi) = fieller_closed_form(-0.1, 1.0, v, 2.0);
+        assert!(want_lo < -0.1 && lo.is_none(), "{lo:?} {want_lo}");
+        assert!((hi.unwrap() - want_hi).abs() < 1e-6, "{hi:?} {want_hi}");
     }
 
     /// Gaussian draws from a xorshift generator (Box-Muller).
