@@ -988,7 +988,39 @@ mod tests {
         assert!((got_hi.unwrap() - hi).abs() < 1e-6, "{m:?} {hi}");
         assert_eq!(m.dof, 6);
         assert_eq!(m.speed_range_mps, Some([pts[0].0, pts[7].0]));
+        // The bend's lever: the kicks' mean speed, 2.7 m/s, and the mean
+        // square of their distances from it, 2 (0.1^2 + 0.3^2 + 0.5^2 +
+        // 0.7^2) / 8 = 0.21 (m/s)^2 (equal weights).
+        let bend = m.bend.as_ref().unwrap();
+        assert!((bend.mean_mps - 2.7).abs() < 1e-12, "{bend:?}");
+        assert!((bend.variance_mps2 - 0.21).abs() < 1e-12, "{bend:?}");
         m
+    }
+
+    /// Six kicks are enough, the limit included; rejected kicks do not
+    /// count towards it: seven with one wild kick predict, six with one
+    /// (five carrying weight) do not.
+    #[test]
+    fn six_kicks_that_carry_weight_are_needed_and_enough() {
+        let line = |u: f64| 1.5 * (u - 3.6);
+        let pts: Vec<(f64, f64)> = (0..6)
+            .map(|i| 2.0 + 0.2 * f64::from(i))
+            .map(|u| (u, line(u)))
+            .collect();
+        let six = predict(&kicks(&pts, 0.05));
+        assert_eq!(six.kicks_used, 6, "{six:?}");
+        assert!(six.wobble_speed_mps.is_some(), "{six:?}");
+        let mut one_wild = pts.clone();
+        one_wild.push((2.5, line(2.5) + 3.0));
+        let m = predict(&kicks(&one_wild, 0.05));
+        assert_eq!((m.kicks_used, m.kicks_rejected), (6, 1), "{m:?}");
+        assert!(m.wobble_speed_mps.is_some(), "{m:?}");
+        let mut five = one_wild;
+        five.remove(5);
+        let m = predict(&kicks(&five, 0.05));
+        assert_eq!((m.kicks_used, m.kicks_rejected), (5, 1), "{m:?}");
+        assert!(m.wobble_speed_mps.is_none(), "{m:?}");
+        assert!(m.warnings[0].contains("5 carry weight"), "{m:?}");
     }
 
     /// The robust fit is a fixed point of its reweighting: from the final
