@@ -952,11 +952,7 @@ mod tests {
             })
             .collect();
         pts.extend_from_slice(extra);
-        let none = BendPrior {
-            mean_per_s_mps2: 0.0,
-            sd_per_s_mps2: 0.0,
-        };
-        let m = predict_bent(&kicks(&pts, sd), Trend::Line, none);
+        let m = predict_bent(&kicks(&pts, sd), Trend::Line, NO_BEND);
         let r = 2.0 / (BISQUARE_C * 1.482_6 * 2.0);
         let q = (1.0 - r * r).powi(2);
         let w = q / (sd * sd);
@@ -995,6 +991,70 @@ mod tests {
         assert!((bend.mean_mps - 2.7).abs() < 1e-12, "{bend:?}");
         assert!((bend.variance_mps2 - 0.21).abs() < 1e-12, "{bend:?}");
         m
+    }
+
+    /// No bend assumed or allowed for.
+    const NO_BEND: BendPrior = BendPrior {
+        mean_per_s_mps2: 0.0,
+        sd_per_s_mps2: 0.0,
+    };
+
+    /// A trend that does not reach zero within the search: eleven kicks at
+    /// 2.0-3.25 m/s exactly on `sigma = 0.1 (u - 8.4)`, SD 0.02 1/s. The
+    /// search ends at the fastest kick plus four ranges, 8.25 m/s, short of
+    /// the zero: no wobble speed, and the lower bound is the first speed
+    /// of the search's grid (a 400th of the range) from the fastest kick up
+    /// where the line is within its noise: Fieller's lower root with the
+    /// covariance `0.02^2 (X^T X)^-1` (an exact line: unit variance 0,
+    /// scaled up to 1), at 6.91 m/s. A falling trend gives no bound.
+    #[test]
+    fn a_zero_beyond_the_search_leaves_a_lower_bound_only() {
+        let (sd, step) = (0.02, 1.25 / 400.0);
+        let us: Vec<f64> = (0..11).map(|i| 2.0 + 0.125 * f64::from(i)).collect();
+        let pts: Vec<(f64, f64)> = us.iter().map(|&u| (u, 0.1 * (u - 8.4))).collect();
+        let m = predict_bent(&kicks(&pts, sd), Trend::Line, NO_BEND);
+        assert_eq!(m.wobble_speed_mps, None, "{m:?}");
+        assert!(
+            m.warnings[0].contains("does not reach zero within the speeds searched"),
+            "{m:?}"
+        );
+        let (s1, s2) = us.iter().fold((0.0, 0.0), |(a, b), u| (a + u, b + u * u));
+        let det = 11.0 * s2 - s1 * s1;
+        let v = [
+            sd * sd * s2 / det,
+            -sd * sd * s1 / det,
+            sd * sd * 11.0 / det,
+        ];
+        let (root, _) = fieller_closed_form(-0.84, 0.1, v, t_975(9));
+        assert!((root - 6.91).abs() < 0.01, "{root}");
+        let lower = m.ci95_mps[0].unwrap();
+        assert!(lower >= root && lower < root + step, "{lower} {root}");
+        assert_eq!(m.ci95_mps[1], None);
+        let falling: Vec<(f64, f64)> = us.iter().map(|&u| (u, -0.5 - 0.1 * (u - 2.0))).collect();
+        let m = predict_bent(&kicks(&falling, sd), Trend::Line, NO_BEND);
+        assert!(m.warnings[0].contains("does not rise"), "{m:?}");
+        assert_eq!(m.ci95_mps, [None, None], "{m:?}");
+    }
+
+    /// The refusals' limits: seven kicks over exactly 0.75 m/s are not a
+    /// narrow range, and a zero 0.45 m/s beyond the fastest (less than the
+    /// range) is no long extrapolation: no warning, both ends bounded. At
+    /// 1.25 m/s beyond (more than the range, less than 1 + the range) the
+    /// upper end is left open.
+    #[test]
+    fn the_range_and_extrapolation_limits() {
+        let us: Vec<f64> = (0..7).map(|i| 2.0 + 0.125 * f64::from(i)).collect();
+        let line =
+            |zero: f64| -> Vec<(f64, f64)> { us.iter().map(|&u| (u, 1.5 * (u - zero))).collect() };
+        let m = predict_bent(&kicks(&line(3.2), 0.02), Trend::Line, NO_BEND);
+        assert_eq!(m.speed_range_mps, Some([2.0, 2.75]));
+        assert!(m.warnings.is_empty(), "{m:?}");
+        assert!((m.wobble_speed_mps.unwrap() - 3.2).abs() < 1e-6, "{m:?}");
+        assert!(m.ci95_mps.iter().all(Option::is_some), "{m:?}");
+        let m = predict_bent(&kicks(&line(4.0), 0.02), Trend::Line, NO_BEND);
+        assert!(m.warnings[0].contains("long extrapolation"), "{m:?}");
+        assert!((m.wobble_speed_mps.unwrap() - 4.0).abs() < 1e-6, "{m:?}");
+        assert!(m.ci95_mps[0].is_some() && m.ci95_mps[1].is_none(), "{m:?}");
     }
 
     /// Six kicks are enough, the limit included; rejected kicks do not
@@ -1039,11 +1099,7 @@ mod tests {
             })
             .collect();
         pts[5].1 += 2.0;
-        let none = BendPrior {
-            mean_per_s_mps2: 0.0,
-            sd_per_s_mps2: 0.0,
-        };
-        let m = predict_bent(&kicks(&pts, sd), Trend::Line, none);
+        let m = predict_bent(&kicks(&pts, sd), Trend::Line, NO_BEND);
         let c = m.coefficients.as_ref().unwrap();
         let z: Vec<f64> = pts
             .iter()
