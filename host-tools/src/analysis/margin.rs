@@ -1029,6 +1029,8 @@ mod tests {
         assert!((root - 6.91).abs() < 0.01, "{root}");
         let lower = m.ci95_mps[0].unwrap();
         assert!(lower >= root && lower < root + step, "{lower} {root}");
+        let k = (lower - 3.25) / step;
+        assert!((k - k.round()).abs() < 1e-6, "{lower} is off the grid");
         assert_eq!(m.ci95_mps[1], None);
         let falling: Vec<(f64, f64)> = us.iter().map(|&u| (u, -0.5 - 0.1 * (u - 2.0))).collect();
         let m = predict_bent(&kicks(&falling, sd), Trend::Line, NO_BEND);
