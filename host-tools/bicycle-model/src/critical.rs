@@ -392,6 +392,32 @@ mod tests {
         assert_eq!(by_newton(&matrix, &bracket(0.04)), None);
     }
 
+    /// Two oscillations `(u - 1) ± 5i` and `(u - 0.7) ± 5i`, the first one's
+    /// bracket [0.2, 1.3] (uneven about its crossing at 1 m/s): the
+    /// bracket's straight line is the branch itself, so it points at the
+    /// crossing's `5i` without doubt; the other oscillation is 0.3 from it,
+    /// and the conjugate 10 away. A line drawn wrong (from the other end,
+    /// or scaled) points nearer the other oscillation, and a sort by the
+    /// distance from anything but the line's value finds another root.
+    #[test]
+    fn the_bracket_line_points_at_the_crossing_beside_a_near_oscillation() {
+        let pair = |re: f64| DMatrix::from_row_slice(2, 2, &[re, -5.0, 5.0, re]);
+        let matrix = |u: f64| {
+            let mut m = DMatrix::zeros(4, 4);
+            m.view_mut((0, 0), (2, 2)).copy_from(&pair(u - 1.0));
+            m.view_mut((2, 2), (2, 2)).copy_from(&pair(u - 0.7));
+            m
+        };
+        let bracket = Bracket {
+            branch: 0,
+            below: (0.2, Complex::new(-0.8, 5.0)),
+            above: (1.3, Complex::new(0.3, 5.0)),
+        };
+        let (u, value) = by_newton(&matrix, &bracket).expect("kept");
+        assert!((u - 1.0).abs() < 1e-12, "{u}");
+        assert!((value - Complex::new(0.0, 5.0)).norm() < 1e-12, "{value}");
+    }
+
     /// On the test bicycle's 1000-speed sweep every crossing is refined by
     /// Newton's method, to the speed the branch followed in small steps and
     /// Brent's method give, in at most 4 steps (each evaluates `A(u)` three
