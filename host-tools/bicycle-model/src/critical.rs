@@ -392,20 +392,23 @@ mod tests {
         assert_eq!(by_newton(&matrix, &bracket(0.04)), None);
     }
 
-    /// Two oscillations `(u - 1) ± 5i` and `(u - 0.7) ± 5i`, the first one's
-    /// bracket [0.2, 1.3] (uneven about its crossing at 1 m/s): the
-    /// bracket's straight line is the branch itself, so it points at the
-    /// crossing's `5i` without doubt; the other oscillation is 0.3 from it,
-    /// and the conjugate 10 away. A line drawn wrong (from the other end,
-    /// or scaled) points nearer the other oscillation, and a sort by the
-    /// distance from anything but the line's value finds another root.
+    /// Two oscillations `(u - 1) ± 5i` and `(u - 0.85) ± 5i` and a decay at
+    /// -0.5 1/s, the first one's bracket [0.2, 1.3] (uneven about its
+    /// crossing at 1 m/s): the bracket's straight line is the branch
+    /// itself, so it points at the crossing's `5i` without doubt; the other
+    /// oscillation is 0.15 from it, the conjugate 10 away, the decay (the
+    /// smallest value) 5.02. A line drawn wrong (from the other end, scaled,
+    /// or not divided by the bracket's width, 1.1 m/s) points nearer the
+    /// other oscillation, and a sort by anything but the distance from the
+    /// line's value finds another root.
     #[test]
     fn the_bracket_line_points_at_the_crossing_beside_a_near_oscillation() {
         let pair = |re: f64| DMatrix::from_row_slice(2, 2, &[re, -5.0, 5.0, re]);
         let matrix = |u: f64| {
-            let mut m = DMatrix::zeros(4, 4);
+            let mut m = DMatrix::zeros(5, 5);
             m.view_mut((0, 0), (2, 2)).copy_from(&pair(u - 1.0));
-            m.view_mut((2, 2), (2, 2)).copy_from(&pair(u - 0.7));
+            m.view_mut((2, 2), (2, 2)).copy_from(&pair(u - 0.85));
+            m[(4, 4)] = -0.5;
             m
         };
         let bracket = Bracket {
