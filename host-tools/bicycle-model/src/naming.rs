@@ -508,4 +508,62 @@ mod tests {
         assert_eq!((reference[7], reference[28]), (3.5, 14.0));
         assert!(got.iter().all(|s| s.reference != s.asked.is_some()));
     }
+
+    /// A group of one branch (`member`) with shares of roll, steer, torso,
+    /// twist and tyre lags, oscillating at `hz` on average (0: real) with
+    /// mean real part `re`.
+    fn group(member: usize, shares: [f64; 5], hz: f64, re: f64) -> Group {
+        Group {
+            members: vec![member],
+            shares: Shares(shares),
+            oscillates: hz > 0.0,
+            freq: std::f64::consts::TAU * hz,
+            mean_re: re,
+            mean_abs_re: re.abs(),
+        }
+    }
+
+    /// The module's rules where two groups compete for a name, worked by
+    /// hand: of two weave-like oscillations the one rolling more (of roll
+    /// and steer) is the weave; of two steer oscillations above 2 Hz the
+    /// lower is the wobble; of two real roll modes the slowest is the
+    /// capsize; of two real steer modes the fastest decaying is the
+    /// castering, and a weave-like oscillation steering most is no
+    /// castering (it decays faster still); a real root carried by the tyre
+    /// lags, slower than either capsize candidate, is `other`, and so is
+    /// an oscillation of the tyre lags that twists the fork a little. The
+    /// losers are `other`.
+    #[test]
+    fn of_two_candidates_each_rule_names_the_one_the_docs_say() {
+        let groups = [
+            group(0, [0.5, 0.4, 0.0, 0.0, 0.1], 0.5, -1.0),
+            group(1, [0.7, 0.2, 0.0, 0.0, 0.1], 0.5, -1.0),
+            group(2, [0.1, 0.8, 0.0, 0.0, 0.1], 9.0, -2.0),
+            group(3, [0.1, 0.8, 0.0, 0.0, 0.1], 7.0, -2.0),
+            group(4, [0.8, 0.1, 0.0, 0.0, 0.1], 0.0, 3.0),
+            group(5, [0.8, 0.1, 0.0, 0.0, 0.1], 0.0, 0.5),
+            group(6, [0.2, 0.7, 0.0, 0.0, 0.1], 0.0, -5.0),
+            group(7, [0.2, 0.7, 0.0, 0.0, 0.1], 0.0, -20.0),
+            group(8, [0.45, 0.5, 0.0, 0.0, 0.05], 0.5, -100.0),
+            group(9, [0.05, 0.0, 0.0, 0.0, 0.95], 0.0, 0.1),
+            group(10, [0.0, 0.0, 0.0, 0.05, 0.95], 20.0, -3.0),
+        ];
+        let o = Mode::Other;
+        assert_eq!(
+            classify(&groups, groups.len()),
+            [
+                o,
+                Mode::Weave,
+                o,
+                Mode::Wobble,
+                o,
+                Mode::Capsize,
+                o,
+                Mode::Castering,
+                o,
+                o,
+                o
+            ]
+        );
+    }
 }
