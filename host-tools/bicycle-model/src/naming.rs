@@ -524,8 +524,9 @@ mod tests {
     }
 
     /// The module's rules where two groups compete for a name, worked by
-    /// hand: of two weave-like oscillations the one rolling more (of roll
-    /// and steer) is the weave; of two steer oscillations above 2 Hz the
+    /// hand: of three weave-like oscillations the one rolling most of its
+    /// roll and steer is the weave (0.97 of them; not the one rolling most
+    /// of all its angles, nor the one steering least); of two steer oscillations above 2 Hz the
     /// lower is the wobble; of two real roll modes the slowest is the
     /// capsize; of two real steer modes the fastest decaying is the
     /// castering, and a weave-like oscillation steering most is no
@@ -536,8 +537,8 @@ mod tests {
     #[test]
     fn of_two_candidates_each_rule_names_the_one_the_docs_say() {
         let groups = [
-            group(0, [0.5, 0.4, 0.0, 0.0, 0.1], 0.5, -1.0),
-            group(1, [0.7, 0.2, 0.0, 0.0, 0.1], 0.5, -1.0),
+            group(0, [0.8, 0.15, 0.0, 0.0, 0.05], 0.5, -1.0),
+            group(1, [0.6, 0.02, 0.0, 0.0, 0.38], 0.5, -1.0),
             group(2, [0.1, 0.8, 0.0, 0.0, 0.1], 9.0, -2.0),
             group(3, [0.1, 0.8, 0.0, 0.0, 0.1], 7.0, -2.0),
             group(4, [0.8, 0.1, 0.0, 0.0, 0.1], 0.0, 3.0),
@@ -547,6 +548,7 @@ mod tests {
             group(8, [0.45, 0.5, 0.0, 0.0, 0.05], 0.5, -100.0),
             group(9, [0.05, 0.0, 0.0, 0.0, 0.95], 0.0, 0.1),
             group(10, [0.0, 0.0, 0.0, 0.05, 0.95], 20.0, -3.0),
+            group(11, [0.1, 0.004, 0.0, 0.0, 0.896], 0.5, -1.0),
         ];
         let o = Mode::Other;
         assert_eq!(
@@ -560,6 +562,7 @@ mod tests {
                 Mode::Capsize,
                 o,
                 Mode::Castering,
+                o,
                 o,
                 o,
                 o
