@@ -100,11 +100,7 @@ impl Output {
         // a redirection's `>>` stays an append and nothing is renamed over
         // the file behind it.
         if names_open_file(target) {
-            let file = OpenOptions::new()
-                .append(true)
-                .open(target)
-                .map_err(|e| CliError::file(target, plain(&e)))?;
-            return Ok(Self::in_place(target, file));
+            return Self::in_place(target, target, OpenOptions::new().append(true));
         }
         let resolved = follow_links(target).map_err(|e| CliError::file(target, plain(&e)))?;
         let existing = match fs::metadata(&resolved) {
@@ -121,11 +117,7 @@ impl Output {
         // A device or a pipe (`-o /dev/null`, a FIFO) is written as it is:
         // renaming a file over it would replace the device itself.
         if existing.as_ref().is_some_and(|m| !m.is_file()) {
-            let file = OpenOptions::new()
-                .write(true)
-                .open(&resolved)
-                .map_err(|e| CliError::file(target, plain(&e)))?;
-            return Ok(Self::in_place(target, file));
+            return Self::in_place(target, &resolved, OpenOptions::new().write(true));
         }
         if let Some(meta) = &existing {
             refuse_protected(target, meta)?;
@@ -144,12 +136,18 @@ impl Output {
         })
     }
 
-    fn in_place(target: &Path, file: fs::File) -> Self {
-        Self {
+    /// The output's two exceptions to the temporary file and rename: the
+    /// file at `path` (`target` or where its links lead), opened with
+    /// `options` and written where it is.
+    fn in_place(target: &Path, path: &Path, options: &OpenOptions) -> Result<Self, CliError> {
+        let file = options
+            .open(path)
+            .map_err(|e| CliError::file(target, plain(&e)))?;
+        Ok(Self {
             sink: Sink::Device(BufWriter::with_capacity(BUFFER_LEN, file)),
             name: target.to_path_buf(),
             pipe_closed: false,
-        }
+        })
     }
 
     /// An output to standard output. A reader that goes away (`| head`)
