@@ -121,19 +121,14 @@ fn main() -> Result<(), String> {
         ),
         ("card", |l: &Line| l.card.clone()),
     ] {
-        // Each measured kick's stated SD and its error in those SDs, by SD.
+        // Each measured kick's stated SD and its error, by SD.
         let mut by_sd: Vec<(f64, f64)> = lines
             .iter()
-            .filter_map(|l| {
-                pick(l).map(|p| {
-                    let sd = p.sigma_sd_per_s;
-                    (sd, (p.sigma_per_s - l.true_sigma) / sd)
-                })
-            })
+            .filter_map(|l| pick(l).map(|p| (p.sigma_sd_per_s, p.sigma_per_s - l.true_sigma)))
             .collect();
         by_sd.sort_by(|a, b| a.0.total_cmp(&b.0));
-        let z: Vec<f64> = by_sd.iter().map(|(_, z)| *z).collect();
-        let errors: Vec<f64> = by_sd.iter().map(|(sd, z)| sd * z).collect();
+        let errors: Vec<f64> = by_sd.iter().map(|(_, e)| *e).collect();
+        let z: Vec<f64> = by_sd.iter().map(|(sd, e)| e / sd).collect();
         let mut sizes: Vec<f64> = errors.iter().map(|e| e.abs()).collect();
         sizes.sort_by(f64::total_cmp);
         let at = |q: f64| sizes.get((q * sizes.len() as f64) as usize).copied();

@@ -8,27 +8,30 @@ mod support;
 use support::bundled;
 
 use wobble_model::eig::eigenvector;
-use wobble_model::{Mode, Model, Sweep};
+use wobble_model::{Mode, Model, StateRole, Sweep};
 
 /// Mean shares of roll, steer, torso, twist and the tyre lags (squared
 /// moduli over their sum, rates left out) of the eigenvectors of `values`.
 fn mean_shares(model: &Model, speeds: &[f64], values: &[wobble_model::Complex<f64>]) -> [f64; 5] {
-    let names = model.state_names();
-    let slot = |n: &str| match n {
-        "phi" => Some(0),
-        "delta" => Some(1),
-        "phi_r" => Some(2),
-        "beta" => Some(3),
-        n if n.starts_with("alpha") || n.starts_with("gamma") => Some(4),
-        _ => None,
-    };
+    let slots: Vec<Option<usize>> = model
+        .state_roles()
+        .into_iter()
+        .map(|role| match role {
+            StateRole::Roll => Some(0),
+            StateRole::Steer => Some(1),
+            StateRole::Torso => Some(2),
+            StateRole::Twist => Some(3),
+            StateRole::Tyre => Some(4),
+            _ => None,
+        })
+        .collect();
     let mut mean = [0.0; 5];
     for (u, v) in speeds.iter().zip(values) {
         let x = eigenvector(&model.state_matrix(*u), *v);
         let mut s = [0.0; 5];
-        for (n, c) in names.iter().zip(x.iter()) {
-            if let Some(i) = slot(n) {
-                s[i] += c.norm_sqr();
+        for (slot, c) in slots.iter().zip(x.iter()) {
+            if let Some(i) = slot {
+                s[*i] += c.norm_sqr();
             }
         }
         let total: f64 = s.iter().sum();
