@@ -89,7 +89,8 @@ pub type Card = (Option<String>, Vec<PathBuf>);
 
 /// The logs of a card (`*.WBL` at the top of `dir`: one card, no name) or
 /// of a folder of cards (none at the top: each subdirectory with logs is a
-/// card, named after it), cards and logs sorted by name.
+/// card, named after it), cards and logs sorted by name; a second name or
+/// a copy of a log is left out with a note ([`crate::inputs::distinct`]).
 ///
 /// # Errors
 /// An unreadable directory, or no log at either level.
@@ -113,6 +114,12 @@ pub fn cards_in(dir: &Path) -> Result<Vec<Card>, CliError> {
     } else {
         cards.push((None, top));
     }
+    let all: Vec<PathBuf> = cards.iter().flat_map(|(_, logs)| logs.clone()).collect();
+    let kept = crate::inputs::distinct(all);
+    for (_, logs) in &mut cards {
+        logs.retain(|log| kept.contains(log));
+    }
+    cards.retain(|(_, logs)| !logs.is_empty());
     if cards.is_empty() {
         return Err(CliError::file(
             dir,

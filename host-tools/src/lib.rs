@@ -11,6 +11,7 @@ pub mod dataset;
 pub mod error;
 pub mod events;
 pub mod export;
+pub mod inputs;
 pub mod interrupt;
 pub mod losses;
 pub mod output;

@@ -7,15 +7,18 @@
 //! without committing it, on any error path, removes the temporary file
 //! and leaves whatever was at the target as it was. An output that is the
 //! same file as one of the command's inputs (same path, a hard link, or a
-//! symlink to it: handles are compared, not names) is refused before
-//! anything is created, and so is standard output when it is an input
-//! (`decode LOG >> LOG`, which `cat` refuses too).
+//! symlink to it: device and inode numbers are compared, not names, and
+//! no file is opened to compare it) is refused before anything is
+//! created, and so is standard output when it is an input (`info LOG >>
+//! LOG`, which `cat` refuses too): every command's standard output and
+//! files are made here, so the rule holds for all of them.
 //!
 //! What is replaced, and how:
 //! - a name for one of the process's open files (`/dev/stdout`,
 //!   `/dev/stderr`, `/dev/fd/N`, `/proc/self/fd/N`, or a link to one) is
 //!   written in place, appending: `-o /dev/stdout >> all.csv` appends like
-//!   the redirection says;
+//!   the redirection says; one open for reading only (`-o /dev/stdin`) is
+//!   refused;
 //! - a device, FIFO or socket is written in place;
 //! - a symlink is followed to its destination (which may not exist yet),
 //!   and the destination is replaced: the link stays a link;
@@ -49,6 +52,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 
 use tempfile::NamedTempFile;
 
+use crate::inputs::Identity;
 use crate::CliError;
 
 /// Bytes buffered before they go to the file or pipe.
@@ -98,8 +102,16 @@ impl Output {
         refuse_inputs(target, inputs)?;
         // One of this process's open files: written through, appending, so
         // a redirection's `>>` stays an append and nothing is renamed over
-        // the file behind it.
-        if names_open_file(target) {
+        // the file behind it. One it only reads (`-o /dev/stdin`) is an
+        // input, never an output.
+        if let Some(fd) = open_descriptor(target) {
+            if opened_read_only(fd) {
+                return Err(CliError::Usage(format!(
+                    "{}: descriptor {fd} is open for reading only (an input); \
+                     refusing to write into it",
+                    crate::text::shown(target)
+                )));
+            }
             return Self::in_place(target, target, OpenOptions::new().append(true));
         }
         let resolved = follow_links(target).map_err(|e| CliError::file(target, plain(&e)))?;
@@ -150,26 +162,30 @@ impl Output {
         })
     }
 
-    /// An output to standard output. A reader that goes away (`| head`)
-    /// ends the command quietly: see [`Self::error`].
-    #[must_use]
-    pub fn stdout() -> Self {
-        Self {
+    /// An output to standard output, refused when standard output is one
+    /// of `inputs` (`info LOG >> LOG`, `summary CARD 1<> CARD/RUN00001.WBL`).
+    /// A reader that goes away (`| head`) ends the command quietly: see
+    /// [`Self::error`].
+    ///
+    /// # Errors
+    /// Standard output is one of `inputs` (a usage error).
+    pub fn stdout(inputs: &[&Path]) -> Result<Self, CliError> {
+        refuse_stdout_input(inputs)?;
+        Ok(Self {
             sink: Sink::Stdout(BufWriter::with_capacity(BUFFER_LEN, io::stdout())),
             name: PathBuf::from("<stdout>"),
             pipe_closed: false,
-        }
+        })
     }
 
-    /// [`Self::create`] for `Some(target)`, else [`Self::stdout`], refused
-    /// when standard output is one of `inputs` (`decode LOG >> LOG`).
+    /// [`Self::create`] for `Some(target)`, else [`Self::stdout`].
+    ///
+    /// # Errors
+    /// Those of either.
     pub fn create_or_stdout(target: Option<&Path>, inputs: &[&Path]) -> Result<Self, CliError> {
         match target {
             Some(t) => Self::create(t, inputs),
-            None => {
-                refuse_stdout_input(inputs)?;
-                Ok(Self::stdout())
-            }
+            None => Self::stdout(inputs),
         }
     }
 
@@ -312,56 +328,73 @@ impl Drop for Temp {
     }
 }
 
-/// Refuses `target` if it is the same file as one of `inputs`. A target or
-/// input that does not exist (yet) cannot be the same file.
+/// Refuses `target` if it is the same file as one of `inputs`: the same
+/// device and inode, whatever the names (a hard link, a symlink,
+/// `/dev/stdout` or `/dev/fd/N` of a redirected input). A target or input
+/// that does not exist (yet) cannot be the same file.
 fn refuse_inputs(target: &Path, inputs: &[&Path]) -> Result<(), CliError> {
-    for input in inputs {
-        if same_file::is_same_file(target, input).unwrap_or(false) {
-            return Err(CliError::Usage(format!(
-                "{}: the output is the input {}; refusing to overwrite it",
-                crate::text::shown(target),
-                crate::text::shown(input)
-            )));
-        }
+    let Some(output) = Identity::of(target) else {
+        return Ok(());
+    };
+    match inputs.iter().find(|i| Identity::of(i) == Some(output)) {
+        Some(input) => Err(CliError::Usage(format!(
+            "{}: the output is the input {}; refusing to overwrite it",
+            crate::text::shown(target),
+            crate::text::shown(input)
+        ))),
+        None => Ok(()),
     }
-    Ok(())
 }
 
-/// Refuses an input that is standard output (a regular file only: a
-/// terminal or pipe that is also read is left to the user, as `cat` does).
+/// Refuses an input that is standard output, by device and inode, when
+/// standard output is a file that can be written anywhere in it (a regular
+/// file or a block device). A terminal or pipe that is also read is left
+/// to the user, as `cat` does.
 fn refuse_stdout_input(inputs: &[&Path]) -> Result<(), CliError> {
     let Ok(stdout) = same_file::Handle::stdout() else {
         return Ok(());
     };
-    let regular = stdout.as_file().metadata().is_ok_and(|m| m.is_file());
-    for input in inputs {
-        if regular && same_file::Handle::from_path(input).is_ok_and(|h| h == stdout) {
-            return Err(CliError::Usage(format!(
-                "{}: standard output is the input; refusing to write into it",
-                crate::text::shown(input)
-            )));
-        }
+    let Ok(meta) = stdout.as_file().metadata() else {
+        return Ok(());
+    };
+    if !(meta.is_file() || is_block_device(&meta)) {
+        return Ok(());
     }
-    Ok(())
+    let output = Identity::from_metadata(&meta);
+    match inputs.iter().find(|i| Identity::of(i) == Some(output)) {
+        Some(input) => Err(CliError::Usage(format!(
+            "{}: standard output is the input; refusing to write into it",
+            crate::text::shown(input)
+        ))),
+        None => Ok(()),
+    }
 }
 
-/// Whether `path`, or a link on the way from it, names one of this
-/// process's open files (`/dev/stdout`, `/dev/fd/3`, `/proc/self/fd/1`).
-fn names_open_file(path: &Path) -> bool {
-    let mut path = path.to_path_buf();
-    for _ in 0..MAX_LINKS {
-        if is_descriptor_name(&path) {
-            return true;
-        }
-        match fs::read_link(&path) {
-            Ok(next) => path = beside(&path, next),
-            Err(_) => return false,
-        }
-    }
+#[cfg(unix)]
+fn is_block_device(meta: &fs::Metadata) -> bool {
+    std::os::unix::fs::FileTypeExt::is_block_device(&meta.file_type())
+}
+
+#[cfg(not(unix))]
+fn is_block_device(_: &fs::Metadata) -> bool {
     false
 }
 
-fn is_descriptor_name(path: &Path) -> bool {
+/// The descriptor number when `path`, or a link on the way from it, names
+/// one of this process's open files (`/dev/stdout`, `/dev/fd/3`,
+/// `/proc/self/fd/1`).
+fn open_descriptor(path: &Path) -> Option<u32> {
+    let mut path = path.to_path_buf();
+    for _ in 0..MAX_LINKS {
+        if let Some(fd) = descriptor_named(&path) {
+            return Some(fd);
+        }
+        path = beside(&path, fs::read_link(&path).ok()?);
+    }
+    None
+}
+
+fn descriptor_named(path: &Path) -> Option<u32> {
     let parts: Vec<String> = path
         .components()
         .map(|c| c.as_os_str().to_string_lossy().into_owned())
@@ -369,11 +402,35 @@ fn is_descriptor_name(path: &Path) -> bool {
     let parts: Vec<&str> = parts.iter().map(String::as_str).collect();
     let own =
         |pid: &str| pid == "self" || pid == "thread-self" || pid == std::process::id().to_string();
-    match parts.as_slice() {
-        ["/", "dev", "stdin" | "stdout" | "stderr"] | ["/", "dev", "fd", _] => true,
-        ["/", "proc", pid, "fd", _] => own(pid),
-        ["/", "proc", pid, "task", _, "fd", _] => own(pid),
-        _ => false,
+    let number = match parts.as_slice() {
+        ["/", "dev", "stdin"] => "0",
+        ["/", "dev", "stdout"] => "1",
+        ["/", "dev", "stderr"] => "2",
+        ["/", "dev", "fd", n] => n,
+        ["/", "proc", pid, "fd", n] if own(pid) => n,
+        ["/", "proc", pid, "task", _, "fd", n] if own(pid) => n,
+        _ => return None,
+    };
+    number.parse().ok()
+}
+
+/// Whether this process opened descriptor `fd` for reading only (the
+/// access mode in `/proc/self/fdinfo`; where that cannot be read, standard
+/// input is taken as read-only and the rest as writable).
+fn opened_read_only(fd: u32) -> bool {
+    /// `O_ACCMODE` and `O_RDONLY` of Linux's open flags.
+    const ACCESS_MODE: u32 = 0o3;
+    const READ_ONLY: u32 = 0;
+    let flags = fs::read_to_string(format!("/proc/self/fdinfo/{fd}"))
+        .ok()
+        .and_then(|info| {
+            info.lines()
+                .find_map(|l| l.strip_prefix("flags:"))
+                .and_then(|f| u32::from_str_radix(f.trim(), 8).ok())
+        });
+    match flags {
+        Some(flags) => flags & ACCESS_MODE == READ_ONLY,
+        None => fd == 0,
     }
 }
 
@@ -561,7 +618,7 @@ mod tests {
     fn a_closed_pipe_is_quiet_only_on_stdout() {
         let pipe = || io::Error::from(io::ErrorKind::BrokenPipe);
         assert!(matches!(
-            Output::stdout().error(pipe()),
+            Output::stdout(&[]).unwrap().error(pipe()),
             CliError::PipeClosed
         ));
         let dir = tempfile::tempdir().unwrap();

@@ -81,8 +81,9 @@ fn a_figure_is_still_drawn_when_the_table_reader_went_away() {
 fn multi_log_failures_close_naming_no_single_file() {
     let dir = tempfile::tempdir().unwrap();
     analysis_support::standard_log(&dir.path().join("RUN00001.WBL"));
+    // Two different files (a byte-identical pair would be one input).
     for bad in ["RUN00002.WBL", "RUN00003.WBL"] {
-        std::fs::write(dir.path().join(bad), b"not a log").unwrap();
+        std::fs::write(dir.path().join(bad), format!("{bad} is not a log")).unwrap();
     }
     let logs: Vec<PathBuf> = ["RUN00001.WBL", "RUN00002.WBL", "RUN00003.WBL"]
         .iter()

@@ -83,3 +83,35 @@ fn the_header_settings_are_used_and_set_retunes_them() {
     let out = wobblog().arg("detect").output().unwrap();
     assert_eq!(out.status.code(), Some(2));
 }
+
+#[test]
+fn a_rejected_set_line_is_a_usage_error_whatever_the_header_holds() {
+    // Nine header lines the parser skips: more than the faults it keeps
+    // with their line numbers, which once hid the `--set` line's fault.
+    let dir = tempfile::tempdir().unwrap();
+    let log = dir.path().join("RUN00001.WBL");
+    let mut config: Vec<String> = (0..9).map(|i| format!("detector.bogus_{i}=1")).collect();
+    config.push("detector.amp_on_deg=20".into());
+    let extras = Extras {
+        config,
+        ..Extras::default()
+    };
+    write_log(&log, &Ride::new(30.0, 5.0, 15.0, 2.0, 0.5), &extras);
+    for set in [
+        "detector.amp_on_deg=NaN",
+        "detector.amp_on_deg=5x",
+        "detector.amp_on_dge=5",
+    ] {
+        let out = wobblog()
+            .arg("detect")
+            .arg(&log)
+            .args(["--set", set])
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{set}: {err}");
+        assert!(err.contains(&format!("--set {set}")), "{set}: {err}");
+    }
+    // The header's own usable line still holds: 20 degrees hears nothing.
+    assert!(alerts(wobblog().arg("detect").arg(&log)).is_empty());
+}

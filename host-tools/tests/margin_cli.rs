@@ -289,3 +289,35 @@ fn hostile_log_names_are_escaped_in_the_table_and_exact_in_json() {
         .collect();
     assert!(logs.iter().any(|l| l.ends_with(name)), "{logs:?}");
 }
+
+#[test]
+fn a_log_named_twice_linked_or_copied_is_counted_once() {
+    let dir = campaign(&speeds(2.0, 3.4, 6));
+    let d = dir.path();
+    let (code, once, stderr) = margin_json(&[d.as_os_str()]);
+    assert_eq!(code, Some(0), "{stderr}");
+    assert_eq!(once["kicks"].as_array().unwrap().len(), 6);
+    let other = tempfile::tempdir().unwrap();
+    let linked = other.path().join("linked.WBL");
+    let copied = other.path().join("copied.WBL");
+    std::fs::hard_link(d.join("RUN00001.WBL"), &linked).unwrap();
+    std::fs::copy(d.join("RUN00002.WBL"), &copied).unwrap();
+    let first = d.join("RUN00000.WBL");
+    let (code, v, stderr) = margin_json(&[
+        d.as_os_str(),
+        first.as_os_str(),
+        first.as_os_str(),
+        linked.as_os_str(),
+        copied.as_os_str(),
+    ]);
+    assert_eq!(code, Some(0), "{stderr}");
+    assert_eq!(v["kicks"], once["kicks"], "{stderr}");
+    assert_eq!(v["wobble_speed_mps"], once["wobble_speed_mps"]);
+    assert_eq!(v["ci95_mps"], once["ci95_mps"]);
+    assert_eq!(stderr.matches("counted once").count(), 4, "{stderr}");
+    assert!(
+        stderr.contains("linked.WBL is the same file as"),
+        "{stderr}"
+    );
+    assert!(stderr.contains("copied.WBL is a copy of"), "{stderr}");
+}

@@ -7,6 +7,7 @@ use clap::CommandFactory;
 use clap_complete::Shell;
 
 use crate::cli::Cli;
+use crate::output::Output;
 use crate::CliError;
 
 /// Arguments of `wobblog completions`.
@@ -21,13 +22,13 @@ pub struct Args {
 pub fn run(args: &Args) -> Result<(), CliError> {
     let mut script = Vec::new();
     clap_complete::generate(args.shell, &mut Cli::command(), "wobblog", &mut script);
-    crate::cmd::logs::print_stdout(&String::from_utf8_lossy(&script))
+    crate::cmd::logs::print(Output::stdout(&[])?, &String::from_utf8_lossy(&script))
 }
 
 /// Prints the man page, with one section per subcommand.
 pub fn man() -> Result<(), CliError> {
     let page = man_page().map_err(|e| CliError::file(Path::new("<stdout>"), e))?;
-    crate::cmd::logs::print_stdout(&page)
+    crate::cmd::logs::print(Output::stdout(&[])?, &page)
 }
 
 /// The man page as roff text.

@@ -7,7 +7,8 @@ use std::path::{Path, PathBuf};
 use wobble_core::config::Config;
 use wobble_core::format::{DecodeStats, Event, Record, BLOCK_LEN};
 
-use crate::cmd::logs::print_stdout;
+use crate::cmd::logs::print;
+use crate::output::Output;
 use crate::reader::read_log_until;
 use crate::text::escape_controls;
 use crate::CliError;
@@ -21,6 +22,7 @@ pub struct Args {
 
 /// Runs `wobblog config`.
 pub fn run(args: &Args) -> Result<(), CliError> {
+    let stdout = Output::stdout(&[&args.log])?;
     let header = read_header(&args.log)?;
     if header.config.is_empty() {
         return Err(CliError::file(
@@ -36,7 +38,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
             faults.first().len()
         );
     }
-    print_stdout(&header.config_text(&args.log))
+    print(stdout, &header.config_text(&args.log))
 }
 
 /// What a log's header says about how it was recorded.

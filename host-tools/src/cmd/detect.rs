@@ -5,7 +5,7 @@
 use std::io::{self, Read};
 use std::path::{Path, PathBuf};
 
-use wobble_core::config::Config;
+use wobble_core::config::{Config, FAULT_REJECTED};
 use wobble_core::detector::{AlertEvent, Detector, Kick, MarginEvent, MarginWarning};
 use wobble_core::format::{Event, FaultSource, MarginRecord, MarginState};
 
@@ -326,16 +326,29 @@ pub fn replay_log(path: &Path, config: &Config) -> Result<Replay, CliError> {
 /// lines, the defaults where it has none), re-tuned by `set` lines
 /// (`key=value`, applied after the header's).
 ///
+/// The header's lines the parser would skip (a bad key or value) are left
+/// out first: the parser keeps only the first few faults with their line
+/// numbers, and a header full of them must not hide a `set` line's.
+///
 /// # Errors
 /// A `set` line the configuration does not accept, as a usage error.
 pub fn log_config(header_lines: &[String], set: &[String]) -> Result<Config, CliError> {
-    let text: String = header_lines
+    let usable = header_lines.iter().filter(|line| {
+        Config::parse(line.as_bytes())
+            .faults
+            .first()
+            .iter()
+            .all(|f| f.code == FAULT_REJECTED)
+    });
+    let usable: Vec<&String> = usable.collect();
+    let text: String = usable
         .iter()
+        .copied()
         .chain(set)
         .map(|l| format!("{l}\n"))
         .collect();
     let loaded = Config::parse(text.as_bytes());
-    let first_set_line = header_lines.len() + 1;
+    let first_set_line = usable.len() + 1;
     let bad: Vec<String> = loaded
         .faults
         .first()
@@ -547,6 +560,13 @@ pub fn table(r: &Replay) -> String {
 
 /// Runs `wobblog detect`.
 pub fn run(args: &Args) -> Result<(), CliError> {
+    let named: Vec<&Path> = args
+        .log
+        .iter()
+        .chain(&args.csv)
+        .map(PathBuf::as_path)
+        .collect();
+    let stdout = crate::output::Output::stdout(&named)?;
     let (r, input, place) = match (&args.log, &args.csv) {
         (Some(log), _) => {
             let header = crate::cmd::config::read_header(log)?;
@@ -595,7 +615,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
     } else {
         table(&r)
     };
-    crate::cmd::logs::print_stdout(&text)
+    crate::cmd::logs::print(stdout, &text)
 }
 
 #[cfg(test)]

@@ -23,7 +23,7 @@ pub struct Args {
 
 /// Runs `wobblog events`.
 pub fn run(args: &Args) -> Result<(), CliError> {
-    let mut out = Output::stdout();
+    let mut out = Output::stdout(&[&args.log])?;
     match list(&args.log, args.output.is_json()?, &mut out)? {
         Ok(()) => out.commit(),
         Err(e) => Err(out.error(e)),

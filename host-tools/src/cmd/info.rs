@@ -2,7 +2,8 @@
 
 use std::path::PathBuf;
 
-use crate::cmd::logs::print_stdout;
+use crate::cmd::logs::print;
+use crate::output::Output;
 use crate::reader::read_log;
 use crate::summary::{Summary, SummaryBuilder};
 use crate::text::escape_controls;
@@ -20,6 +21,7 @@ pub struct Args {
 
 /// Runs `wobblog info`.
 pub fn run(args: &Args) -> Result<(), CliError> {
+    let stdout = Output::stdout(&[&args.log])?;
     let summary = summarise(&args.log)?;
     let text = if args.output.is_json()? {
         let json =
@@ -28,7 +30,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
     } else {
         render(&args.log, &summary)
     };
-    print_stdout(&text)
+    print(stdout, &text)
 }
 
 /// Decodes the log at `path` into a summary.

@@ -110,10 +110,11 @@ pub fn warnings(losses: &Losses) -> Vec<String> {
     lines
 }
 
-/// Writes `text` to standard output. A closed pipe (`| head`) ends the
-/// output quietly, where `print!` would panic; other errors are reported.
-pub fn print_stdout(text: &str) -> Result<(), CliError> {
-    let mut out = Output::stdout();
+/// Writes `text` to `out` (standard output, made by [`Output::stdout`]
+/// with the command's inputs before its work) and commits it. A closed
+/// pipe (`| head`) ends the output quietly, where `print!` would panic;
+/// other errors are reported.
+pub fn print(mut out: Output, text: &str) -> Result<(), CliError> {
     match out.write_all(text.as_bytes()) {
         Ok(()) => out.commit(),
         Err(e) => Err(out.error(e)),

@@ -11,7 +11,7 @@ use crate::analysis::campaign_kicks::{campaign_kicks, CampaignKick, Prefer};
 use crate::analysis::margin::{predict_with, KickPoint, Margin, Trend};
 use crate::analysis::Run;
 use crate::cmd::detect::log_config;
-use crate::cmd::logs::{for_each_log, print_stdout, warn_losses};
+use crate::cmd::logs::{for_each_log, print, warn_losses};
 use crate::cmd::margin_model::{estimate, ModelEstimate, DEFAULT_PARAMS};
 use crate::cmd::summary::logs_in;
 use crate::output::Output;
@@ -181,7 +181,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
     if let Some(plot) = &args.plot {
         ImageKind::of(plot)?;
     }
-    let logs = expand(&args.inputs)?;
+    let logs = crate::inputs::distinct(expand(&args.inputs)?);
     let mut inputs: Vec<&Path> = logs.iter().map(PathBuf::as_path).collect();
     if let Some(params) = &args.model {
         inputs.push(params);
@@ -191,6 +191,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         .as_deref()
         .map(|p| Output::create(p, &inputs))
         .transpose()?;
+    let stdout = Output::stdout(&inputs)?;
     let (rows, result) = gather(&logs, args.kicks);
     if rows.is_empty() && result.is_err() {
         return result;
@@ -220,7 +221,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
     } else {
         render_text(&report, logs.len())
     };
-    let printed = print_stdout(&text);
+    let printed = print(stdout, &text);
     if let Some(out) = plot_out {
         let figure = MarginPlot {
             kicks: report

@@ -76,12 +76,12 @@ impl From<&GpsFix> for FixJson {
 
 /// Runs `wobblog nmea`.
 pub fn run(args: &Args) -> Result<(), CliError> {
+    let mut out = Output::stdout(&[&args.input])?;
     let capture = std::fs::File::open(&args.input).map_err(|e| CliError::file(&args.input, e))?;
     let config = GpsConfig {
         baud: args.baud,
         ..GpsConfig::default()
     };
-    let mut out = Output::stdout();
     let replayed = replay(capture, config, &mut |fix| write_fix(&mut out, fix));
     let stats = match replayed {
         Ok(stats) => stats,

@@ -6,7 +6,8 @@ use std::path::PathBuf;
 
 use wobble_core::selftest::{read_report, Verdict};
 
-use crate::cmd::logs::print_stdout;
+use crate::cmd::logs::print;
+use crate::output::Output;
 use crate::text::escape_controls;
 use crate::CliError;
 
@@ -19,6 +20,7 @@ pub struct Args {
 
 /// Runs `wobblog selftest`.
 pub fn run(args: &Args) -> Result<(), CliError> {
+    let stdout = Output::stdout(&[&args.report])?;
     let bytes = std::fs::read(&args.report).map_err(|e| CliError::file(&args.report, e))?;
     let text =
         std::str::from_utf8(&bytes).map_err(|_| CliError::file(&args.report, "not UTF-8 text"))?;
@@ -47,7 +49,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
             failed.join(", ")
         )
     });
-    print_stdout(&out)?;
+    print(stdout, &out)?;
     // A failed check is a failure of the command, so scripts can tell.
     if failed.is_empty() {
         Ok(())

@@ -5,7 +5,8 @@ use std::path::{Path, PathBuf};
 use serde::Serialize;
 
 use crate::analysis::{wobble_speed_mps, Ride, Stability};
-use crate::cmd::logs::{for_each_log, print_stdout, warn_losses};
+use crate::cmd::logs::{for_each_log, print, warn_losses};
+use crate::output::Output;
 use crate::CliError;
 
 /// Output formats of `wobblog summary`.
@@ -110,6 +111,7 @@ pub fn logs_in(dir: &Path) -> Result<Vec<PathBuf>, CliError> {
 pub fn run(args: &Args) -> Result<(), CliError> {
     let cards = crate::dataset::cards_in(&args.dir)?;
     let logs: Vec<PathBuf> = cards.iter().flat_map(|(_, logs)| logs.clone()).collect();
+    let stdout = Output::stdout(&logs.iter().map(PathBuf::as_path).collect::<Vec<_>>())?;
     let mut rows = Vec::new();
     let result = for_each_log(&logs, "summarising", |log| {
         let ride = Ride::load(log)?;
@@ -127,7 +129,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
     } else {
         args.format
     };
-    let printed = print_stdout(&render(&rows, format));
+    let printed = print(stdout, &render(&rows, format));
     result.and(printed)
 }
 

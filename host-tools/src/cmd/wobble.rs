@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use serde::Serialize;
 
 use crate::analysis::{wobble_speed_mps, Episode, Ride, Stability};
-use crate::cmd::logs::{for_each_log, print_stdout, warn_losses};
+use crate::cmd::logs::{for_each_log, print, warn_losses};
 use crate::output::Output;
 use crate::plot::modes::ModePlot;
 use crate::plot::{render, ImageKind};
@@ -61,15 +61,17 @@ pub fn run(args: &Args) -> Result<(), CliError> {
     if let Some(plot) = &args.plot {
         ImageKind::of(plot)?;
     }
-    let inputs: Vec<&Path> = args.logs.iter().map(PathBuf::as_path).collect();
+    let logs = crate::inputs::distinct(args.logs.clone());
+    let inputs: Vec<&Path> = logs.iter().map(PathBuf::as_path).collect();
     let plot_out = args
         .plot
         .as_deref()
         .map(|p| Output::create(p, &inputs))
         .transpose()?;
+    let stdout = Output::stdout(&inputs)?;
     let mut reports = Vec::new();
     let mut names = Vec::new();
-    let result = for_each_log(&args.logs, "analysing", |log| {
+    let result = for_each_log(&logs, "analysing", |log| {
         let ride = Ride::load(log)?;
         warn_losses(log, &ride.summary);
         let (from, to) = args.window.window().boot_s(&ride.summary.utc_syncs, log)?;
@@ -104,7 +106,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
     }
     // The figure is drawn even when the table's reader went away, and only
     // when every log was read: a failed command leaves an old figure as it was.
-    let printed = print_stdout(&text);
+    let printed = print(stdout, &text);
     if let (Some(out), Ok(())) = (plot_out, &result) {
         let runs = names
             .into_iter()

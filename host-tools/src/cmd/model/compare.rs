@@ -11,7 +11,7 @@ use wobble_model::Mode;
 use super::episodes::{self, LoggedEpisode};
 use super::figure::{EigenFigure, Layer, Line};
 use super::{load, sweep, Speeds};
-use crate::cmd::logs::print_stdout;
+use crate::cmd::logs::print;
 use crate::output::Output;
 use crate::plot::{render, ImageKind};
 use crate::CliError;
@@ -45,13 +45,14 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         .as_deref()
         .map(|o| Output::create(o, &inputs))
         .transpose()?;
-    let (found, loaded) = episodes::load(&args.logs);
+    let stdout = Output::stdout(&inputs)?;
+    let (found, loaded) = episodes::load(&crate::inputs::distinct(args.logs.clone()));
     let speeds: Vec<f64> = found.iter().map(|e| e.episode.speed_at_onset_mps).collect();
     let wobble = mode_at(&model, Mode::Wobble, &speeds)
         .map_err(|e| CliError::file(&args.params, e))?
         .ok_or_else(|| CliError::file(&args.params, "the model has no wobble mode"))?;
     let text = residual_table(&found, &wobble);
-    print_stdout(&text)?;
+    print(stdout, &text)?;
     // A log that could not be read fails the command: the figure is not
     // committed then, and an old one stays as it was.
     if let (Some(out), Ok(())) = (out, &loaded) {

@@ -11,7 +11,7 @@ use wobble_model::params::to_toml;
 
 use super::episodes;
 use super::param_error;
-use crate::cmd::logs::print_stdout;
+use crate::cmd::logs::print;
 use crate::output::Output;
 use crate::CliError;
 
@@ -51,7 +51,8 @@ pub fn run(args: &Args) -> Result<(), CliError> {
     let mut inputs: Vec<&Path> = args.logs.iter().map(PathBuf::as_path).collect();
     inputs.push(&args.params);
     let mut out = Output::create(&args.output, &inputs)?;
-    let (found, loaded) = episodes::load(&args.logs);
+    let stdout = Output::stdout(&inputs)?;
+    let (found, loaded) = episodes::load(&crate::inputs::distinct(args.logs.clone()));
     let obs: Vec<_> = found
         .iter()
         .filter(|e| !e.censored())
@@ -86,6 +87,6 @@ pub fn run(args: &Args) -> Result<(), CliError> {
     out.write_all(to_toml(&fitted).as_bytes())
         .map_err(|e| out.error(e))?;
     out.commit()?;
-    print_stdout(&text)?;
+    print(stdout, &text)?;
     loaded
 }

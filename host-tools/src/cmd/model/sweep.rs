@@ -10,7 +10,7 @@ use wobble_model::{critical_speeds, Mode, Model, ParamSet};
 use super::eig::describe;
 use super::figure::{EigenFigure, Layer, Line};
 use super::{param_error, sweep, Speeds};
-use crate::cmd::logs::print_stdout;
+use crate::cmd::logs::print;
 use crate::output::Output;
 use crate::plot::{render, ImageKind};
 use crate::CliError;
@@ -52,6 +52,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         return Err(CliError::Usage("--factors must be positive numbers".into()));
     }
     let set = super::load_set(&args.params)?;
+    let stdout = Output::stdout(&[&args.params])?;
     let out = args
         .output
         .as_deref()
@@ -89,7 +90,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
             line,
         });
     }
-    print_stdout(&text)?;
+    print(stdout, &text)?;
     if let Some(out) = out {
         let figure = EigenFigure {
             title: format!("{}: {} x {:?}", set.name, args.param, args.factors),
