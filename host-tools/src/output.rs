@@ -383,7 +383,7 @@ fn is_block_device(_: &fs::Metadata) -> bool {
 /// The descriptor number when `path`, or a link on the way from it, names
 /// one of this process's open files (`/dev/stdout`, `/dev/fd/3`,
 /// `/proc/self/fd/1`).
-fn open_descriptor(path: &Path) -> Option<u32> {
+pub(crate) fn open_descriptor(path: &Path) -> Option<u32> {
     let mut path = path.to_path_buf();
     for _ in 0..MAX_LINKS {
         if let Some(fd) = descriptor_named(&path) {

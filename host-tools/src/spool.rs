@@ -9,13 +9,30 @@
 //! behind whatever ends the process. Memory use does not grow with it.
 //! A command that reads its log twice (`decode` looks for the first UTC
 //! sync pair before it writes rows) reads the same copy both times.
+//!
+//! A stream cannot fill the disk: one whose first [`PROBE_LEN`] bytes hold
+//! no valid log block (`/dev/zero`, `yes`, a serial line of text) is not a
+//! log and is refused there, and none is copied beyond [`MAX_LEN`], the
+//! largest file a card's FAT32 file system can hold. Standard input that
+//! cannot be opened by name (a socket) is read from the descriptor.
 
 use std::fs::File;
-use std::io::{Seek, SeekFrom};
+use std::io::{Read, Seek, SeekFrom, Write};
 use std::path::{Path, PathBuf};
 use std::sync::{Mutex, PoisonError};
 
+use wobble_core::format::Decoder;
+
 use crate::CliError;
+
+/// Bytes of a stream read before it is refused for holding no valid block.
+pub const PROBE_LEN: u64 = 16 << 20;
+
+/// The longest stream copied: the largest file FAT32 holds.
+pub const MAX_LEN: u64 = (4 << 30) - 1;
+
+/// Bytes read from a stream at a time.
+const CHUNK_LEN: usize = 1 << 20;
 
 /// The streams copied so far by this process, by the path they were read
 /// through.
@@ -29,17 +46,8 @@ static SPOOLED: Mutex<Vec<(PathBuf, File)>> = Mutex::new(Vec::new());
 /// message says where, and why).
 pub fn open_seekable(path: &Path) -> Result<(File, u64), CliError> {
     let io = |e| CliError::file(path, e);
-    let mut file = File::open(path).map_err(io)?;
-    let meta = file.metadata().map_err(io)?;
-    if meta.is_file() {
-        return Ok((file, meta.len()));
-    }
-    if is_block_device(&meta) {
-        // A card in a reader: seekable, with no length in its metadata.
-        let len = file.seek(SeekFrom::End(0)).map_err(io)?;
-        file.seek(SeekFrom::Start(0)).map_err(io)?;
-        return Ok((file, len));
-    }
+    // A stream already copied is read from its copy: opening a FIFO again
+    // would wait for a writer that is gone.
     let mut spooled = SPOOLED.lock().unwrap_or_else(PoisonError::into_inner);
     if let Some((_, copy)) = spooled.iter().find(|(p, _)| p == path) {
         let mut copy = copy.try_clone().map_err(io)?;
@@ -47,6 +55,20 @@ pub fn open_seekable(path: &Path) -> Result<(File, u64), CliError> {
         copy.seek(SeekFrom::Start(0)).map_err(io)?;
         return Ok((copy, len));
     }
+    let source = match open(path).map_err(io)? {
+        Source::File(mut file) => {
+            let meta = file.metadata().map_err(io)?;
+            if meta.is_file() || is_block_device(&meta) {
+                // A card in a reader is seekable, with no length in its
+                // metadata.
+                let len = file.seek(SeekFrom::End(0)).map_err(io)?;
+                file.seek(SeekFrom::Start(0)).map_err(io)?;
+                return Ok((file, len));
+            }
+            Source::File(file)
+        }
+        Source::Stdin => Source::Stdin,
+    };
     let failed = |e: std::io::Error| {
         CliError::file(
             path,
@@ -57,10 +79,96 @@ pub fn open_seekable(path: &Path) -> Result<(File, u64), CliError> {
         )
     };
     let mut copy = tempfile::tempfile().map_err(failed)?;
-    let len = std::io::copy(&mut file, &mut copy).map_err(failed)?;
+    let len = match source {
+        Source::File(mut file) => copy_log(&mut file, &mut copy),
+        Source::Stdin => copy_log(&mut std::io::stdin().lock(), &mut copy),
+    }
+    .map_err(|e| match e {
+        Copy::Io(e) => failed(e),
+        Copy::Refused(message) => CliError::file(path, message),
+    })?;
     copy.seek(SeekFrom::Start(0)).map_err(failed)?;
     spooled.push((path.to_path_buf(), copy.try_clone().map_err(failed)?));
     Ok((copy, len))
+}
+
+/// Where a stream is read from.
+enum Source {
+    File(File),
+    /// Standard input, read from its descriptor: a socket has no name to
+    /// open it by.
+    Stdin,
+}
+
+/// Opens `path`, or standard input's descriptor for a name of it that the
+/// system cannot open (`/dev/stdin` on a socket: "no such device").
+fn open(path: &Path) -> std::io::Result<Source> {
+    match File::open(path) {
+        Ok(file) => Ok(Source::File(file)),
+        Err(e)
+            if e.raw_os_error() == Some(ENXIO)
+                && crate::output::open_descriptor(path) == Some(0) =>
+        {
+            Ok(Source::Stdin)
+        }
+        Err(e) => Err(e),
+    }
+}
+
+/// "No such device or address": what opening a socket by name gives.
+const ENXIO: i32 = 6;
+
+enum Copy {
+    Io(std::io::Error),
+    Refused(String),
+}
+
+/// Copies the stream `from` into `to`, returning its length; refused when
+/// its first [`PROBE_LEN`] bytes hold no valid block or it passes
+/// [`MAX_LEN`].
+fn copy_log(from: &mut impl Read, to: &mut File) -> Result<u64, Copy> {
+    let mut probe = Decoder::new();
+    let mut found = false;
+    let mut buf = vec![0u8; CHUNK_LEN];
+    let mut filled = 0;
+    let mut len = 0u64;
+    loop {
+        let n = match from.read(&mut buf[filled..]) {
+            Ok(n) => n,
+            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
+            Err(e) => return Err(Copy::Io(e)),
+        };
+        to.write_all(&buf[filled..filled + n]).map_err(Copy::Io)?;
+        len += n as u64;
+        filled += n;
+        if len > MAX_LEN {
+            return Err(Copy::Refused(format!(
+                "the stream is longer than any card log can be ({} bytes, the FAT32 file size \
+                 limit); stopped copying it",
+                MAX_LEN
+            )));
+        }
+        let at_end = n == 0;
+        if !found {
+            let consumed = probe.scan(&buf[..filled], at_end, &mut |_| {}, &mut |_, _| {
+                found = true;
+            });
+            buf.copy_within(consumed..filled, 0);
+            filled -= consumed;
+            if !found && len >= PROBE_LEN {
+                return Err(Copy::Refused(format!(
+                    "no valid log block in the stream's first {} MiB: not a wobble-logger log \
+                     (stopped reading it)",
+                    PROBE_LEN >> 20
+                )));
+            }
+        } else {
+            filled = 0;
+        }
+        if at_end {
+            return Ok(len);
+        }
+    }
 }
 
 #[cfg(unix)]
@@ -71,4 +179,45 @@ fn is_block_device(meta: &std::fs::Metadata) -> bool {
 #[cfg(not(unix))]
 fn is_block_device(_: &std::fs::Metadata) -> bool {
     false
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A FIFO at a new path in `dir`, fed `bytes` once by a writer thread.
+    fn fifo_with(dir: &Path, bytes: Vec<u8>) -> PathBuf {
+        let fifo = dir.join("f.fifo");
+        assert!(std::process::Command::new("mkfifo")
+            .arg(&fifo)
+            .status()
+            .unwrap()
+            .success());
+        let path = fifo.clone();
+        std::thread::spawn(move || std::fs::write(path, bytes));
+        fifo
+    }
+
+    fn read_all(mut file: File) -> Vec<u8> {
+        let mut bytes = Vec::new();
+        file.read_to_end(&mut bytes).unwrap();
+        bytes
+    }
+
+    #[test]
+    fn a_stream_opened_twice_reads_whole_from_its_start_both_times() {
+        let dir = tempfile::tempdir().unwrap();
+        // A block of any content is copied: the probe looks for a valid
+        // block only after PROBE_LEN bytes.
+        let bytes: Vec<u8> = (0..3000u32).map(|i| (i % 251) as u8).collect();
+        let fifo = fifo_with(dir.path(), bytes.clone());
+        let (first, len) = open_seekable(&fifo).unwrap();
+        assert_eq!(len, bytes.len() as u64);
+        assert_eq!(read_all(first), bytes);
+        // The second open (the FIFO's writer is gone) is the same copy,
+        // rewound after the first reader left it at its end.
+        let (second, len) = open_seekable(&fifo).unwrap();
+        assert_eq!(len, bytes.len() as u64);
+        assert_eq!(read_all(second), bytes);
+    }
 }
