@@ -8,8 +8,9 @@
 //! SEEDS=100..112 cargo run -p wobble-hil --release --example campaign_kicks > kicks.csv
 //! cargo run -p wobble-hil --release --example margin_coverage -- kicks.csv
 //! ```
-//! `VERBOSE=1` prints every campaign; `BEND=-0.04:0.02` adds a line
-//! assuming that curvature (mean:SD, 1/s per (m/s)^2).
+//! `VERBOSE=1` prints every campaign; `BEND=-1:3:0.7` adds a line
+//! assuming that bend shape (mean:SD towards convex:SD towards concave, of
+//! the dimensionless shape of `wobblog::analysis::margin::bend`).
 
 use std::collections::BTreeMap;
 
@@ -76,23 +77,24 @@ fn parse(text: &str) -> Result<Vec<Line>, String> {
         .collect()
 }
 
-/// `BEND=MEAN:SD[,MEAN:SD...]`: more curvature priors for the line, 1/s
-/// per (m/s)^2.
+/// `BEND=MEAN:SD_CONVEX:SD_CONCAVE[,...]`: more bend shape priors for the
+/// line.
 fn extra_priors() -> Result<Vec<(String, Trend, BendPrior)>, String> {
     let Ok(spec) = std::env::var("BEND") else {
         return Ok(Vec::new());
     };
     spec.split(',')
         .map(|p| {
-            let (mean, sd) = p
-                .split_once(':')
-                .and_then(|(m, s)| Some((m.parse().ok()?, s.parse().ok()?)))
-                .ok_or(format!("BEND: {p} is not MEAN:SD"))?;
-            let prior = BendPrior {
-                mean_per_s_mps2: mean,
-                sd_per_s_mps2: sd,
+            let v: Vec<f64> = p.split(':').filter_map(|x| x.parse().ok()).collect();
+            let [mean, sd_convex, sd_concave] = v[..] else {
+                return Err(format!("BEND: {p} is not MEAN:SD_CONVEX:SD_CONCAVE"));
             };
-            Ok((format!("line, bend {mean} SD {sd}"), Trend::Line, prior))
+            let prior = BendPrior {
+                mean,
+                sd_convex,
+                sd_concave,
+            };
+            Ok((format!("line, bend {p}"), Trend::Line, prior))
         })
         .collect()
 }
@@ -179,11 +181,7 @@ fn main() -> Result<(), String> {
     ] {
         let mut fits = vec![
             ("line".to_owned(), Trend::Line, BendPrior::DEFAULT),
-            (
-                "line, unsigned bend".to_owned(),
-                Trend::Line,
-                BendPrior::UNSIGNED,
-            ),
+            ("straight line".to_owned(), Trend::Line, BendPrior::NONE),
             ("quadratic".to_owned(), Trend::Quadratic, BendPrior::DEFAULT),
         ];
         fits.extend(extra_priors()?);

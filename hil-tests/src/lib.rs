@@ -7,5 +7,6 @@
 
 pub mod corpus;
 pub mod kick_metrics;
+pub mod margin_stress;
 pub mod metrics;
 pub mod qemu;

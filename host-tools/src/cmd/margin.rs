@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 use serde::Serialize;
 
 use crate::analysis::campaign_kicks::{campaign_kicks, CampaignKick, Prefer};
-use crate::analysis::margin::{predict_with, KickPoint, Margin, Trend};
+use crate::analysis::margin::{predict_with, KickPoint, Margin, Trend, RIDE_MARGIN};
 use crate::analysis::Run;
 use crate::cmd::detect::log_config;
 use crate::cmd::logs::{for_each_log, print, warn_losses};
@@ -53,6 +53,19 @@ pub struct Args {
     /// (fitted to the kicks alone: worse on the simulated campaigns).
     #[arg(long, value_enum, default_value_t = Trend::Line)]
     pub trend: Trend,
+    /// The riding margin, per cent of the lower bound: the riding limit
+    /// (`ride_below_mps`) is the lower bound less this much.
+    #[arg(long, value_name = "PERCENT", default_value_t = 100.0 * RIDE_MARGIN,
+          value_parser = parse_percent)]
+    pub ride_margin: f64,
+}
+
+/// A riding margin in per cent: a number from 0 to 90.
+fn parse_percent(text: &str) -> Result<f64, String> {
+    match text.parse::<f64>() {
+        Ok(v) if (0.0..=90.0).contains(&v) => Ok(v),
+        _ => Err(format!("{text} is not a per cent from 0 to 90")),
+    }
 }
 
 /// One kick as reported.
@@ -76,6 +89,15 @@ pub struct Report {
     pub wobble_speed_mps: Option<f64>,
     /// Its 95 % interval `[lo, hi]`, `hi` null when the data cannot bound it.
     pub ci95_mps: [Option<f64>; 2],
+    /// Why the interval is open above, when it is.
+    pub open_because: Option<String>,
+    /// The riding limit: the lower bound less the riding margin (null
+    /// without a lower bound).
+    pub ride_below_mps: Option<f64>,
+    /// The riding margin, a fraction of the lower bound.
+    pub ride_margin: f64,
+    /// The highest speed for the next pass (null without a riding limit).
+    pub next_pass_max_mps: Option<f64>,
     /// Kicks the fit used.
     pub kicks_used: usize,
     /// Kicks it rejected.
@@ -94,6 +116,9 @@ pub struct Report {
     /// say (variance of unit weight; the interval is widened by it when
     /// above 1).
     pub unit_variance: Option<f64>,
+    /// The between-kick SD of the true damping, 1/s (added to each kick's
+    /// own SD in the weights and the interval).
+    pub between_kick_sd_per_s: Option<f64>,
     /// Why the answer is weaker than it looks.
     pub warnings: Vec<String>,
     /// Every kick, in the order of the logs.
@@ -153,15 +178,20 @@ fn gather(logs: &[PathBuf], prefer: Prefer) -> (Vec<KickRow>, Result<(), CliErro
 
 /// The report of `rows` and the prediction made from them.
 #[must_use]
-pub fn report(mut rows: Vec<KickRow>, trend: Trend) -> (Report, Margin) {
+pub fn report(mut rows: Vec<KickRow>, trend: Trend, ride_margin: f64) -> (Report, Margin) {
     let points: Vec<KickPoint> = rows.iter().map(|r| KickPoint::from(&r.kick)).collect();
-    let margin = predict_with(&points, trend);
+    let mut margin = predict_with(&points, trend);
+    margin.set_riding_margin(ride_margin);
     for (row, w) in rows.iter_mut().zip(&margin.weights) {
         row.used = *w > 0.0;
     }
     let report = Report {
         wobble_speed_mps: margin.wobble_speed_mps,
         ci95_mps: margin.ci95_mps,
+        open_because: margin.open_because.clone(),
+        ride_below_mps: margin.advice.ride_below_mps,
+        ride_margin: margin.advice.margin_fraction,
+        next_pass_max_mps: margin.advice.next_pass_max_mps,
         kicks_used: margin.kicks_used,
         kicks_rejected: margin.kicks_rejected,
         method: margin.method.clone(),
@@ -169,6 +199,7 @@ pub fn report(mut rows: Vec<KickRow>, trend: Trend) -> (Report, Margin) {
         trend: margin.trend,
         coefficients: margin.coefficients.clone(),
         unit_variance: margin.unit_variance,
+        between_kick_sd_per_s: margin.between_kick_sd_per_s,
         warnings: margin.warnings.clone(),
         kicks: rows,
         model: None,
@@ -196,7 +227,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
     if rows.is_empty() && result.is_err() {
         return result;
     }
-    let (mut report, margin) = report(rows, args.trend);
+    let (mut report, margin) = report(rows, args.trend, args.ride_margin / 100.0);
     if let Some(params) = &args.model {
         let keys: Vec<String> = if args.params.is_empty() {
             DEFAULT_PARAMS.iter().map(|k| (*k).to_owned()).collect()
@@ -285,6 +316,28 @@ fn render_text(r: &Report, logs: usize) -> String {
             let _ = writeln!(o, "no predicted wobble speed");
         }
     }
+    if let Some(why) = &r.open_because {
+        let _ = writeln!(o, "interval open above: {why}");
+    }
+    match r.ride_below_mps {
+        Some(v) => {
+            let _ = writeln!(
+                o,
+                "ride below {v:.2} m/s (the lower bound less {:.0} %)",
+                100.0 * r.ride_margin
+            );
+        }
+        None => {
+            let _ = writeln!(
+                o,
+                "no riding limit: the kicks bound no wobble speed from below; stay at speeds \
+                 already kicked"
+            );
+        }
+    }
+    if let Some(v) = r.next_pass_max_mps {
+        let _ = writeln!(o, "next pass at most {v:.2} m/s");
+    }
     if let Some([lo, hi]) = r.speed_range_mps {
         let _ = writeln!(o, "kicks used between {lo:.2} and {hi:.2} m/s");
     }
@@ -303,6 +356,9 @@ fn render_text(r: &Report, logs: usize) -> String {
             "scatter about the trend: {:.2} times the kicks' stated SD",
             s2.sqrt()
         );
+    }
+    if let Some(tau) = r.between_kick_sd_per_s {
+        let _ = writeln!(o, "between-kick SD of the true damping: {tau:.3} 1/s");
     }
     for w in &r.warnings {
         let _ = writeln!(o, "warning: {w}");

@@ -43,6 +43,8 @@ const FIT: RGBColor = RGBColor(0x20, 0x20, 0x20);
 const BAND: RGBColor = RGBColor(0xc8, 0xd4, 0xe8);
 const MODEL: RGBColor = RGBColor(0x2c, 0xa0, 0x2c);
 const CROSSING: RGBColor = RGBColor(0xff, 0x7f, 0x0e);
+const RIDE: RGBColor = RGBColor(0x94, 0x67, 0xbd);
+const NEXT: RGBColor = RGBColor(0x8c, 0x56, 0x4b);
 /// Points on the line and band.
 const STEPS: usize = 120;
 
@@ -60,6 +62,7 @@ impl MarginPlot {
             m.wobble_speed_mps,
             m.ci95_mps[0],
             m.ci95_mps[1],
+            m.advice.next_pass_max_mps,
             self.model_speed.map(|s| s.0),
         ]
         .into_iter()
@@ -152,7 +155,7 @@ impl Figure for MarginPlot {
                 .draw_series(LineSeries::new(fit, FIT.stroke_width(2)))
                 .map_err(err)?
                 .label(match self.margin.trend {
-                    Trend::Line => "robust line, the model's bend",
+                    Trend::Line => "robust line, bent by the shape prior",
                     Trend::Quadratic => "robust quadratic",
                 })
                 .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], FIT.stroke_width(2)));
@@ -167,6 +170,28 @@ impl Figure for MarginPlot {
                 .label(format!("predicted wobble speed {w:.2} m/s"))
                 .legend(|(x, y)| {
                     PathElement::new(vec![(x, y), (x + 20, y)], CROSSING.stroke_width(2))
+                });
+        }
+        for (speed, colour, what) in [
+            (self.margin.advice.ride_below_mps, RIDE, "ride below"),
+            (
+                self.margin.advice.next_pass_max_mps,
+                NEXT,
+                "next pass at most",
+            ),
+        ] {
+            let Some(v) = speed.filter(|v| x_range.contains(v)) else {
+                continue;
+            };
+            chart
+                .draw_series(std::iter::once(PathElement::new(
+                    vec![(v, y_range.start), (v, y_range.end)],
+                    colour.stroke_width(2),
+                )))
+                .map_err(err)?
+                .label(format!("{what} {v:.2} m/s"))
+                .legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2))
                 });
         }
         if self.model_curve.is_some() {

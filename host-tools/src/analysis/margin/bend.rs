@@ -1,0 +1,111 @@
+//! What the line assumes about sigma's bend beyond the kicks, as a shape
+//! relative to the wobble speed.
+//!
+//! Near the wobble speed `u*` sigma is `b (u - u*) + (k/2) (u - u*)^2`. In
+//! units of the wobble speed and of the damping at half of it, `D =
+//! -sigma(u*/2)`, the bend is the number `beta = k u*^2 / D`: 0 for a
+//! straight trend, negative when sigma flattens towards the wobble speed
+//! (concave), positive when it steepens (convex); a trend that rises all
+//! the way from `u*/2` to `u*` has `-8 < beta < 8` (at -8 it arrives flat,
+//! at 8 it leaves `u*/2` flat). The same shape on a bicycle whose wobble
+//! speed is twice as high, or whose damping is twice as strong, has the
+//! same `beta` but a different `k`: a prior in `beta` carries across
+//! bicycles where a prior in 1/s per (m/s)^2 does not.
+
+use serde::Serialize;
+
+/// The allowance the line makes for sigma's bend: its curvature
+/// `k` is taken as unknown, `prior_per_s_mps2` (the bend the trend is
+/// given, [`BendPrior`] at the predicted wobble speed) with standard
+/// deviation `sd_convex_per_s_mps2` towards convex bends, which bring the
+/// zero closer (it widens the interval below `split_mps`, the prediction)
+/// and `sd_concave_per_s_mps2` towards concave ones, which take it
+/// further (above `split_mps`): a two-piece prior, as a family of
+/// bicycles is not symmetric about its mean. A line fitted by least squares to `a + b u +
+/// (d/2) u^2` is off at `u` by exactly `(d/2) ((u - m)^2 - v)`, `m` and `v`
+/// the weighted mean and variance of the kicks' speeds (the line absorbs
+/// the rest); the kicks are fitted with the prior's bend taken out, so `d`
+/// is the curvature's departure from the prior and the trend's value at
+/// `u` is uncertain by that much more: in quadrature, `(sd/2) |(u - m)^2 -
+/// v|`.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Bend {
+    /// Weighted mean speed of the kicks used, m/s.
+    pub mean_mps: f64,
+    /// Weighted variance of their speeds, (m/s)^2.
+    pub variance_mps2: f64,
+    /// The curvature the trend is bent by, 1/s per (m/s)^2.
+    pub prior_per_s_mps2: f64,
+    /// Standard deviation of the curvature about it towards convex bends,
+    /// 1/s per (m/s)^2.
+    pub sd_convex_per_s_mps2: f64,
+    /// ... towards concave bends.
+    pub sd_concave_per_s_mps2: f64,
+    /// Below this speed the convex side counts, above it the concave, m/s.
+    pub split_mps: f64,
+    /// The shape it was taken from.
+    pub shape: BendPrior,
+}
+
+impl Bend {
+    /// The standard uncertainty it adds to the trend's value at `u`, 1/s.
+    #[must_use]
+    pub fn sd_at(&self, u: f64) -> f64 {
+        let sd = if u < self.split_mps {
+            self.sd_convex_per_s_mps2
+        } else {
+            self.sd_concave_per_s_mps2
+        };
+        0.5 * sd * ((u - self.mean_mps).powi(2) - self.variance_mps2).abs()
+    }
+}
+
+/// The line's assumption about the bend: the dimensionless shape `beta`
+/// (module documentation) about `mean`, with standard deviation
+/// `sd_convex` above it and `sd_concave` below it.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct BendPrior {
+    /// Mean of `beta`.
+    pub mean: f64,
+    /// Its standard deviation towards convex shapes (larger `beta`).
+    pub sd_convex: f64,
+    /// ... towards concave shapes.
+    pub sd_concave: f64,
+}
+
+impl BendPrior {
+    /// The default ([`BEND_SHAPE_MEAN`], [`BEND_SHAPE_SD`]).
+    pub const DEFAULT: Self = Self {
+        mean: BEND_SHAPE_MEAN,
+        sd_convex: BEND_SHAPE_SD_CONVEX,
+        sd_concave: BEND_SHAPE_SD_CONCAVE,
+    };
+    /// No bend assumed or allowed for: a straight line.
+    pub const NONE: Self = Self {
+        mean: 0.0,
+        sd_convex: 0.0,
+        sd_concave: 0.0,
+    };
+
+    /// The curvature, 1/s per (m/s)^2, of `beta` on a trend whose wobble
+    /// speed is `zero_mps` and whose damping at half of it is
+    /// `damping_per_s` (> 0): `(mean, sd_convex, sd_concave)`.
+    #[must_use]
+    pub fn curvature(&self, zero_mps: f64, damping_per_s: f64) -> (f64, f64, f64) {
+        let unit = damping_per_s.max(0.0) / (zero_mps * zero_mps);
+        (
+            self.mean * unit,
+            self.sd_convex * unit,
+            self.sd_concave * unit,
+        )
+    }
+}
+
+/// The mean bend shape `beta` the line assumes (module documentation):
+/// the family of bicycles in `host-tools/docs/kick-testing.md` ("The bend
+/// prior").
+pub const BEND_SHAPE_MEAN: f64 = -1.0;
+/// Its standard deviation towards convex shapes.
+pub const BEND_SHAPE_SD_CONVEX: f64 = 3.0;
+/// Its standard deviation towards concave shapes.
+pub const BEND_SHAPE_SD_CONCAVE: f64 = 0.7;
