@@ -14,10 +14,16 @@
 //!   bisquare (iteratively reweighted, scale from the median absolute
 //!   deviation and never below the kicks' own uncertainties), so one bad
 //!   kick cannot move it;
+//! - the kicks' scatter about the bicycle's mean damping beyond what their
+//!   SDs say, a between-kick variance `tau^2` of the kicks the bisquare
+//!   kept (DerSimonian and Laird's moment estimate, the host's random
+//!   effect in closed form), is added to each kick's `sd^2` and the line
+//!   fitted again with weights `1 / (sd^2 + tau^2)`;
 //! - the wobble speed is the zero `-a / b`; its 95 % interval is Fieller's
 //!   (the speeds at which the line is not significantly different from
-//!   zero, t with `n - 2` degrees of freedom on the covariance scaled by the
-//!   residual scatter): the *lower bound* is what the warning uses;
+//!   zero, t with `n - 2` degrees of freedom on that line's covariance,
+//!   scaled by its residual scatter when above 1): the *lower bound* is
+//!   what the warning uses;
 //! - no estimate from fewer than [`MIN_KICKS`] kicks carrying weight, a
 //!   speed range narrower than [`MIN_SPAN_MPS`], or a slope that is not
 //!   positive; the upper end is left open when the rise of sigma is not
@@ -270,13 +276,13 @@ fn median(v: &mut [f32]) -> f32 {
     }
 }
 
-/// The robust line: Tukey's bisquare by iterative reweighting. Returns the
-/// line and the final weights.
-fn robust_line(points: &[Point]) -> Option<(Line, [f32; MAX_KICKS])> {
+/// The robust line: Tukey's bisquare by iterative reweighting, each kick's
+/// variance its `sd^2` plus `tau2`. Returns the line and the final weights.
+fn robust_line(points: &[Point], tau2: f32) -> Option<(Line, [f32; MAX_KICKS])> {
     let n = points.len();
     let mut base = [0.0_f32; MAX_KICKS];
     for (b, p) in base.iter_mut().zip(points) {
-        *b = p.weight;
+        *b = 1.0 / (1.0 / p.weight + tau2);
     }
     let mut w = base;
     let mut line = weighted_line(points, &base[..n])?;
@@ -335,20 +341,79 @@ fn fieller(a: f32, b: f32, cov: [f32; 3], t: f32) -> Option<(f32, Option<f32>)> 
     }
 }
 
+/// The between-kick variance of the kicks the bisquare kept (weight `w`
+/// above 0): DerSimonian and Laird's moment estimate for a weighted line,
+/// `tau^2 = max(0, (Q - (k - 2)) / (S - T))`, `Q` the chi-square about the
+/// line weighted `v = 1 / sd^2`, `S = sum v`, `T = sum v^2 / S + sum v^2
+/// du^2 / sum v du^2` (`du` from the weighted mean speed: the trace that
+/// the line's two coefficients take), `k` the kicks kept. One pass, no
+/// iteration: the host's Paule-Mandel estimate in closed form for the
+/// board's budget (the two agree when the kicks' SDs do). The weights `v`
+/// of the kicks kept and `tau^2`.
+fn between_kick_variance(points: &[Point], w: &[f32]) -> Option<([f32; MAX_KICKS], f32)> {
+    let n = points.len();
+    let mut v = [0.0_f32; MAX_KICKS];
+    let mut kept = 0.0_f32;
+    for k in 0..n {
+        if w[k] > 0.0 {
+            v[k] = points[k].weight;
+            kept += 1.0;
+        }
+    }
+    let fixed = weighted_line(points, &v[..n])?;
+    let (mut q, mut s, mut s2, mut suu, mut s2uu) = (0.0_f32, 0.0_f32, 0.0_f32, 0.0_f32, 0.0_f32);
+    for (p, &v) in points.iter().zip(&v[..n]) {
+        let (r, du) = (fixed.residual(p), p.speed_mps - fixed.centre);
+        q += v * r * r;
+        s += v;
+        s2 += v * v;
+        suu += v * du * du;
+        s2uu += v * v * du * du;
+    }
+    let trace = s2 / s + s2uu / suu;
+    let tau2 = ((q - (kept - 2.0)) / (s - trace)).max(0.0);
+    Some((v, if tau2.is_finite() { tau2 } else { 0.0 }))
+}
+
+/// The line on the kicks kept (weight `w` above 0, `dof` of them less
+/// two) weighted `1 / (sd^2 + tau^2)`, `tau^2` theirs
+/// ([`between_kick_variance`]), and its covariance, scaled by its residual
+/// variance of unit weight when above 1 (Knapp and Hartung).
+fn with_between_kick_variance(points: &[Point], w: &[f32], dof: usize) -> Option<(Line, [f32; 3])> {
+    let n = points.len();
+    let (mut v, tau2) = between_kick_variance(points, w)?;
+    for x in &mut v[..n] {
+        if *x > 0.0 {
+            *x = 1.0 / (1.0 / *x + tau2);
+        }
+    }
+    let line = weighted_line(points, &v[..n])?;
+    let mut ssr = 0.0_f32;
+    for (p, &v) in points.iter().zip(&v[..n]) {
+        let r = line.residual(p);
+        ssr += v * r * r;
+    }
+    let scale = (ssr / dof as f32).max(1.0);
+    Some((line, line.inv.map(|x| x * scale)))
+}
+
 /// The estimate from `points` (see the module docs).
 fn estimate(points: &[Point]) -> Option<WobbleSpeed> {
     if points.len() < MIN_KICKS {
         return None;
     }
-    let (line, w) = robust_line(points)?;
-    let (mut used, mut lo_u, mut hi_u, mut ssr) = (0usize, f32::INFINITY, 0.0_f32, 0.0_f32);
+    // Outliers on the kicks' own SDs, then again with the between-kick
+    // variance those kept show, so that precise kicks scattered by it are
+    // not taken for outliers.
+    let (_, w) = robust_line(points, 0.0)?;
+    let tau2 = between_kick_variance(points, &w)?.1;
+    let (line, w) = robust_line(points, tau2)?;
+    let (mut used, mut lo_u, mut hi_u) = (0usize, f32::INFINITY, 0.0_f32);
     for (p, &w) in points.iter().zip(&w) {
         if w > 0.0 {
             used += 1;
             lo_u = lo_u.min(p.speed_mps);
             hi_u = hi_u.max(p.speed_mps);
-            let r = line.residual(p);
-            ssr += w * r * r;
         }
     }
     let span = hi_u - lo_u;
@@ -357,10 +422,7 @@ fn estimate(points: &[Point]) -> Option<WobbleSpeed> {
         return None;
     }
     let dof = used - 2;
-    // Residual variance of unit weight, never below what the kicks' own
-    // uncertainties say.
-    let s2 = (ssr / dof as f32).max(1.0);
-    let cov = line.inv.map(|v| v * s2);
+    let (line, cov) = with_between_kick_variance(points, &w, dof)?;
     let (lo, hi) = fieller(line.a, line.b, cov, t_975(dof))?;
     let zero = line.centre - line.a / line.b;
     let open = zero - hi_u > span;
@@ -390,10 +452,17 @@ pub(crate) fn cost() -> (Cost1, Cost1) {
     // n (n - 1) / 2 compares and swaps); the line; the convergence test.
     let pass =
         (Cost1::SQRT + Cost1::new(7, 4, 2)) * n + Cost1::new(1, 5, n * (n - 1) / 2 + 5) + line;
-    // Then the residual variance (per kick), the t quantile, Fieller's
-    // quadratic and its roots.
-    let interval = Cost1::SQRT + Cost1::new(3 * n + 45, 4 * n + 20, 3 * n + 10);
-    let estimate = line + pass * ITERATIONS as u32 + interval;
+    // The between-kick variance: a line on the kicks kept, the chi-square
+    // and four sums (per kick), the trace, tau^2; each weight again (a
+    // division per kick) and the line with them, its residual variance.
+    let between = line + Cost1::new(7 * n + 8, 6 * n + 4, 2 * n + 6);
+    let refit = line + Cost1::new(5 * n, 3 * n, n);
+    // Two robust lines (the second with tau^2 in each kick's base weight),
+    // the variance twice and the final line, then the t quantile,
+    // Fieller's quadratic and its roots.
+    let robust = line + pass * ITERATIONS as u32 + Cost1::new(2 * n, n, n);
+    let interval = Cost1::SQRT + Cost1::new(45, 20, 10);
+    let estimate = robust * 2 + between * 2 + refit + interval;
     let update = Cost1::new(0, 1, 4);
     (estimate, update)
 }
@@ -579,6 +648,88 @@ mod tests {
         assert!(
             narrow.lower_mps > got.lower_mps + 0.01,
             "{narrow:?} {got:?}"
+        );
+    }
+
+    /// Kicks of two stated SDs scattered about `sigma = 0.8 (u - 4.5)` far
+    /// more than either says (a between-kick SD of about 0.15 1/s): the
+    /// interval is DerSimonian and Laird's, worked here in `f64` from its
+    /// definition (weights `v = 1 / sd^2`, `Q` about the `v`-weighted line,
+    /// `tau^2 = (Q - (n - 2)) / (S - T)`, the line again with weights `1 /
+    /// (sd^2 + tau^2)`, Fieller with t of `n - 2`), and wider than the
+    /// bisquare line's with the kicks' SDs scaled alone would have it on
+    /// the precise kicks.
+    #[test]
+    fn kicks_scattered_beyond_their_sds_carry_a_between_kick_variance() {
+        let scatter = [0.12, -0.2, 0.05, 0.18, -0.1, -0.16, 0.2, 0.02, -0.14, 0.09];
+        let ses = [0.005_f64, 0.03];
+        let rows: std::vec::Vec<(f64, f64, f64)> = (0..10)
+            .map(|i| {
+                let u = 2.0 + 0.2 * f64::from(i as u8);
+                let se = ses[i % 2];
+                (u, 0.8 * (u - 4.5) + scatter[i], se)
+            })
+            .collect();
+        let mut warning = MarginWarning::new(0.5);
+        for &(u, y, se) in &rows {
+            warning.add_kick(&kick(u as f32, y as f32, se as f32));
+        }
+        let got = warning.estimate().unwrap();
+        assert_eq!(got.kicks, 10, "{got:?}");
+        let sd2: std::vec::Vec<f64> = rows
+            .iter()
+            .map(|r| (3.3 * r.2).powi(2) + 0.0175_f64.powi(2))
+            .collect();
+        // The weighted line about its weighted mean speed.
+        let line = |w: &[f64]| {
+            let s: f64 = w.iter().sum();
+            let m = rows.iter().zip(w).map(|(r, w)| w * r.0).sum::<f64>() / s;
+            let a = rows.iter().zip(w).map(|(r, w)| w * r.1).sum::<f64>() / s;
+            let suu: f64 = rows.iter().zip(w).map(|(r, w)| w * (r.0 - m).powi(2)).sum();
+            let b = rows
+                .iter()
+                .zip(w)
+                .map(|(r, w)| w * (r.0 - m) * (r.1 - a))
+                .sum::<f64>()
+                / suu;
+            (m, a, b, s, suu)
+        };
+        let v: std::vec::Vec<f64> = sd2.iter().map(|s| 1.0 / s).collect();
+        let (m, a, b, s, suu) = line(&v);
+        let q: f64 = rows
+            .iter()
+            .zip(&v)
+            .map(|(r, v)| v * (r.1 - a - b * (r.0 - m)).powi(2))
+            .sum();
+        let s2: f64 = v.iter().map(|v| v * v).sum();
+        let s2uu: f64 = rows
+            .iter()
+            .zip(&v)
+            .map(|(r, v)| v * v * (r.0 - m).powi(2))
+            .sum();
+        let tau2 = (q - 8.0) / (s - (s2 / s + s2uu / suu));
+        assert!(tau2 > 0.01, "{tau2}");
+        let w: std::vec::Vec<f64> = sd2.iter().map(|s| 1.0 / (s + tau2)).collect();
+        let (m, a, b, s, suu) = line(&w);
+        let ssr: f64 = rows
+            .iter()
+            .zip(&w)
+            .map(|(r, w)| w * (r.1 - a - b * (r.0 - m)).powi(2))
+            .sum();
+        let scale = (ssr / 8.0).max(1.0);
+        let (vaa, vbb) = (scale / s, scale / suu);
+        let t2 = f64::from(t_975(8)).powi(2);
+        let (qa, qb, qc) = (b * b - t2 * vbb, 2.0 * a * b, a * a - t2 * vaa);
+        let r = (qb * qb - 4.0 * qa * qc).sqrt();
+        let (lo, hi) = (m + (-qb - r) / (2.0 * qa), m + (-qb + r) / (2.0 * qa));
+        assert!(
+            (f64::from(got.estimate_mps.unwrap()) - (m - a / b)).abs() < 2e-3,
+            "{got:?}"
+        );
+        assert!((f64::from(got.lower_mps) - lo).abs() < 5e-3, "{got:?} {lo}");
+        assert!(
+            (f64::from(got.upper_mps.unwrap()) - hi).abs() < 5e-3,
+            "{got:?} {hi}"
         );
     }
 
