@@ -2,7 +2,8 @@
 //! (`wobble_hil::margin_stress`): per shape class, the coverage of the
 //! closed 95 % intervals, how often the lower bound lies more than 5 % and
 //! 10 % above the truth, how often the interval stays open, and the point
-//! estimate's error.
+//! estimate's error; the host's (`wobblog margin`) on two scatter ranges,
+//! the board's (`MarginWarning`) on the acceptance's.
 //!
 //! ```text
 //! cargo run -p wobble-hil --release --example margin_stress -- [FIRST_SEED] [CAMPAIGNS]
@@ -11,7 +12,7 @@
 //! `beta` of `wobblog::analysis::margin::bend`). The figures in `host-tools/docs/kick-testing.md` are from seeds 1000000
 //! on (2000 campaigns per class); the defaults were chosen on seeds 0-999.
 
-use wobble_hil::margin_stress::{host_outcomes, Recipe, Shape, Tally};
+use wobble_hil::margin_stress::{board_outcomes, host_outcomes, Recipe, Shape, Tally};
 use wobblog::analysis::margin::BendPrior;
 
 fn main() -> Result<(), String> {
@@ -56,6 +57,20 @@ fn main() -> Result<(), String> {
         }
         print_row(name, "pooled (with a wobble speed)", &Tally::of(&pooled));
     }
+    // The board: a straight line over its latest 24 kicks, no riding limit.
+    let mut pooled = Vec::new();
+    for shape in Shape::ALL {
+        let outcomes = board_outcomes(&Recipe::acceptance(shape), first, campaigns);
+        print_row("board, scatter 0.12", shape.name(), &Tally::of(&outcomes));
+        if shape.beta().is_some() {
+            pooled.extend(outcomes);
+        }
+    }
+    print_row(
+        "board, scatter 0.12",
+        "pooled (with a wobble speed)",
+        &Tally::of(&pooled),
+    );
     Ok(())
 }
 

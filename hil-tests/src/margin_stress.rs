@@ -14,6 +14,7 @@
 //! stable above): no wobble speed may be claimed ahead.
 
 use crate::corpus::rng::Rng;
+use wobble_core::detector::{Kick, MarginWarning, SIGMA_SD_FLOOR_PER_S, SIGMA_SE_FACTOR};
 use wobblog::analysis::margin::{predict_bent, BendPrior, KickPoint, Margin, Trend};
 
 /// The shape of sigma against speed.
@@ -254,6 +255,42 @@ pub fn host_outcomes(
         .map(|seed| {
             let c = campaign(recipe, seed);
             score(&c, &predict_bent(&c.kicks, Trend::Line, prior))
+        })
+        .collect()
+}
+
+/// The board's outcomes (`MarginWarning`, its latest 24 kicks, `f32`) on
+/// the same campaigns: each kick given the fit error `se` whose
+/// calibrated uncertainty is the kick's stated SD.
+#[must_use]
+pub fn board_outcomes(recipe: &Recipe, first: u64, campaigns: u64) -> Vec<Outcome> {
+    let (factor, floor) = (SIGMA_SE_FACTOR, SIGMA_SD_FLOOR_PER_S);
+    (first..first + campaigns)
+        .map(|seed| {
+            let c = campaign(recipe, seed);
+            let mut board = MarginWarning::new(0.0);
+            for k in &c.kicks {
+                let se = (k.sigma_sd_per_s.powi(2) - floor * floor).max(0.0).sqrt() / factor;
+                board.add_kick(&Kick {
+                    samples_ago: 0,
+                    speed_mps: Some(k.speed_mps as f32),
+                    freq_hz: k.freq_hz as f32,
+                    sigma_per_s: k.sigma_per_s as f32,
+                    sigma_se_per_s: se as f32,
+                    amp_deg: 1.0,
+                    segments: 10,
+                });
+            }
+            let e = board.estimate();
+            score_parts(
+                c.wobble_speed_mps,
+                e.and_then(|e| e.estimate_mps).map(f64::from),
+                [
+                    e.map(|e| f64::from(e.lower_mps)),
+                    e.and_then(|e| e.upper_mps).map(f64::from),
+                ],
+                None,
+            )
         })
         .collect()
 }
