@@ -67,9 +67,9 @@ targets=(
   "naming|wobble-model|host-tools/bicycle-model/src/naming.rs|speeds,sway_like,classify|--test naming_grid --test rigid_rider --test sway_mode --test wobble_model --test whipple_benchmark --test bicycleparameters_bicycles"
   "critical|wobble-model|host-tools/bicycle-model/src/critical.rs|sign,by_newton|--lib"
   "critical-newton|wobble-model|host-tools/bicycle-model/src/critical/newton.rs|.|--lib"
-  "margin-regression|wobblog|host-tools/src/analysis/margin.rs|.|--lib|analysis::margin::"
+  "margin-regression|wobblog|host-tools/src/analysis/margin/[!t]*.rs|.|--lib|analysis::margin::"
   "decay-trend|wobble-core|firmware/core/src/detector/trend.rs|.|--lib --test detector_machine --test detector_props"
-  "margin-warning|wobble-core|firmware/core/src/detector/margin.rs|MarginWarning,fieller,estimate,robust_line,weighted_line,median,t_975|--lib|detector::margin::"
+  "margin-warning|wobble-core|firmware/core/src/detector/margin.rs|MarginWarning,fieller,estimate,robust_line,weighted_line,between_kick_variance,median,t_975|--lib|detector::margin::"
 )
 
 list=false

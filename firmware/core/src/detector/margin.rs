@@ -5,7 +5,7 @@
 //! Each kick's ring-down ([`Kick`]) gives the wobble mode's growth rate
 //! sigma at its speed; sigma rises towards zero as the speed approaches the
 //! wobble speed. The estimate is the host's `wobblog margin` method
-//! (`host-tools/src/analysis/margin.rs`) in `f32` over the last
+//! (`host-tools/src/analysis/margin/`) in `f32` over the last
 //! [`MAX_KICKS`] kicks with a known speed:
 //!
 //! - a straight line `sigma = a + b u`, each kick weighted by `1 / sd^2`
