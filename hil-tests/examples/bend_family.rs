@@ -21,9 +21,9 @@
 //! line must extrapolate. A bicycle without a wobble speed between the
 //! rider's slowest balanced speed and 12 m/s, or whose wobble mode the
 //! model does not follow down to half of it, is listed and left out; so is
-//! one whose sigma does not rise all the way from `u*/2` to `u*` (`|beta|
-//! >= 8`: the wobble band's mode switches to another on the way, which no
-//! damping extrapolation sees), and a bicycle whose figures repeat an
+//! one whose sigma does not rise all the way from `u*/2` to `u*` (`beta`
+//! of 8 or more in size: the wobble band's mode switches to another on the
+//! way, which no damping extrapolation sees), and a bicycle whose figures repeat an
 //! earlier one's (a parameter file that is also a campaign variant). The
 //! spread is given as the family's SD and, about the prior's mean
 //! `wobblog::analysis::margin::BEND_SHAPE_MEAN`, as the RMS of the shapes
