@@ -19,6 +19,14 @@ fn tally(shape: Shape) -> Tally {
     ))
 }
 
+/// The board's lower bound allows for the same convex bends as the
+/// host's.
+#[test]
+fn the_board_allows_for_the_hosts_convex_bend() {
+    let board = f64::from(wobble_core::detector::margin::BEND_SHAPE_SD_CONVEX);
+    assert_eq!(board, wobblog::analysis::margin::BEND_SHAPE_SD_CONVEX);
+}
+
 /// A bicycle stable above its kicks and less so below them: no wobble
 /// speed is claimed ahead, no riding limit is made up, and the rise of
 /// sigma towards the slowest kicks is said in most campaigns.
