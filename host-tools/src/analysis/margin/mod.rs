@@ -25,8 +25,7 @@
 //!   data that cannot bound the wobble speed give an open interval, and
 //!   [`Margin::open_because`] says why.
 //! - **Refusals**: fewer than [`MIN_KICKS`] kicks, a speed range narrower
-//!   than [`MIN_SPAN_MPS`] (or [`MIN_SPAN_FRACTION`] of the fastest kick's
-//!   speed, when less), or an extrapolation beyond the fastest kick
+//!   than [`MIN_SPAN_MPS`], or an extrapolation beyond the fastest kick
 //!   longer than [`MAX_EXTRAPOLATION`] times the measured range: the
 //!   result says so (`warnings`), and the interval's upper end is open.
 //! - **Advice** ([`advice`]): the riding limit (the lower bound less a
@@ -186,11 +185,6 @@ fn total_variance(cov: &[Vec<f64>], bend: Option<&Bend>, u: f64) -> f64 {
 pub const MIN_KICKS: usize = 6;
 /// ... spread over at least this range of speed, m/s.
 pub const MIN_SPAN_MPS: f64 = 0.75;
-/// ... or this fraction of the fastest kick's speed, when that is less (a
-/// bicycle wobbling at 2.2 m/s is kicked between the slowest speed a
-/// rider balances at, about 1.5 m/s, and 0.85 of its wobble speed: 0.37
-/// m/s, a fifth of the fastest kick's speed). The board's rule too.
-pub const MIN_SPAN_FRACTION: f64 = 0.2;
 /// An extrapolation beyond the fastest kick longer than this times the
 /// measured range is not trusted: the interval is left open above.
 pub const MAX_EXTRAPOLATION: f64 = 1.0;
@@ -428,10 +422,9 @@ fn estimate(kicks: &[KickPoint], usable: &[usize], prior: BendPrior, out: &mut M
     };
     out.wobble_speed_mps = Some(zero);
     let mut open = Vec::new();
-    let min_span = MIN_SPAN_MPS.min(MIN_SPAN_FRACTION * hi_u);
-    if span < min_span {
+    if span < MIN_SPAN_MPS {
         open.push(format!(
-            "narrow speed range: {lo_u:.2}-{hi_u:.2} m/s, at least {min_span:.2} m/s needed"
+            "narrow speed range: {lo_u:.2}-{hi_u:.2} m/s, at least {MIN_SPAN_MPS} m/s needed"
         ));
     }
     let reach = zero - hi_u;

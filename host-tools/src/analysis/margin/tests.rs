@@ -584,30 +584,6 @@ fn narrow_range_leaves_the_interval_open() {
     assert!(m.warnings.iter().any(|w| w.contains("narrow")), "{m:?}");
 }
 
-/// A bicycle wobbling at 2.2 m/s, kicked at 1.5-1.885 m/s (a range of
-/// 0.385 m/s, over a fifth of 1.885): a closed interval holding the zero,
-/// no straight line assumed; the same range at 3.0-3.385 m/s is narrow.
-#[test]
-fn a_low_wobble_speed_is_estimated_from_a_narrow_range() {
-    let at = |from: f64| -> Vec<(f64, f64)> {
-        (0..8)
-            .map(|i| {
-                let u = from + 0.055 * f64::from(i);
-                let off = if i % 2 == 1 { 0.02 } else { -0.02 };
-                (u, 1.2 * (u - 2.2 - (from - 1.5)) + off)
-            })
-            .collect()
-    };
-    let m = predict_bent(&kicks(&at(1.5), 0.03), Trend::Line, NO_BEND);
-    assert!((m.wobble_speed_mps.unwrap() - 2.2).abs() < 0.05, "{m:?}");
-    assert!(
-        matches!(m.ci95_mps, [Some(lo), Some(hi)] if lo < 2.2 && 2.2 < hi),
-        "{m:?}"
-    );
-    let m = predict_bent(&kicks(&at(3.0), 0.03), Trend::Line, NO_BEND);
-    assert!(m.open_because.unwrap().contains("narrow speed range"));
-}
-
 #[test]
 fn long_extrapolation_is_said_and_left_open() {
     // Kicks at 1.5-2.1 m/s of a line crossing at 4.5 m/s.
