@@ -14,6 +14,7 @@
 //! stable above): no wobble speed may be claimed ahead.
 
 use crate::corpus::rng::Rng;
+use wobble_core::config::DEFAULT_MARGIN_MPS;
 use wobble_core::detector::{Kick, MarginWarning, SIGMA_SD_FLOOR_PER_S, SIGMA_SE_FACTOR};
 use wobblog::analysis::margin::{predict_bent, BendPrior, KickPoint, Margin, Trend};
 
@@ -261,7 +262,9 @@ pub fn host_outcomes(
 
 /// The board's outcomes (`MarginWarning`, its latest 24 kicks, `f32`) on
 /// the same campaigns: each kick given the fit error `se` whose
-/// calibrated uncertainty is the kick's stated SD.
+/// calibrated uncertainty is the kick's stated SD; its "riding limit" is
+/// the warning's threshold, the lower bound less the default
+/// `alert.margin_mps`.
 #[must_use]
 pub fn board_outcomes(recipe: &Recipe, first: u64, campaigns: u64) -> Vec<Outcome> {
     let (factor, floor) = (SIGMA_SE_FACTOR, SIGMA_SD_FLOOR_PER_S);
@@ -289,7 +292,9 @@ pub fn board_outcomes(recipe: &Recipe, first: u64, campaigns: u64) -> Vec<Outcom
                     e.map(|e| f64::from(e.lower_mps)),
                     e.and_then(|e| e.upper_mps).map(f64::from),
                 ],
-                None,
+                // The warning's threshold: the lower bound less the
+                // default `alert.margin_mps`.
+                e.map(|e| f64::from(e.lower_mps - DEFAULT_MARGIN_MPS)),
             )
         })
         .collect()
