@@ -262,7 +262,10 @@ fn figure_8_has_a_dot_per_episode_and_a_legend_per_run() {
     let a = dir.path().join("A.WBL");
     let b = dir.path().join("B.WBL");
     analysis_support::standard_log(&a);
-    analysis_support::standard_log(&b);
+    // Another ride (a byte-identical copy would be one input).
+    let (_, extras) = analysis_support::standard_log(&b);
+    let ride = analysis_support::Ride::new(30.0, 5.0, 15.0, 2.0, 0.4);
+    analysis_support::write_log(&b, &ride, &extras);
     let svg_path = dir.path().join("modes.svg");
     let json = stdout_of(
         wobblog()
