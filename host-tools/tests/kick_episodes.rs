@@ -86,3 +86,14 @@ proptest! {
         prop_assert!(ring.is_some_and(|e| (e.sigma_per_s - sigma).abs() < 0.3), "{:?}", episodes);
     }
 }
+
+/// A case the property test above once drew (exact values kept): a slow,
+/// small push, then a ring decaying at -1.77 1/s.
+#[test]
+fn a_slow_small_push_then_a_decaying_ring_is_stable() {
+    let run = kick_run(Some((2.0, 0.2481)), 1.2, -1.7653, 6.0, 0);
+    let episodes = find_episodes(&run);
+    for e in &episodes {
+        assert_eq!(e.stability, Stability::Stable, "{e:?}");
+    }
+}

@@ -82,6 +82,9 @@ const CAUSAL_SHARE: f64 = 0.5;
 const CAUSAL_WINDOW_S: f64 = 0.3;
 /// The causal check of a growth leaves out this much of the climb's end, s.
 const CAUSAL_TRIM_S: f64 = 0.15;
+/// The longest push on the bar, s: the climb before it is its answer
+/// alone (see [`CAUSAL_SHARE`]).
+const SLOW_PUSH_S: f64 = 0.3;
 /// A decay fit the largest swing cannot start (a push there) starts this
 /// much later in turn...
 const PUSH_STEP_S: f64 = 0.05;
@@ -368,16 +371,23 @@ impl<'a> Span<'a> {
             // magnitude response); the push's answer before the push is
             // only in the zero-phase one. Compared over
             // [`CAUSAL_WINDOW_S`] ending [`CAUSAL_TRIM_S`] before the top
-            // of the climb (the push itself may fill the last moments).
+            // of the climb (a short push may fill the last moments), and
+            // over the part of the climb before [`SLOW_PUSH_S`] from its top
+            // (a slow push fills more than the trim).
             let causal_ok = !growing || {
-                let end = fitted.end.saturating_sub(self.samples(CAUSAL_TRIM_S));
-                let start = end.saturating_sub(self.samples(CAUSAL_WINDOW_S));
                 let rms = |x: &[f64]| {
                     let n = x.len().max(1) as f64;
                     (x.iter().map(|v| v * v).sum::<f64>() / n).sqrt()
                 };
-                end > start.max(fitted.start)
-                    && rms(&causal[start..end]) >= CAUSAL_SHARE * rms(&band[start..end])
+                let shows = |w: Range<usize>| {
+                    w.end > w.start && rms(&causal[w.clone()]) >= CAUSAL_SHARE * rms(&band[w])
+                };
+                let width = self.samples(CAUSAL_WINDOW_S);
+                let end = fitted.end.saturating_sub(self.samples(CAUSAL_TRIM_S));
+                let late = end.saturating_sub(width).max(fitted.start)..end;
+                let before_push = fitted.end.saturating_sub(self.samples(SLOW_PUSH_S));
+                let early = before_push.saturating_sub(width).max(range.start)..before_push;
+                shows(late) && (early.len() < 2 || shows(early))
             };
             (ok && causal_ok).then_some((fitted, mode))
         };
