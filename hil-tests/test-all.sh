@@ -54,5 +54,8 @@ step "QEMU image (netduinoplus2): clippy and release build, run by the tests"
 cargo clippy -p wobble-qemu-image --target "$TARGET" -- -D warnings
 (cd hil-tests/qemu-image && cargo build --release)
 
-step "tests"
+# Property tests draw their cases from the fixed seed in .cargo/config.toml
+# (the environment's PROPTEST_RNG_SEED wins): every run of one tree runs the
+# same cases. Fresh seeds and more cases: hil-tests/proptest-fresh.sh.
+step "tests (PROPTEST_RNG_SEED=${PROPTEST_RNG_SEED:-from .cargo/config.toml})"
 cargo test

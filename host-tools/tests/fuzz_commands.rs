@@ -8,8 +8,11 @@
 //! arbitrary CSV and NMEA text. Nothing may panic, and memory-bound
 //! invariants must hold.
 //!
-//! Runs for `WOBBLOG_FUZZ_SECONDS` (default 3) of new cases after the saved
-//! regressions, so the test command stays short; for a long run:
+//! The test command runs one round of 8 new cases per harness, drawn from
+//! the fixed proptest seed (`PROPTEST_RNG_SEED`, `.cargo/config.toml`), so
+//! every run of one tree tests the same cases; with `WOBBLOG_FUZZ_SECONDS`
+//! it runs rounds for that long, each from the next seed; for a long run
+//! (fresh seeds: `hil-tests/proptest-fresh.sh`):
 //!
 //! ```text
 //! WOBBLOG_FUZZ_SECONDS=600 cargo test -p wobblog --release --test fuzz_commands -- --nocapture
@@ -21,7 +24,7 @@ use std::time::{Duration, Instant};
 
 use proptest::collection::vec;
 use proptest::prelude::*;
-use proptest::test_runner::{Config, TestRunner};
+use proptest::test_runner::{Config, RngSeed, TestRunner};
 use wobble_core::format::block::BlockHeader;
 use wobble_core::format::{
     Block, BlockEncoder, ChannelDef, ConfigLine, FixMode, Frame, GpsFix, LogInfo, Record, UtcSync,
@@ -232,13 +235,23 @@ fn draw(figure: &impl Figure, dir: &Path, name: &str) {
     wobblog::plot::render(figure, out).unwrap();
 }
 
-/// Budget of new cases for each harness, from `WOBBLOG_FUZZ_SECONDS`.
+/// Time for new cases for each harness, from `WOBBLOG_FUZZ_SECONDS`; none
+/// (one round) without it.
 fn budget() -> Duration {
     let s = std::env::var("WOBBLOG_FUZZ_SECONDS")
         .ok()
         .and_then(|v| v.parse().ok())
-        .unwrap_or(3.0);
+        .unwrap_or(0.0);
     Duration::from_secs_f64(s)
+}
+
+/// The seed of round `round`: the configured seed's `round`-th successor
+/// when it is fixed, else a fresh one.
+fn seed_of(round: u64) -> RngSeed {
+    match Config::default().rng_seed {
+        RngSeed::Fixed(seed) => RngSeed::Fixed(seed.wrapping_add(round)),
+        RngSeed::Random => RngSeed::Random,
+    }
 }
 
 /// Runs `test` on values of `strategy` until the budget is spent; a failure
@@ -247,14 +260,17 @@ fn budget() -> Duration {
 fn fuzz<S: Strategy>(name: &str, strategy: S, test: impl Fn(S::Value)) {
     let start = Instant::now();
     let mut cases = 0u32;
+    let mut round = 0;
     while cases == 0 || start.elapsed() < budget() {
-        // A runner stops after its number of cases: a fresh one (fresh
-        // random seed) for every round.
+        // A runner stops after its number of cases: a new one, with the
+        // next seed, for every round.
         let mut runner = TestRunner::new(Config {
             cases: 8,
             failure_persistence: None,
+            rng_seed: seed_of(round),
             ..Config::default()
         });
+        round += 1;
         let result = runner.run(&strategy, |v| {
             test(v);
             Ok(())
