@@ -62,7 +62,10 @@ enum Command {
 /// stderr; the exit code says what kind of failure it was.
 #[must_use]
 pub fn main() -> ExitCode {
-    let cli = Cli::parse();
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => return clap_exit(&e),
+    };
     crate::output::set_force(cli.force);
     let result = match cli.command {
         Command::Info(args) => cmd::info::run(&args),
@@ -84,6 +87,29 @@ pub fn main() -> ExitCode {
         Command::Man => cmd::completions::man(),
     };
     report(result)
+}
+
+/// Prints what clap stopped at (help, version, a usage error) and ends as
+/// it would, except that help or version text that cannot be written (`--help
+/// > /dev/full`) is a failure; a reader gone (`--help | head`) is not.
+fn clap_exit(e: &clap::Error) -> ExitCode {
+    let code = ExitCode::from(u8::try_from(e.exit_code()).unwrap_or(2));
+    if e.use_stderr() {
+        let _ = e.print();
+        return code;
+    }
+    let written = e.print().and_then(|()| {
+        use std::io::Write;
+        std::io::stdout().flush()
+    });
+    match written {
+        Ok(()) => code,
+        Err(io) if io.kind() == std::io::ErrorKind::BrokenPipe => ExitCode::SUCCESS,
+        Err(io) => {
+            eprintln!("wobblog: standard output: {io}");
+            ExitCode::FAILURE
+        }
+    }
 }
 
 fn report(result: Result<(), CliError>) -> ExitCode {

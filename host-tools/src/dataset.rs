@@ -1,7 +1,8 @@
 //! A campaign as Parquet datasets, one folder per table, so Polars,
 //! pyarrow and DuckDB open each with their default options:
 //! `frames/run=N/part-0.parquet` (Hive-partitioned, under `card=NAME/` as
-//! well for a folder of cards; the run number unpadded so readers type it
+//! well for a folder of cards, `NAME` percent-encoded as Hive readers
+//! decode it; the run number unpadded so readers type it
 //! as an integer), `runs/part-0.parquet` (one row per run, as `wobblog
 //! summary`) and `episodes/part-0.parquet` (one row per wobble episode, as
 //! `wobblog wobble`). Every file carries its columns' units as key-value
@@ -41,10 +42,29 @@ impl LogEntry {
         let run = PathBuf::from(format!("run={}", self.run));
         let frames = Path::new(FRAMES);
         match &self.card {
-            Some(card) => frames.join(format!("card={card}")).join(run),
+            Some(card) => frames.join(format!("card={}", hive_value(card))).join(run),
             None => frames.join(run),
         }
     }
+}
+
+/// `value` as a Hive partition value: every byte but ASCII letters, digits
+/// and `-_.~` percent-encoded (`rider=anna` is `rider%3Danna`, a newline
+/// `%0A`, `%2F` is `%252F`), as readers decode it (pyarrow's default `uri`
+/// segment encoding, Polars, DuckDB). A name left as it is breaks the
+/// `key=value` folder (`=`), the path (`/`, newlines) or reads back as
+/// another name (`%`).
+fn hive_value(value: &str) -> String {
+    use std::fmt::Write;
+    let mut out = String::with_capacity(value.len());
+    for byte in value.bytes() {
+        if byte.is_ascii_alphanumeric() || b"-_.~".contains(&byte) {
+            out.push(char::from(byte));
+        } else {
+            let _ = write!(out, "%{byte:02X}");
+        }
+    }
+    out
 }
 
 /// The run number in a log's file name (`RUN00003.WBL` is 3).
@@ -127,6 +147,25 @@ pub fn cards_in(dir: &Path) -> Result<Vec<Card>, CliError> {
         ));
     }
     Ok(cards)
+}
+
+/// Removes the temporary datasets `.NAME.XXXXXX.tmp` in `parent` that
+/// runs which are gone left behind (nobody holds their lock), with a note.
+fn remove_stale(parent: &Path, name: &str) {
+    let prefix = format!(".{name}.");
+    let Ok(entries) = std::fs::read_dir(parent) else {
+        return;
+    };
+    for entry in entries.flatten() {
+        let file_name = entry.file_name();
+        let random = file_name
+            .to_str()
+            .and_then(|n| n.strip_prefix(&prefix))
+            .and_then(|r| r.strip_suffix(".tmp"));
+        if random.is_some_and(|r| r.len() == 6 && !r.contains('.')) && entry.path().is_dir() {
+            crate::owner::clear_abandoned(&entry.path());
+        }
+    }
 }
 
 /// One run's row of `runs.parquet`.
@@ -374,7 +413,9 @@ pub fn build(
     strict: bool,
     progress: impl FnMut(&LogEntry, Outcome<'_>),
 ) -> Result<usize, CliError> {
-    if target.exists() {
+    // A symlink counts, dangling or not: the final rename would fail on
+    // it after all the work.
+    if std::fs::symlink_metadata(target).is_ok() {
         return Err(CliError::file(
             target,
             "exists already; a dataset is written whole into a new directory",
@@ -387,15 +428,23 @@ pub fn build(
     let name = target
         .file_name()
         .map_or_else(String::new, |n| n.to_string_lossy().into_owned());
-    // Removed if a signal ends the process before it is in place.
-    let temp = crate::interrupt::make_tracked(
+    remove_stale(parent, &name);
+    // Removed if a signal ends the process before it is in place; locked
+    // (the lock held until the end) so no other run takes it for a leftover.
+    let (temp, _lock) = crate::interrupt::make_tracked(
         || {
-            tempfile::Builder::new()
-                .prefix(&format!(".{name}."))
-                .suffix(".tmp")
-                .tempdir_in(parent)
+            crate::owner::make_held(
+                || {
+                    tempfile::Builder::new()
+                        .prefix(&format!(".{name}."))
+                        .suffix(".tmp")
+                        .rand_bytes(6)
+                        .tempdir_in(parent)
+                },
+                |dir| std::fs::File::open(dir.path()),
+            )
         },
-        tempfile::TempDir::path,
+        |(dir, _)| dir.path(),
     )
     .map_err(|e| CliError::file(target, format!("cannot create the dataset: {e}")))?;
     // A non-empty directory that appeared at `target` meanwhile makes the
@@ -410,4 +459,36 @@ pub fn build(
     // The directory moved; there is nothing left to clean up.
     let _ = temp.keep();
     Ok(skipped)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn partition_of(card: &str) -> PathBuf {
+        LogEntry {
+            card: Some(card.into()),
+            run: 3,
+            path: PathBuf::from("RUN00003.WBL"),
+        }
+        .partition()
+    }
+
+    #[test]
+    fn card_names_are_percent_encoded_in_partitions() {
+        for (card, folder) in [
+            ("anna", "card=anna"),
+            ("rider=anna", "card=rider%3Danna"),
+            ("a\nb", "card=a%0Ab"),
+            ("a%2Fb", "card=a%252Fb"),
+            ("a/b c", "card=a%2Fb%20c"),
+            ("Zoë", "card=Zo%C3%AB"),
+        ] {
+            assert_eq!(
+                partition_of(card),
+                Path::new("frames").join(folder).join("run=3"),
+                "{card:?}"
+            );
+        }
+    }
 }

@@ -56,11 +56,7 @@ fn watch() {
                 // Held to the end: nothing new is tracked meanwhile.
                 let live = live();
                 for path in live.iter() {
-                    let _ = if path.is_dir() {
-                        std::fs::remove_dir_all(path)
-                    } else {
-                        std::fs::remove_file(path)
-                    };
+                    remove(path);
                 }
                 let _ = signal_hook::low_level::emulate_default_handler(signal);
                 std::process::exit(128 + signal);
@@ -70,3 +66,26 @@ fn watch() {
 
 #[cfg(not(unix))]
 fn watch() {}
+
+/// Attempts at removing a temporary directory that a worker still adds to.
+const REMOVE_ATTEMPTS: usize = 20;
+
+/// Removes the temporary file or directory at `path`. A worker thread may
+/// still make a folder in a temporary directory while it goes (only new
+/// files wait for the lock the clean-up holds), which makes one removal
+/// fail with "directory not empty": it is tried again until it is gone.
+fn remove(path: &Path) {
+    for _ in 0..REMOVE_ATTEMPTS {
+        let result = if path.is_dir() {
+            std::fs::remove_dir_all(path)
+        } else {
+            std::fs::remove_file(path)
+        };
+        match result {
+            Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+                std::thread::sleep(std::time::Duration::from_millis(1));
+            }
+            _ => return,
+        }
+    }
+}

@@ -15,6 +15,7 @@ pub mod inputs;
 pub mod interrupt;
 pub mod losses;
 pub mod output;
+pub mod owner;
 pub mod plot;
 pub mod reader;
 pub mod resample;

@@ -27,9 +27,10 @@
 //!   (which a rename would split from it) is refused unless `--force`;
 //! - a directory is refused before any work is done.
 //!
-//! The temporary file is `.NAME.PID.XXXXXX.tmp`; one left by a run that
-//! was killed (its process gone) is removed, with a note, by the next run
-//! writing the same target. Messages name the target, never the
+//! The temporary file is `.NAME.PID.XXXXXX.tmp`, locked by its writer
+//! ([`crate::owner`]); one left by a run that was killed (nobody holds its
+//! lock) is removed, with a note, by the next run writing the same target,
+//! and one whose writer lives, in whatever PID namespace, is left alone. Messages name the target, never the
 //! temporary file.
 //!
 //! ```no_run
@@ -519,16 +520,15 @@ fn dir_of(target: &Path) -> &Path {
     }
 }
 
-/// Removes temporary files of `target` left by runs whose process is gone
-/// (killed before they could clean up), with a note for each; where
-/// processes cannot be looked up, only reports them.
+/// Removes temporary files of `target` left by runs that are gone (killed
+/// before they could clean up: nobody holds their lock), with a note for
+/// each.
 fn remove_stale(target: &Path) {
     let dir = dir_of(target);
     let prefix = format!(".{}.", temp_stem(target));
     let Ok(entries) = fs::read_dir(dir) else {
         return;
     };
-    let can_look = Path::new("/proc/self").exists();
     for entry in entries.flatten() {
         let name = entry.file_name();
         let name = name.to_string_lossy();
@@ -544,18 +544,7 @@ fn remove_stale(target: &Path) {
         if random.len() != 6 || pid.is_empty() || !pid.bytes().all(|b| b.is_ascii_digit()) {
             continue;
         }
-        let path = entry.path();
-        if !can_look {
-            eprintln!(
-                "wobblog: note: {} may be left by an interrupted run",
-                crate::text::shown(&path)
-            );
-        } else if !Path::new("/proc").join(pid).exists() && fs::remove_file(&path).is_ok() {
-            eprintln!(
-                "wobblog: note: removed {}, left by an interrupted run",
-                crate::text::shown(&path)
-            );
-        }
+        crate::owner::clear_abandoned(&entry.path());
     }
 }
 
@@ -572,9 +561,15 @@ fn temp_beside(target: &Path, existing: Option<&fs::Metadata>) -> io::Result<Nam
         use std::os::unix::fs::PermissionsExt;
         builder.permissions(fs::Permissions::from_mode(0o666));
     }
-    let temp = crate::interrupt::make_tracked(
-        || builder.tempfile_in(dir_of(target)),
-        NamedTempFile::path,
+    // Locked from the start: another run never takes it for a leftover.
+    let (temp, _) = crate::interrupt::make_tracked(
+        || {
+            crate::owner::make_held(
+                || builder.tempfile_in(dir_of(target)),
+                |t| t.as_file().try_clone(),
+            )
+        },
+        |(t, _)| t.path(),
     )?;
     if let Some(meta) = existing {
         temp.as_file().set_permissions(meta.permissions())?;

@@ -167,7 +167,7 @@ fn closing_the_output_pipe_early_is_not_an_error() {
     use std::process::Stdio;
     let dir = tempfile::tempdir().unwrap();
     let log = sample_log(dir.path());
-    let mut child = std::process::Command::new(assert_cmd::cargo::cargo_bin("wobblog"))
+    let mut child = std::process::Command::new(wobblog().get_program())
         .arg("decode")
         .arg(&log)
         .stdout(Stdio::piped())
@@ -191,7 +191,7 @@ fn info_to_a_closed_pipe_does_not_panic() {
     use std::process::Stdio;
     let dir = tempfile::tempdir().unwrap();
     let log = sample_log(dir.path());
-    let child = std::process::Command::new(assert_cmd::cargo::cargo_bin("wobblog"))
+    let child = std::process::Command::new(wobblog().get_program())
         .arg("info")
         .arg(&log)
         .stdout(Stdio::piped())
@@ -278,4 +278,24 @@ fn json_and_format_jsonl_are_one_convention() {
         .unwrap();
     assert!(json.status.success());
     assert_eq!(json.stdout, jsonl.stdout);
+}
+
+#[test]
+fn help_that_cannot_be_written_is_a_failure() {
+    let full = std::fs::OpenOptions::new()
+        .write(true)
+        .open("/dev/full")
+        .unwrap();
+    for args in [&["--help"][..], &["info", "--help"], &["--version"]] {
+        let out = std::process::Command::new(wobblog().get_program())
+            .args(args)
+            .stdout(full.try_clone().unwrap())
+            .output()
+            .unwrap();
+        assert_eq!(out.status.code(), Some(1), "{args:?}");
+        assert!(
+            String::from_utf8_lossy(&out.stderr).contains("No space left on device"),
+            "{args:?}"
+        );
+    }
 }

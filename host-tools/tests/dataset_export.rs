@@ -21,11 +21,22 @@ fn card(dir: &Path) -> Vec<usize> {
                 write_log(&path, &ride, &standard_log(&dir.join("tmp.wbl")).1);
                 std::fs::remove_file(dir.join("tmp.wbl")).unwrap();
                 ride.t_s.len()
+            } else if run == 3 {
+                other_log(&path)
             } else {
                 standard_log(&path).0.t_s.len()
             }
         })
         .collect()
+}
+
+/// A log as long as the standard one, with other bytes (a byte-identical
+/// copy would be one input), written to `path`; its number of frames.
+fn other_log(path: &Path) -> usize {
+    let (_, extras) = standard_log(path);
+    let ride = Ride::new(30.0, 5.0, 15.0, 2.0, 0.4);
+    write_log(path, &ride, &extras);
+    ride.t_s.len()
 }
 
 /// Runs `wobblog export DIR -o DS`.
@@ -160,8 +171,9 @@ fn a_folder_of_cards_is_partitioned_by_card_and_run() {
     let cards = dir.path().join("cards");
     for name in ["blue", "red"] {
         std::fs::create_dir_all(cards.join(name)).unwrap();
-        standard_log(&cards.join(name).join("RUN00001.WBL"));
     }
+    standard_log(&cards.join("blue/RUN00001.WBL"));
+    other_log(&cards.join("red/RUN00001.WBL"));
     let ds = dir.path().join("ds");
     wobblog()
         .arg("export")
@@ -258,4 +270,41 @@ fn the_dataset_appears_whole_or_not_at_all() {
         std::fs::read_to_string(ds.join("mine.txt")).unwrap(),
         "keep"
     );
+}
+
+#[test]
+fn a_dangling_link_at_the_target_is_refused_before_the_work() {
+    let dir = tempfile::tempdir().unwrap();
+    let card_dir = dir.path().join("card");
+    card(&card_dir);
+    let ds = dir.path().join("season");
+    std::os::unix::fs::symlink("nowhere", &ds).unwrap();
+    let out = export(&card_dir, &ds);
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("exists already"), "{err}");
+    // Refused at once: no log was read, so no run was written.
+    assert!(!err.contains("runs written"), "{err}");
+    assert!(std::fs::symlink_metadata(&ds).unwrap().is_symlink());
+}
+
+#[test]
+fn a_temporary_dataset_left_by_a_killed_run_is_removed_by_the_next() {
+    let dir = tempfile::tempdir().unwrap();
+    let card_dir = dir.path().join("card");
+    card(&card_dir);
+    let left = dir.path().join(".season.k1LLed.tmp");
+    std::fs::create_dir_all(left.join("frames/run=1")).unwrap();
+    std::fs::write(left.join("frames/run=1/part-0.parquet"), b"half").unwrap();
+    // One whose writer lives (its lock held) stays.
+    let live = dir.path().join(".season.al1ve0.tmp");
+    std::fs::create_dir(&live).unwrap();
+    let held = std::fs::File::open(&live).unwrap();
+    rustix::fs::flock(&held, rustix::fs::FlockOperation::LockExclusive).unwrap();
+    let out = export(&card_dir, &dir.path().join("season"));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert!(!left.exists(), "{err}");
+    assert!(err.contains("left by an interrupted run"), "{err}");
+    assert!(live.exists());
 }

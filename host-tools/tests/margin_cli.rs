@@ -335,3 +335,21 @@ fn a_log_named_twice_linked_or_copied_is_counted_once() {
     );
     assert!(stderr.contains("copied.WBL is a copy of"), "{stderr}");
 }
+
+#[test]
+fn no_figure_when_a_log_failed() {
+    let dir = campaign(&speeds(2.0, 3.4, 6));
+    std::fs::write(dir.path().join("RUN00099.WBL"), b"not a log").unwrap();
+    let png = dir.path().join("margin.png");
+    std::fs::write(&png, b"old figure").unwrap();
+    let out = wobblog()
+        .arg("margin")
+        .arg(dir.path())
+        .arg("--plot")
+        .arg(&png)
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("RUN00099.WBL"));
+    assert_eq!(std::fs::read(&png).unwrap(), b"old figure");
+}

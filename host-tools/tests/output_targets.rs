@@ -260,3 +260,23 @@ fn a_signal_removes_the_temporary_file_and_keeps_the_old_target() {
         assert_eq!(std::fs::read(&target).unwrap(), b"old log", "{signal}");
     }
 }
+
+#[test]
+fn a_temporary_file_whose_writer_lives_is_left_alone_whatever_its_pid() {
+    // A writer in another PID namespace (a container on a shared volume)
+    // has a PID this process cannot see: its lock, not its PID, says it
+    // lives. Once it is gone, the leftover is removed.
+    let dir = tempfile::tempdir().unwrap();
+    let log = sample(dir.path());
+    let temp = dir.path().join(".out.csv.999999999.abcdef.tmp");
+    let writer = std::fs::File::create(&temp).unwrap();
+    rustix::fs::flock(&writer, rustix::fs::FlockOperation::LockExclusive).unwrap();
+    let out = dir.path().join("out.csv");
+    assert!(decode_to(&log, &out, false).status.success());
+    assert!(temp.exists(), "a live writer's file was removed");
+    drop(writer);
+    let again = decode_to(&log, &out, false);
+    assert!(again.status.success());
+    assert!(!temp.exists());
+    assert!(String::from_utf8_lossy(&again.stderr).contains("left by an interrupted run"));
+}

@@ -17,7 +17,8 @@ Layout: one folder per table, each a dataset of its own:
   DATASET/runs/part-0.parquet           one row per run, as `wobblog summary`
   DATASET/episodes/part-0.parquet       one row per wobble episode, as
                                         `wobblog wobble`, censoring included
-Partition values are plain (run=1), so readers type them; every file
+Partition values are plain (run=1), so readers type them; a card's name
+is percent-encoded as Hive readers decode it (card=rider%3Danna); every file
 carries its columns' units as metadata (unit.NAME). Default options open it:
   polars.scan_parquet('DATASET/frames/')
   pyarrow.parquet.read_table('DATASET/frames')

@@ -253,7 +253,9 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         render_text(&report, logs.len())
     };
     let printed = print(stdout, &text);
-    if let Some(out) = plot_out {
+    // Drawn only when every log was read: a failed command leaves an old
+    // figure as it was.
+    if let (Some(out), Ok(())) = (plot_out, &result) {
         let figure = MarginPlot {
             kicks: report
                 .kicks
