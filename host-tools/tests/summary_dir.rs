@@ -119,10 +119,11 @@ fn hostile_log_names_are_escaped_in_the_table_and_csv_and_exact_in_json() {
         "b\u{9b}2J\u{202e}LBW.WBL",
         "c\nRUN09999.WBL  99.00.WBL",
     ];
-    for name in names {
+    // Three different rides (a byte-identical copy would be one input).
+    for (i, name) in names.iter().enumerate() {
         analysis_support::write_log(
             &dir.path().join(name),
-            &Ride::new(5.0, 3.0, 0.0, 0.0, 0.0),
+            &Ride::new(5.0 + i as f64, 3.0, 0.0, 0.0, 0.0),
             &Extras::default(),
         );
     }
