@@ -381,6 +381,30 @@ mod tests {
         assert_eq!(c.stats().samples, 3);
     }
 
+    /// A pulse latched at the very microsecond the FIFO read ended is the
+    /// pulse of the sample that read found waiting (the sensor writes its
+    /// sample before it pulses): paired, not placed by the period.
+    #[test]
+    fn a_pulse_exactly_at_the_reads_end_is_its_samples() {
+        let mut c = SampleClock::new();
+        c.data_ready(100_000);
+        c.sample(Some(raw(1)));
+        c.sample(Some(raw(2)));
+        let _ = c.frame(110_000, 110_020);
+        c.data_ready(110_020);
+        c.data_ready(120_020);
+        c.sample(Some(raw(3)));
+        let v = c.frame(120_000, 120_030);
+        assert_eq!(c.stats().untimed, 0);
+        assert_eq!(c.stats().samples, 3);
+        // 108 ms lies 8 of the 10.02 ms from the first sample to the second.
+        let want = 1.0 + 8_000.0 / 10_020.0;
+        assert!(
+            v.counts.is_some_and(|x| (x[0] - want).abs() < 1e-4),
+            "{v:?}"
+        );
+    }
+
     #[test]
     fn lost_pulses_samples_and_gaps_are_counted() {
         let mut c = SampleClock::new();

@@ -553,6 +553,42 @@ mod tests {
         assert!(mcap::MessageStream::new(&bad).unwrap().any(|m| m.is_err()));
     }
 
+    /// Messages out of time order in one chunk: its index says the latest
+    /// time, not the last message's; the length of its message indexes is
+    /// theirs alone (record headers of 9 bytes, a body of 6 bytes and 16
+    /// per message), not counted from the chunk's start.
+    #[test]
+    fn a_chunk_index_has_the_latest_time_and_its_message_indexes_length() {
+        let mut f = McapFile::with_chunk_bytes(Vec::new(), "test 1", 1 << 20).unwrap();
+        let s = f.add_schema("b", "jsonschema", b"{}").unwrap();
+        let a = f.add_channel(s, "/a", "json").unwrap();
+        let b = f.add_channel(s, "/b", "json").unwrap();
+        for (channel, t) in [(a, 1_000), (b, 1_009), (a, 1_005), (a, 1_002)] {
+            f.message(channel, 0, (t, t), b"{}").unwrap();
+        }
+        let bytes = f.finish().unwrap();
+        let all = records(&bytes);
+        let index_len: u64 = all
+            .iter()
+            .filter_map(|r| match r {
+                mcap::records::Record::MessageIndex(m) => Some(9 + 6 + 16 * m.records.len() as u64),
+                _ => None,
+            })
+            .sum();
+        assert_eq!(index_len, 2 * 15 + 4 * 16);
+        let chunk_indexes: Vec<_> = all
+            .iter()
+            .filter_map(|r| match r {
+                mcap::records::Record::ChunkIndex(c) => Some(c),
+                _ => None,
+            })
+            .collect();
+        assert_eq!(chunk_indexes.len(), 1);
+        let c = chunk_indexes[0];
+        assert_eq!((c.message_start_time, c.message_end_time), (1_000, 1_009));
+        assert_eq!(c.message_index_length, index_len);
+    }
+
     #[test]
     fn a_file_without_messages_is_still_whole() {
         let mut f = McapFile::new(Vec::new(), "test 1").unwrap();

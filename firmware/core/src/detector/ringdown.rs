@@ -574,4 +574,79 @@ mod tests {
         let k = ring(5.7, 0.1, 1.0, bins, 5.5).expect("a kick");
         assert!((k.sigma_per_s - 0.1).abs() < 0.05, "{k:?}");
     }
+
+    /// The fit's standard error is the weighted least squares one with
+    /// n - 2 degrees of freedom: worked here in f64 from the formula (the
+    /// line through (t, ln |y|) weighted by |y|^2), apart from the code.
+    #[test]
+    fn the_standard_error_has_n_minus_2_degrees_of_freedom() {
+        let t = [0.0_f64, 0.1, 0.2, 0.3, 0.4];
+        let l = [0.0_f64, -0.2, -0.55, -0.6, -0.95];
+        let seg: Vec<Segment> = t
+            .iter()
+            .zip(l)
+            .map(|(&t_s, l)| Segment {
+                t_s: t_s as f32,
+                re: (0.6 * l.exp()) as f32,
+                im: (0.8 * l.exp()) as f32,
+            })
+            .collect();
+        let w: Vec<f64> = l.iter().map(|l| (2.0 * l).exp()).collect();
+        let sw: f64 = w.iter().sum();
+        let tm = w.iter().zip(t).map(|(w, t)| w * t).sum::<f64>() / sw;
+        let lm = w.iter().zip(l).map(|(w, l)| w * l).sum::<f64>() / sw;
+        let stt: f64 = w.iter().zip(t).map(|(w, t)| w * (t - tm).powi(2)).sum();
+        let stl: f64 = (0..5).map(|k| w[k] * (t[k] - tm) * (l[k] - lm)).sum();
+        let sigma = stl / stt;
+        let ssr: f64 = (0..5)
+            .map(|k| w[k] * (l[k] - lm - sigma * (t[k] - tm)).powi(2))
+            .sum();
+        let se = (ssr / 3.0 / stt).sqrt();
+        let line = line_fit(&seg).expect("a line");
+        assert!(
+            (f64::from(line.sigma) - sigma).abs() < 1e-4,
+            "{}",
+            line.sigma
+        );
+        assert!(
+            (f64::from(line.sigma_se) - se).abs() < 1e-4 * se,
+            "{} against {se}",
+            line.sigma_se
+        );
+    }
+
+    /// A kick's record is stamped when it happened: `samples_ago` samples
+    /// at 100 Hz before the sample that reports it.
+    #[test]
+    fn a_record_is_stamped_at_the_kick() {
+        let kick = Kick {
+            samples_ago: 150,
+            speed_mps: Some(3.2),
+            freq_hz: 6.4,
+            sigma_per_s: -1.1,
+            sigma_se_per_s: 0.05,
+            amp_deg: 1.5,
+            segments: 9,
+        };
+        // 1.5 s before 10 s.
+        assert_eq!(kick.to_record(10_000_000, 100.0).t_us, 8_500_000);
+        assert_eq!(kick.to_record(10_000_000, 50.0).t_us, 7_000_000);
+    }
+
+    /// A ring whose wheel speed drops out part of the way has no speed:
+    /// the mean of the part that had one is not the ring's.
+    #[test]
+    fn a_ring_whose_speed_drops_out_has_no_speed() {
+        let mut r = RingDown::new(100.0, (5.8, 9.2), 4.0);
+        r.start(0, 7.0);
+        let mut kick = None;
+        for i in 0..400 {
+            let t = i as f32 / 100.0;
+            let y = 1.5 * libm::expf(-1.0 * t) * libm::sinf(core::f32::consts::TAU * 7.0 * t);
+            let speed = (t < 0.5).then_some(3.0);
+            kick = kick.or(r.sample(y, speed));
+        }
+        let k = kick.or_else(|| r.finish()).expect("a kick");
+        assert_eq!(k.speed_mps, None, "{k:?}");
+    }
 }
