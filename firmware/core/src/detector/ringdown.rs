@@ -642,7 +642,7 @@ mod tests {
         let mut kick = None;
         for i in 0..400 {
             let t = i as f32 / 100.0;
-            let y = 1.5 * libm::expf(-1.0 * t) * libm::sinf(core::f32::consts::TAU * 7.0 * t);
+            let y = 1.5 * libm::expf(-t) * libm::sinf(core::f32::consts::TAU * 7.0 * t);
             let speed = (t < 0.5).then_some(3.0);
             kick = kick.or(r.sample(y, speed));
         }
