@@ -70,6 +70,10 @@ pub fn read_log_until(
     let (mut file, len) = crate::spool::open_seekable(path)?;
     let io = |e| CliError::file(path, e);
     let scan = scan(&mut file, len).map_err(io)?;
+    let other_version = scan.skipped.iter().find_map(|&(_, _, cause)| match cause {
+        SkipCause::UnsupportedVersion(v) => Some(v),
+        _ => None,
+    });
     let stats = if scan.in_order {
         file.seek(SeekFrom::Start(0)).map_err(io)?;
         stream(&mut file, len, first_len, &mut visit).map_err(io)?
@@ -77,6 +81,16 @@ pub fn read_log_until(
         in_sequence_order(&mut file, scan, &mut visit).map_err(io)?
     };
     if stats.blocks == 0 {
+        if let Some(v) = other_version {
+            return Err(CliError::file(
+                path,
+                format!(
+                    "unsupported format version: its blocks are of format major version {v}, \
+                     this wobblog reads version {}",
+                    wobble_core::format::block::VERSION_MAJOR
+                ),
+            ));
+        }
         let what = if len == 0 {
             "empty file".to_string()
         } else {

@@ -299,3 +299,26 @@ fn help_that_cannot_be_written_is_a_failure() {
         );
     }
 }
+
+#[test]
+fn a_log_of_another_major_version_says_so() {
+    use wobble_core::format::BLOCK_LEN;
+    let dir = tempfile::tempdir().unwrap();
+    let mut bytes = std::fs::read(sample_log(dir.path())).unwrap();
+    // Every block as a version-2 writer would seal it: its CRC is right.
+    for block in bytes.chunks_mut(BLOCK_LEN) {
+        block[4] = 2;
+        let crc = crc32fast::hash(&block[..BLOCK_LEN - 4]);
+        block[BLOCK_LEN - 4..].copy_from_slice(&crc.to_le_bytes());
+    }
+    let log = dir.path().join("RUN00002.WBL");
+    std::fs::write(&log, bytes).unwrap();
+    let out = wobblog().arg("info").arg(&log).output().unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("RUN00002.WBL") && err.contains("unsupported format version"),
+        "{err}"
+    );
+    assert!(err.contains("major version 2"), "{err}");
+}

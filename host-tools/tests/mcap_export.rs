@@ -273,3 +273,21 @@ fn columns_choose_the_fields_and_channels_and_say_where_the_rest_go() {
     assert_eq!(topics, ["/events", "/sensors"]);
     assert_eq!(by_topic["/sensors"][0].cdr_f64(), [5.0]);
 }
+
+#[test]
+fn columns_that_no_message_carries_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let log = dir.path().join("RUN00001.WBL");
+    analysis_support::standard_log(&log);
+    let mcap = dir.path().join("e.mcap");
+    let out = wobblog()
+        .arg("decode")
+        .arg(&log)
+        .args(["--columns", "t_s,utc", "-o"])
+        .arg(&mcap)
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("none is a field of an MCAP message"));
+    assert!(!mcap.exists());
+}

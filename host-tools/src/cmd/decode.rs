@@ -100,7 +100,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
     };
     export.window.check_order(&args.log)?;
     if export.format == Format::Mcap && args.columns.is_some() {
-        say_mcap_homes(&export.columns);
+        say_mcap_homes(&export.columns)?;
     }
     let binary = matches!(export.format, Format::Parquet | Format::Mcap);
     if binary && args.output.is_none() && std::io::stdout().is_terminal() {
@@ -137,7 +137,21 @@ pub fn run(args: &Args) -> Result<(), CliError> {
 
 /// Says where each chosen column that is not a sensor field goes in MCAP,
 /// and which have no home there.
-fn say_mcap_homes(columns: &[Column]) {
+///
+/// # Errors
+/// No chosen column is a field of a message (`t_s,utc` alone): the file
+/// would hold no message.
+fn say_mcap_homes(columns: &[Column]) -> Result<(), CliError> {
+    let carried = |name: &str| {
+        SENSOR_OR_GPS.contains(&crate::export::mcap::home_of(name).unwrap_or_default())
+    };
+    if !columns.iter().any(|c| carried(c.name)) {
+        return Err(CliError::Usage(
+            "--columns: none is a field of an MCAP message (t_s and utc are every message's \
+             times); choose a sensor or GPS column too"
+                .into(),
+        ));
+    }
     for column in columns {
         match crate::export::mcap::home_of(column.name) {
             Some(crate::export::mcap::SENSORS_TOPIC) => {}
@@ -148,7 +162,14 @@ fn say_mcap_homes(columns: &[Column]) {
             ),
         }
     }
+    Ok(())
 }
+
+/// The homes of [`crate::export::mcap::home_of`] that are message fields.
+const SENSOR_OR_GPS: [&str; 2] = [
+    crate::export::mcap::SENSORS_TOPIC,
+    crate::export::mcap::GPS_HOME,
+];
 
 /// Decodes `log` into `out`; returns what could not be recovered.
 pub fn decode_to(

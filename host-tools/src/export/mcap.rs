@@ -55,6 +55,9 @@ const SENSORS_SCHEMA_NAME: &str = "wobblog_msgs/msg/Sensors";
 /// before the GPS (`ax_g` ... `speed_mps`).
 const SENSOR_FIELDS: &[&str] = super::CSV_COLUMNS.split_at(9).0.split_at(1).1;
 
+/// Where the GPS columns go in MCAP ([`home_of`]).
+pub const GPS_HOME: &str = "/gps (foxglove.LocationFix)";
+
 /// Where a chosen column goes in MCAP (`"/sensors"` for a sensor field), or
 /// `None` when it has no home there.
 #[must_use]
@@ -62,7 +65,7 @@ pub fn home_of(column: &str) -> Option<&'static str> {
     match column {
         "t_s" => Some("every message's publish time (ns since boot)"),
         "utc" => Some("every message's log time (ns since 1970, UTC)"),
-        "gps_lat_deg" | "gps_lon_deg" => Some("/gps (foxglove.LocationFix)"),
+        "gps_lat_deg" | "gps_lon_deg" => Some(GPS_HOME),
         _ if SENSOR_FIELDS.contains(&column) => Some(SENSORS_TOPIC),
         _ => None,
     }
