@@ -56,6 +56,7 @@ cargo clippy -p wobble-qemu-image --target "$TARGET" -- -D warnings
 
 # Property tests draw their cases from the fixed seed in .cargo/config.toml
 # (the environment's PROPTEST_RNG_SEED wins): every run of one tree runs the
-# same cases. Fresh seeds and more cases: hil-tests/proptest-fresh.sh.
+# same cases. Fresh seeds and more cases: hil-tests/proptest-fresh.sh
+# (host-tools/docs/robustness.md, "Property tests").
 step "tests (PROPTEST_RNG_SEED=${PROPTEST_RNG_SEED:-from .cargo/config.toml})"
 cargo test

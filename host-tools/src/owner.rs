@@ -1,4 +1,4 @@
-//! Temporary outputs owned by an advisory lock (`flock`): a writer holds
+//! Temporary outputs owned by an advisory lock (`flock` on Unix): a writer holds
 //! an exclusive lock on its temporary file (or `export`'s temporary
 //! directory) from the moment it exists until it is renamed or removed, and
 //! a later run removes a leftover only if it can take that lock itself. A
@@ -17,19 +17,10 @@ use std::path::Path;
 /// # Errors
 /// The file system does not lock files.
 pub fn hold(file: &File) -> io::Result<bool> {
-    #[cfg(unix)]
-    {
-        use rustix::fs::{flock, FlockOperation};
-        match flock(file, FlockOperation::NonBlockingLockExclusive) {
-            Ok(()) => Ok(true),
-            Err(e) if e == rustix::io::Errno::WOULDBLOCK => Ok(false),
-            Err(e) => Err(e.into()),
-        }
-    }
-    #[cfg(not(unix))]
-    {
-        let _ = file;
-        Ok(true)
+    match file.try_lock() {
+        Ok(()) => Ok(true),
+        Err(std::fs::TryLockError::WouldBlock) => Ok(false),
+        Err(std::fs::TryLockError::Error(e)) => Err(e),
     }
 }
 

@@ -300,7 +300,7 @@ fn a_temporary_dataset_left_by_a_killed_run_is_removed_by_the_next() {
     let live = dir.path().join(".season.al1ve0.tmp");
     std::fs::create_dir(&live).unwrap();
     let held = std::fs::File::open(&live).unwrap();
-    rustix::fs::flock(&held, rustix::fs::FlockOperation::LockExclusive).unwrap();
+    held.lock().unwrap();
     let out = export(&card_dir, &dir.path().join("season"));
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "{err}");

@@ -270,7 +270,7 @@ fn a_temporary_file_whose_writer_lives_is_left_alone_whatever_its_pid() {
     let log = sample(dir.path());
     let temp = dir.path().join(".out.csv.999999999.abcdef.tmp");
     let writer = std::fs::File::create(&temp).unwrap();
-    rustix::fs::flock(&writer, rustix::fs::FlockOperation::LockExclusive).unwrap();
+    writer.lock().unwrap();
     let out = dir.path().join("out.csv");
     assert!(decode_to(&log, &out, false).status.success());
     assert!(temp.exists(), "a live writer's file was removed");
