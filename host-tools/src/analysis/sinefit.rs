@@ -243,6 +243,54 @@ mod tests {
         (-2.0 * u1.ln()).sqrt() * (TAU * u2).cos()
     }
 
+    /// The standard error is `sqrt(cost / (N - n) [(J^T J)^-1]_kk)`: here
+    /// with the Jacobian by central differences of the model written out
+    /// again and inverted by nalgebra, apart from the code's analytic one
+    /// and its elimination. 24 samples, 4 parameters: 20 degrees of freedom.
+    #[test]
+    fn the_standard_error_has_samples_less_parameters_degrees_of_freedom() {
+        let t: Vec<f64> = (0..24).map(|i| f64::from(i) * 0.01).collect();
+        let x: Vec<f64> = t.iter().map(|&ts| (TAU * 7.0 * ts).sin()).collect();
+        let mut p = [0.0; MAX_PARAMS];
+        p[..4].copy_from_slice(&[1.1, 0.2, -1.3, TAU * 6.8]);
+        let f = |q: &[f64; 4], tau: f64| {
+            (q[2] * tau).exp() * (q[0] * (q[3] * tau).sin() + q[1] * (q[3] * tau).cos())
+        };
+        let q = [p[0], p[1], p[2], p[3]];
+        let mut jtj = nalgebra::Matrix4::<f64>::zeros();
+        for &tau in &t {
+            let mut row = [0.0; 4];
+            for (k, d) in row.iter_mut().enumerate() {
+                let (mut up, mut down) = (q, q);
+                up[k] += 1e-6;
+                down[k] -= 1e-6;
+                *d = (f(&up, tau) - f(&down, tau)) / 2e-6;
+            }
+            let j = nalgebra::Vector4::from(row);
+            jtj += j * j.transpose();
+        }
+        let inverse = jtj.try_inverse().unwrap();
+        let cost = 0.37;
+        for k in 0..4 {
+            let want = (cost / 20.0 * inverse[(k, k)]).sqrt();
+            let got = standard_error(&t, &x, 0.0, &p, 4, cost, k);
+            assert!((got - want).abs() < 1e-5 * want, "{k}: {got} against {want}");
+        }
+    }
+
+    /// Residuals that alternate in sign are anti-correlated: the sum of
+    /// their autocorrelations is below 1, and so would the factor be; it
+    /// never narrows an interval below the white-noise one.
+    #[test]
+    fn the_colour_factor_is_never_below_one() {
+        let t: Vec<f64> = (0..64).map(|i| f64::from(i) * 0.01).collect();
+        let x: Vec<f64> = (0..64).map(|i| if i % 2 == 0 { 0.1 } else { -0.1 }).collect();
+        // No mode (a = b = 0) and omega 0: the residuals are `x`, every
+        // lag's cosine 1.
+        let p = [0.0; MAX_PARAMS];
+        assert_eq!(colour_factor(&t, &x, 0.0, &p, 4), 1.0);
+    }
+
     /// The standard error of sigma is the spread of sigma over repeated
     /// noisy realisations of the same ring-down (Monte Carlo, 200 draws):
     /// within 20 % of it.
