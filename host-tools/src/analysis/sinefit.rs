@@ -274,7 +274,10 @@ mod tests {
         for k in 0..4 {
             let want = (cost / 20.0 * inverse[(k, k)]).sqrt();
             let got = standard_error(&t, &x, 0.0, &p, 4, cost, k);
-            assert!((got - want).abs() < 1e-5 * want, "{k}: {got} against {want}");
+            assert!(
+                (got - want).abs() < 1e-5 * want,
+                "{k}: {got} against {want}"
+            );
         }
     }
 
@@ -284,7 +287,9 @@ mod tests {
     #[test]
     fn the_colour_factor_is_never_below_one() {
         let t: Vec<f64> = (0..64).map(|i| f64::from(i) * 0.01).collect();
-        let x: Vec<f64> = (0..64).map(|i| if i % 2 == 0 { 0.1 } else { -0.1 }).collect();
+        let x: Vec<f64> = (0..64)
+            .map(|i| if i % 2 == 0 { 0.1 } else { -0.1 })
+            .collect();
         // No mode (a = b = 0) and omega 0: the residuals are `x`, every
         // lag's cosine 1.
         let p = [0.0; MAX_PARAMS];
