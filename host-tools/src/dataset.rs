@@ -149,6 +149,22 @@ pub fn cards_in(dir: &Path) -> Result<Vec<Card>, CliError> {
     Ok(cards)
 }
 
+/// `err` with a file of the temporary dataset `temp` named as it would be
+/// in `target` (`DATASET/frames/run=1/part-0.parquet: No space left on
+/// device`): the temporary name means nothing to the user and is gone.
+fn named_in(err: CliError, temp: &Path, target: &Path) -> CliError {
+    match err {
+        CliError::File { path, message } => match path.strip_prefix(temp) {
+            Ok(inside) => CliError::File {
+                path: target.join(inside),
+                message,
+            },
+            Err(_) => CliError::File { path, message },
+        },
+        other => other,
+    }
+}
+
 /// Removes the temporary datasets `.NAME.XXXXXX.tmp` in `parent` that
 /// runs which are gone left behind (nobody holds their lock), with a note.
 fn remove_stale(parent: &Path, name: &str) {
@@ -449,11 +465,15 @@ pub fn build(
     .map_err(|e| CliError::file(target, format!("cannot create the dataset: {e}")))?;
     // A non-empty directory that appeared at `target` meanwhile makes the
     // rename fail rather than be replaced.
-    let result = write_dataset(entries, temp.path(), strict, progress).and_then(|skipped| {
-        std::fs::rename(temp.path(), target)
-            .map(|()| skipped)
-            .map_err(|e| CliError::file(target, format!("cannot move the dataset in place: {e}")))
-    });
+    let result = write_dataset(entries, temp.path(), strict, progress)
+        .map_err(|e| named_in(e, temp.path(), target))
+        .and_then(|skipped| {
+            std::fs::rename(temp.path(), target)
+                .map(|()| skipped)
+                .map_err(|e| {
+                    CliError::file(target, format!("cannot move the dataset in place: {e}"))
+                })
+        });
     crate::interrupt::untrack(temp.path());
     let skipped = result?;
     // The directory moved; there is nothing left to clean up.
@@ -472,6 +492,26 @@ mod tests {
             path: PathBuf::from("RUN00003.WBL"),
         }
         .partition()
+    }
+
+    #[test]
+    fn a_write_error_names_the_file_in_the_dataset_not_the_temporary_one() {
+        let temp = Path::new("cards/.season.a1b2c3.tmp");
+        let err = CliError::file(
+            &temp.join("frames/run=1/part-0.parquet"),
+            "No space left on device",
+        );
+        let named = named_in(err, temp, Path::new("season"));
+        assert_eq!(
+            named.to_string(),
+            "season/frames/run=1/part-0.parquet: No space left on device"
+        );
+        // A log's own error stays the log's.
+        let log = CliError::file(Path::new("cards/RUN00001.WBL"), "bad");
+        assert_eq!(
+            named_in(log, temp, Path::new("season")).to_string(),
+            "cards/RUN00001.WBL: bad"
+        );
     }
 
     #[test]
