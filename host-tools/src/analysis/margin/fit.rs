@@ -228,7 +228,7 @@ pub(super) fn paule_mandel(
         } else {
             hi = mid;
         }
-        if hi - lo <= 1e-12 + 1e-9 * hi {
+        if hi - lo <= 1e-12 + 1e-7 * hi {
             break;
         }
     }

@@ -249,8 +249,9 @@ fn search_cap(lo: f64, hi: f64) -> f64 {
 
 /// The line's fit with the bend's curvature following the prediction:
 /// fitted with half of `k` taken out, `k` from the prior at the fit's zero
-/// and damping at half of it, until `k` settles (or the trend has no zero:
-/// the last `k`). The fit and `c = k/2`.
+/// and damping at half of it, until `k` settles (secant steps on `c`, the
+/// first a plain one; or the trend has no zero: the last `k` that gave
+/// one). The fit and `c = k/2`.
 fn bent_line(
     (u, y, sd): (&[f64], &[f64], &[f64]),
     prior: BendPrior,
@@ -261,22 +262,42 @@ fn bent_line(
         let unbent: Vec<f64> = u.iter().zip(y).map(|(u, y)| y - c * u * u).collect();
         robust_fit(u, &unbent, sd, 2)
     };
-    let mut c = 0.0;
-    let mut fit = fit_at(c)?;
-    for _ in 0..BEND_ROUNDS {
+    // What the prior asks of `c` given the fit made with `c`.
+    let wanted = |fit: &fit::RobustFit, c: f64| {
         let coef = [fit.coef[0], fit.coef[1], c];
-        let Some(zero) = upward_zero(&coef, lo, cap) else {
+        let zero = upward_zero(&coef, lo, cap)?;
+        Some(0.5 * prior.curvature(zero, -value(&coef, 0.5 * zero)).0)
+    };
+    let mut best = (fit_at(0.0)?, 0.0);
+    let mut last: Option<(f64, f64)> = None;
+    for _ in 0..BEND_ROUNDS {
+        let c = best.1;
+        let Some(next) = wanted(&best.0, c) else {
             break;
         };
-        let damping = -value(&coef, 0.5 * zero);
-        let next = 0.5 * prior.curvature(zero, damping).0;
-        if (next - c).abs() <= 1e-9 {
+        let r = next - c;
+        if r.abs() <= 1e-7 * next.abs().max(1e-3) {
             break;
         }
-        c = next;
-        fit = fit_at(c)?;
+        let step = match last {
+            Some((c0, r0)) if (r - r0).abs() > 1e-15 => {
+                let s = c - r * (c - c0) / (r - r0);
+                if s.is_finite() {
+                    s
+                } else {
+                    next
+                }
+            }
+            _ => next,
+        };
+        last = Some((c, r));
+        let fit = fit_at(step)?;
+        if wanted(&fit, step).is_none() {
+            break;
+        }
+        best = (fit, step);
     }
-    Some((fit, c))
+    Some(best)
 }
 
 /// Predicts the wobble speed from `kicks` by fitting `trend`, a line
