@@ -12,7 +12,7 @@ use super::{Margin, MIN_SPAN_MPS};
 /// lower bound lay more than 5 % above the truth in 1.2 % of the
 /// campaigns and more than 10 % in 0.4 % (1.9 % of the convex class, a
 /// shape beyond the prior's mean), so a limit 10 % below the lower bound
-/// stays below the wobble speed in 99.7 % of them (98.6 % of the convex
+/// stays below the wobble speed in 99.7 % of them (98.7 % of the convex
 /// class).
 pub const RIDE_MARGIN: f64 = 0.10;
 
