@@ -300,3 +300,26 @@ fn resample_still_refuses_what_cannot_be_a_log() {
         assert_refuses(dir.path(), &["encode", "--resample"], text, expected);
     }
 }
+
+#[test]
+fn a_time_jump_the_encoder_cannot_hold_names_its_line() {
+    // 1e13 s is inside what a log's times may be, but no block can hold a
+    // step of more than 2^63 us from its time base.
+    let dir = tempfile::tempdir().unwrap();
+    let csv = dir.path().join("jump.csv");
+    std::fs::write(
+        &csv,
+        "t_s,steer_deg\n0,1\n0.01,1\n0.02,1\n10000000000000,1\n",
+    )
+    .unwrap();
+    let out = wobblog()
+        .args(["encode", "--csv"])
+        .arg(&csv)
+        .arg("-o")
+        .arg(dir.path().join("jump.WBL"))
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("jump.csv: line 5: "), "{err}");
+}

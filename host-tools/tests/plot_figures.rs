@@ -440,3 +440,23 @@ fn example_images() {
     assert!(std::fs::metadata(&fig6).unwrap().len() > 20_000);
     assert!(std::fs::metadata(&fig8).unwrap().len() > 20_000);
 }
+
+#[test]
+fn a_log_of_one_frame_is_plotted() {
+    let dir = tempfile::tempdir().unwrap();
+    let csv = dir.path().join("one.csv");
+    std::fs::write(&csv, "t_s,steer_deg\n0,1\n").unwrap();
+    let log = dir.path().join("one.WBL");
+    stdout_of(
+        wobblog()
+            .args(["encode", "--csv"])
+            .arg(&csv)
+            .arg("-o")
+            .arg(&log),
+    );
+    for name in ["one.png", "one.svg"] {
+        let out = dir.path().join(name);
+        stdout_of(wobblog().arg("plot").arg(&log).arg("-o").arg(&out));
+        assert!(std::fs::metadata(&out).unwrap().len() > 1000, "{name}");
+    }
+}

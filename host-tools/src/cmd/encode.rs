@@ -337,7 +337,7 @@ impl<W: Write> LogWriter<'_, W> {
         let block = self
             .encoder
             .push(record)
-            .map_err(|e| CliError::file(self.in_name, e))?;
+            .map_err(|e| CliError::file(self.in_name, format!("line {}: {e}", self.line)))?;
         write_block(&mut self.output, self.out_name, block)
     }
 

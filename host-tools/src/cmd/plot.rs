@@ -72,6 +72,11 @@ pub fn run(args: &Args) -> Result<(), CliError> {
     };
     let name = log_name(&args.log);
     let fs_hz = summary.frame_rate_hz();
+    // A single frame spans its own period: a run of one frame is plotted.
+    let data_s = match data_s {
+        (a, b) if b <= a && fs_hz > 0.0 => (a, a + 1.0 / fs_hz),
+        span => span,
+    };
     let mut builder =
         TimePlotBuilder::new(&name, &summary, data_s, fs_hz, window_s).ok_or_else(no_frames)?;
     read_rows(&args.log, |_| {}, |row| builder.push_row(row))?;
