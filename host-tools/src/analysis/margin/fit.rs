@@ -217,7 +217,7 @@ pub(super) fn paule_mandel(
     while excess(hi)? > 0.0 {
         lo = hi;
         hi *= 4.0;
-        if hi > 1e6 {
+        if hi > 1e12 {
             return None;
         }
     }

@@ -550,6 +550,27 @@ fn unusable_kicks_are_rejected() {
     assert_eq!(few.kicks_rejected, 6);
 }
 
+/// Kicks scattered by 1500 1/s (a between-kick variance of millions):
+/// the fit still runs, carries every kick, and finds no significant rise
+/// rather than calling the speeds too close together.
+#[test]
+fn a_huge_scatter_is_a_huge_between_kick_variance() {
+    let pts: Vec<(f64, f64)> = (0..10)
+        .map(|i| {
+            let u = 2.0 + 0.2 * f64::from(i);
+            (
+                u,
+                1.5 * (u - 4.2) + if i % 2 == 0 { 1500.0 } else { -1500.0 },
+            )
+        })
+        .collect();
+    let m = predict(&kicks(&pts, 0.05));
+    assert_eq!(m.kicks_used, 10, "{m:?}");
+    assert!(m.between_kick_sd_per_s.unwrap() > 1000.0, "{m:?}");
+    assert!(m.warnings.iter().all(|w| !w.contains("spread")), "{m:?}");
+    assert_eq!(m.wobble_speed_mps, None, "{m:?}");
+}
+
 /// The median of odd and even counts, in any order.
 #[test]
 fn the_median_of_odd_and_even_counts() {
