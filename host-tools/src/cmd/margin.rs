@@ -47,9 +47,9 @@ pub struct Args {
     /// `card` (only the card's records) or `host` (only the host's).
     #[arg(long, value_enum, default_value_t = Prefer::Best)]
     pub kicks: Prefer,
-    /// The trend of sigma against speed: `line` (a line bent as sigma bends
-    /// on the model's bicycles, its interval allowing for a different bend
-    /// beyond the kicks) or `quadratic`
+    /// The trend of sigma against speed: `line` (a line bent by a shape
+    /// relative to the wobble speed, its interval allowing for a different
+    /// bend beyond the kicks) or `quadratic`
     /// (fitted to the kicks alone: worse on the simulated campaigns).
     #[arg(long, value_enum, default_value_t = Trend::Line)]
     pub trend: Trend,
