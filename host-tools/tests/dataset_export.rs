@@ -308,3 +308,35 @@ fn a_temporary_dataset_left_by_a_killed_run_is_removed_by_the_next() {
     assert!(err.contains("left by an interrupted run"), "{err}");
     assert!(live.exists());
 }
+
+#[test]
+fn a_signal_at_any_moment_leaves_no_temporary_dataset() {
+    // The signal's clean-up once raced the worker's folders: an early
+    // SIGINT left `.season.XXXXXX.tmp/` in about half the runs.
+    let dir = tempfile::tempdir().unwrap();
+    let card_dir = dir.path().join("card");
+    card(&card_dir);
+    for delay_ms in [0, 1, 2, 3, 5, 8, 12, 20, 30, 50] {
+        let ds = dir.path().join("season");
+        let _ = std::fs::remove_dir_all(&ds);
+        let mut child = std::process::Command::new(wobblog().get_program())
+            .arg("export")
+            .arg(&card_dir)
+            .arg("-o")
+            .arg(&ds)
+            .stderr(std::process::Stdio::null())
+            .spawn()
+            .unwrap();
+        std::thread::sleep(std::time::Duration::from_millis(delay_ms));
+        let _ = std::process::Command::new("kill")
+            .args(["-s", "INT", &child.id().to_string()])
+            .status();
+        let _ = child.wait();
+        let left: Vec<String> = std::fs::read_dir(dir.path())
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .filter(|n| n.starts_with(".season."))
+            .collect();
+        assert!(left.is_empty(), "after {delay_ms} ms: {left:?}");
+    }
+}
