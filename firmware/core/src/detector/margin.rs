@@ -26,7 +26,9 @@
 //!   for a convex bend as the host's is ([`BEND_SHAPE_SD_CONVEX`]): the
 //!   *lower bound* is what the warning uses;
 //! - no estimate from fewer than [`MIN_KICKS`] kicks carrying weight, a
-//!   speed range narrower than [`MIN_SPAN_MPS`], or a slope that is not
+//!   speed range narrower than [`MIN_SPAN_MPS`] (or, for a low fastest
+//!   kick, [`MIN_SPAN_SHARE`] of the range above [`SLOWEST_KICK_MPS`], never
+//!   under [`MIN_SPAN_FLOOR_MPS`]), or a slope that is not
 //!   positive; the upper end is left open when the rise of sigma is not
 //!   significant or the zero lies further beyond the fastest kick than the
 //!   range measured.
@@ -53,6 +55,17 @@ pub const MAX_KICKS: usize = 24;
 pub const MIN_KICKS: usize = 6;
 /// Narrowest range of the kicks' speeds an estimate is made from, m/s.
 pub const MIN_SPAN_MPS: f32 = 0.75;
+/// ... or, when less, this share of the range between the slowest speed a
+/// kick is measured at ([`SLOWEST_KICK_MPS`]) and the fastest kick: a
+/// bicycle wobbling at 2.2 m/s is kicked at 1.5-1.9 m/s at most, and is
+/// estimated from a range that spans most of that.
+pub const MIN_SPAN_SHARE: f32 = 0.8;
+/// The slowest speed the detector measures a kick at, m/s (its default
+/// `min_speed_mps`).
+pub const SLOWEST_KICK_MPS: f32 = 1.5;
+/// Never narrower than this, m/s: twice the error a speed drifting during
+/// a ring-down puts on a kick's speed (0.15 m/s on the stress campaigns).
+pub const MIN_SPAN_FLOOR_MPS: f32 = 0.3;
 /// Tukey's bisquare constant (95 % efficiency for Gaussian scatter).
 const BISQUARE_C: f32 = 4.685;
 /// The SD of sigma's bend shape towards convex bends that the lower bound
@@ -472,8 +485,10 @@ fn estimate(points: &[Point]) -> Option<WobbleSpeed> {
         }
     }
     let span = hi_u - lo_u;
-    if used < MIN_KICKS || span.is_nan() || span < MIN_SPAN_MPS || line.b.is_nan() || line.b <= 0.0
-    {
+    let min_span = MIN_SPAN_MPS
+        .min(MIN_SPAN_SHARE * (hi_u - SLOWEST_KICK_MPS))
+        .max(MIN_SPAN_FLOOR_MPS);
+    if used < MIN_KICKS || span.is_nan() || span < min_span || line.b.is_nan() || line.b <= 0.0 {
         return None;
     }
     let dof = used - 2;
@@ -807,6 +822,35 @@ mod tests {
             (f64::from(got.upper_mps.unwrap()) - hi).abs() < 5e-3,
             "{got:?} {hi}"
         );
+    }
+
+    /// A bicycle wobbling at 2.2 m/s: eight kicks from 1.5 m/s (the
+    /// slowest the detector measures) to 1.885 m/s (0.86 of it), a range of
+    /// 0.385 m/s: under 0.75 m/s, but over 0.8 of the 0.385 m/s above 1.5:
+    /// an estimate, its interval holding the zero. The same range at
+    /// 3.0-3.385 m/s gives none; and the constant is the detector's.
+    #[test]
+    fn a_low_wobble_speed_is_estimated_from_a_narrow_range() {
+        assert_eq!(
+            SLOWEST_KICK_MPS,
+            crate::detector::DetectorConfig::default().min_speed_mps
+        );
+        let at = |from: f32| -> std::vec::Vec<(f32, f32)> {
+            (0..8)
+                .map(|i| {
+                    let u = from + 0.055 * i as f32;
+                    let off = if i % 2 == 1 { 0.02 } else { -0.02 };
+                    (u, 1.2 * (u - 2.2 - (from - 1.5)) + off)
+                })
+                .collect()
+        };
+        let e = warning_after(&at(1.5), 0.01).estimate().unwrap();
+        assert!((e.estimate_mps.unwrap() - 2.2).abs() < 0.05, "{e:?}");
+        assert!(
+            e.lower_mps < 2.2 && e.upper_mps.is_some_and(|h| h > 2.2),
+            "{e:?}"
+        );
+        assert_eq!(warning_after(&at(3.0), 0.01).estimate(), None);
     }
 
     /// Kicks at 1.5-2.3 m/s of a line crossing at 4.5 m/s: the zero lies
