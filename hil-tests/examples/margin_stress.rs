@@ -10,7 +10,7 @@
 //! ```
 //! `BEND=MEAN:SD_CONVEX:SD_CONCAVE` sets the line's bend prior (the shape
 //! `beta` of `wobblog::analysis::margin::bend`). The figures in `host-tools/docs/kick-testing.md` are from seeds 1000000
-//! on (2000 campaigns per class); the defaults were chosen on seeds 0-999.
+//! on (2000 campaigns per class); the defaults were chosen on seeds 0-399.
 
 use wobble_hil::margin_stress::{board_outcomes, host_outcomes, Recipe, Shape, Tally};
 use wobblog::analysis::margin::BendPrior;

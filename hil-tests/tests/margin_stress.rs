@@ -1,7 +1,7 @@
 //! The margin prediction on a small, seeded sample of the stress
 //! campaigns (`wobble_hil::margin_stress`; the full tables come from
 //! `cargo run -p wobble-hil --release --example margin_stress`). Seeds
-//! 5000 on: neither those the defaults were chosen on (0-999) nor those
+//! 5000 on: neither those the defaults were chosen on (0-399) nor those
 //! of the published figures (1000000 on).
 
 use wobble_hil::margin_stress::{campaign, host_outcomes, Recipe, Shape, Tally};
