@@ -459,4 +459,8 @@ fn a_log_of_one_frame_is_plotted() {
         stdout_of(wobblog().arg("plot").arg(&log).arg("-o").arg(&out));
         assert!(std::fs::metadata(&out).unwrap().len() > 1000, "{name}");
     }
+    // The frame's value in each panel, as a dot (a line of one point
+    // would draw nothing).
+    let svg = std::fs::read_to_string(dir.path().join("one.svg")).unwrap();
+    assert_eq!(svg.matches("<circle").count(), PANELS.len(), "{svg:.300}");
 }

@@ -404,12 +404,15 @@ impl Figure for TimePlot {
                 });
             }
             for points in series {
-                chart
-                    .draw_series(LineSeries::new(
-                        points.iter().map(|&(t, v)| (self.x(t), v)),
-                        LINE_COLOUR,
-                    ))
-                    .map_err(err)?;
+                let line =
+                    LineSeries::new(points.iter().map(|&(t, v)| (self.x(t), v)), LINE_COLOUR);
+                // A stretch of one sample has no line to draw: a dot shows it.
+                let line = if points.len() == 1 {
+                    line.point_size(2)
+                } else {
+                    line
+                };
+                chart.draw_series(line).map_err(err)?;
             }
             let keyed = !(self.alerts_s.is_empty()
                 && self.lost_s.is_empty()
