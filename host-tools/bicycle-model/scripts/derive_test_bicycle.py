@@ -119,7 +119,8 @@ def write(path, name, rider_kg, c):
     # Devices on the rear rack: a 0.3 x 0.2 x 0.15 m box above the rear axle.
     devices = (DEVICES_KG, -0.05, -0.45, DEVICES_KG * (0.2**2 + 0.15**2) / 12, 0.0,
                DEVICES_KG * (0.3**2 + 0.15**2) / 12, DEVICES_KG * (0.3**2 + 0.2**2) / 12)
-    rear = combine(combine(scale(BROWSER_B, k_bike), scale(legs, k_rider)), devices)
+    frame = combine(scale(BROWSER_B, k_bike), devices)
+    rear = combine(frame, scale(legs, k_rider))
     # The front frame split at the steering head: the fork below it as a
     # rod from the crown to the axle.
     lam = math.radians(90.0 - HEAD_ANGLE_DEG)
@@ -145,7 +146,11 @@ def write(path, name, rider_kg, c):
     ]
     lines += wheel_lines("rear_wheel", BROWSER_R, k_bike, f"{MOORE}: Browser rear wheel (28 in), mass scaled to the 14.5 kg bicycle")
     lines += wheel_lines("front_wheel", BROWSER_F, k_bike, f"{MOORE}: Browser front wheel (28 in), mass scaled to the 14.5 kg bicycle")
-    lines += body_lines("rear_frame", rear, f"{MOORE}: Browser frame scaled to 14.5 kg, rider's legs (Jason) scaled to {rider_kg:g} kg, 3.5 kg devices on the rack (seed Table 1)")
+    if c.legs_apart:
+        lines += body_lines("rear_frame", frame, f"{MOORE}: Browser frame scaled to 14.5 kg, 3.5 kg devices on the rack (seed Table 1)")
+        lines += body_lines("rider_legs", scale(legs, k_rider), f"{MOORE}: Jason's legs (his body on the Browser less the upper body) scaled to a {rider_kg:g} kg rider")
+    else:
+        lines += body_lines("rear_frame", rear, f"{MOORE}: Browser frame scaled to 14.5 kg, rider's legs (Jason) scaled to {rider_kg:g} kg, 3.5 kg devices on the rack (seed Table 1)")
     lines += body_lines("torso", scale(torso, k_rider), f"{MOORE}: Jason's upper body (head, arms, trunk) scaled to a {rider_kg:g} kg rider")
     lines += ["[hip]",
               f"z = {q(hip_z, 'm', 'saddle height of the Browser with Jason (estimated)')}",
@@ -206,6 +211,7 @@ CORPUS = Choices(
     head_damping=V(2.0, "tuned with the stiffness"),
     front_tyre=FIRST_TYRE,
     rear_tyre=FIRST_TYRE,
+    legs_apart=False,
 )
 
 # The paper's test bicycle, re-derived.
@@ -242,9 +248,11 @@ PAPER = Choices(
     head_damping=V(2.0, "tuned with the stiffness"),
     front_tyre=PAPER_TYRE,
     rear_tyre=PAPER_TYRE,
+    legs_apart=True,
 )
 
 if __name__ == "__main__":
     write("params/test-bicycle.toml", "Seed paper's test bicycle, 83 kg rider", RIDER_KG, CORPUS)
-    write("params/paper-test-bicycle.toml", "Seed paper's test bicycle, 83 kg rider", RIDER_KG, PAPER)
-    write("params/paper-test-bicycle-light-rider.toml", "Seed paper's test bicycle, 55 kg rider", 55.0, PAPER)
+    # The start of the identification (examples/identify.rs), which writes
+    # params/paper-test-bicycle.toml and its light-rider file from it.
+    write("identify/paper-test-bicycle-start.toml", "Seed paper's test bicycle, 83 kg rider (start of the identification)", RIDER_KG, PAPER)

@@ -14,6 +14,7 @@ pub mod multibody;
 mod naming;
 pub mod neutral;
 pub mod no_slip;
+pub mod paper;
 pub mod params;
 pub mod simulate;
 pub mod sweep;

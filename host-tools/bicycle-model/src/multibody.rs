@@ -11,7 +11,7 @@
 //! | rear | roll `phi` (x axis at the ground), pitch (rear axle, dependent) | main frame, rider's lower body, rear wheel |
 //! | torso | rear + hip `phi_r` (x axis at hip height) | rider's upper torso |
 //! | front upper | rear + steer `delta` (steer axis) | handlebar, fork crown |
-//! | front sub | front upper + twist `beta` (axis at the steering head, perpendicular to the steer axis) | fork blades, front wheel |
+//! | front sub | front upper + twist `beta` (axis through the steer axis at the steering head, in the plane of symmetry; perpendicular to the steer axis unless turned) | fork blades, front wheel |
 //!
 //! Generalised speeds `w = (v, r, dphi, dphi_r, ddelta, dbeta)`,
 //! coordinates `q = (phi, phi_r, delta, beta)`. The linear equations are
@@ -89,6 +89,12 @@ pub struct Geometry {
     pub hip_z: f64,
     /// z where the twist axis crosses the steer axis, m.
     pub twist_z: f64,
+    /// The twist axis's angle from the normal to the steer axis, in the
+    /// plane of symmetry, rad: 0 is perpendicular to the steer axis
+    /// (forward and up), `-steer_axis_tilt` horizontal (a roll of the front
+    /// assembly about a longitudinal axis), positive turns it towards the
+    /// vertical.
+    pub twist_axis_angle: f64,
     /// Gravity, m/s^2.
     pub gravity: f64,
 }
@@ -171,7 +177,10 @@ impl Chains {
                     coord: Some(DELTA),
                 },
                 Joint {
-                    axis: Vector3::new(cl, 0.0, -sl),
+                    axis: {
+                        let (s, c) = (geo.steer_axis_tilt + geo.twist_axis_angle).sin_cos();
+                        Vector3::new(c, 0.0, -s)
+                    },
                     point: twist_point,
                     coord: Some(BETA),
                 },

@@ -51,9 +51,12 @@ pub struct WobbleParams {
     pub rear_wheel: Wheel,
     /// Front wheel.
     pub front_wheel: Wheel,
-    /// Main frame with the rider's lower body and what the rack carries.
+    /// Main frame with the rider's lower body and what the rack carries
+    /// (a file's `[rider_legs]`, when it has one, lumped into its
+    /// `[rear_frame]`: the legs held rigid with the frame).
     pub rear_frame: Body,
-    /// Rider's upper torso (with head and arms).
+    /// Rider's upper torso (with head and arms), and the legs when a file
+    /// seats them on the hinge (`[seated_legs]`).
     pub torso: Body,
     /// Height coordinate of the hip hinge, m.
     pub hip_z: f64,
@@ -67,6 +70,9 @@ pub struct WobbleParams {
     pub fork: Body,
     /// Height coordinate where the twist axis crosses the steer axis, m.
     pub twist_z: f64,
+    /// The twist axis's angle from the normal to the steer axis, rad
+    /// (`steer_head.axis_angle`, default 0: perpendicular to the steer axis).
+    pub twist_axis_angle: f64,
     /// Steering-head twist stiffness, N m/rad.
     pub head_stiffness: f64,
     /// Steering-head twist damping, N m s/rad.
@@ -154,14 +160,26 @@ impl WobbleParams {
             gravity: base.gravity,
             rear_wheel: base.rear_wheel,
             front_wheel: base.front_wheel,
-            rear_frame: base.rear_frame,
+            rear_frame: match set.quantity("rider_legs.mass") {
+                Some(_) => lump(&base.rear_frame, &Body::from_set(set, "rider_legs")?),
+                None => base.rear_frame,
+            },
             front_frame: base.front_frame,
-            torso: Body::from_set(set, "torso")?,
+            // `[seated_legs]`: the legs on the hinge with the upper body,
+            // the whole rider rolling on the saddle.
+            torso: match set.quantity("seated_legs.mass") {
+                Some(_) => lump(
+                    &Body::from_set(set, "torso")?,
+                    &Body::from_set(set, "seated_legs")?,
+                ),
+                None => Body::from_set(set, "torso")?,
+            },
             hip_z: get("hip.z", Unit::Length)?,
             hip_stiffness: get("hip.stiffness", Unit::TorsionalStiffness)?,
             hip_damping: get("hip.damping", Unit::TorsionalDamping)?,
             fork: Body::from_set(set, "fork")?,
             twist_z: get("steer_head.z", Unit::Length)?,
+            twist_axis_angle: set.get_or("steer_head.axis_angle", Unit::Angle, 0.0)?,
             head_stiffness: get("steer_head.stiffness", Unit::TorsionalStiffness)?,
             head_damping: get("steer_head.damping", Unit::TorsionalDamping)?,
             steer_damping: set.get_or("steer.damping", Unit::TorsionalDamping, 0.0)?,
@@ -228,6 +246,7 @@ impl WobbleParams {
             front_radius: self.front_wheel.radius,
             hip_z: self.hip_z,
             twist_z: self.twist_z,
+            twist_axis_angle: self.twist_axis_angle,
             gravity: self.gravity,
         };
         let bodies = vec![

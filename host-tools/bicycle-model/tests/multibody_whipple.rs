@@ -37,6 +37,7 @@ fn benchmark_bodies_reduce_to_the_closed_forms() {
         front_radius: b.front_wheel.radius,
         hip_z: -0.8,
         twist_z: -0.7,
+        twist_axis_angle: 0.0,
         gravity: b.gravity,
     };
     let bodies = [

@@ -85,6 +85,7 @@ fn state_matrix_with_hip(u: f64, k9: f64, c9: f64) -> DMatrix<f64> {
         front_radius: RF,
         hip_z: HIP_Z,
         twist_z: -0.7,
+        twist_axis_angle: 0.0,
         gravity: 9.81,
     };
     let [m, c1, k0g, k2] =

@@ -1,5 +1,6 @@
 //! The second torso-carrying pair of a tense rider's bicycle (near 16 Hz on
-//! the seed paper's test bicycle) is the `sway`, not a second `lean`: the
+//! the seed paper's test bicycle as first re-derived, the files these
+//! figures were measured on) is the `sway`, not a second `lean`: the
 //! main frame rolling and sliding sideways on the rear tyre's lateral
 //! compliance, the upper body rolling against it on the hip. Its name is
 //! checked here against what its eigenvectors and its parameters say,
@@ -38,8 +39,8 @@ fn sway_at_5(sweep: &Sweep) -> Complex<f64> {
 #[test]
 fn each_wobble_bicycle_has_one_sway_pair_at_13_to_18_hz() {
     for file in [
-        "paper-test-bicycle.toml",
-        "paper-test-bicycle-light-rider.toml",
+        "paper-test-bicycle-unidentified.toml",
+        "paper-test-bicycle-unidentified-light-rider.toml",
         "test-bicycle.toml",
     ] {
         let (_, sweep) = sweep(&bundled(file));
@@ -56,7 +57,7 @@ fn each_wobble_bicycle_has_one_sway_pair_at_13_to_18_hz() {
         }
     }
     // The tensed rider's lean is the 5-7 Hz pair, not the sway.
-    let (_, sweep) = sweep(&bundled("paper-test-bicycle.toml"));
+    let (_, sweep) = sweep(&bundled("paper-test-bicycle-unidentified.toml"));
     for v in &sweep.upper(Mode::Lean).unwrap().values {
         assert!((5.0..7.0).contains(&hz(*v)), "lean {v}");
     }
@@ -68,7 +69,7 @@ fn each_wobble_bicycle_has_one_sway_pair_at_13_to_18_hz() {
 /// is opposite to the frame's roll (the frame rolls under a held torso).
 #[test]
 fn the_sway_is_the_frame_rolling_on_the_rear_tyre_under_the_torso() {
-    let (model, sweep) = sweep(&bundled("paper-test-bicycle.toml"));
+    let (model, sweep) = sweep(&bundled("paper-test-bicycle-unidentified.toml"));
     let value = sway_at_5(&sweep);
     let x = eigenvector(&model.state_matrix(5.0), value);
     let names = model.state_names();
@@ -92,9 +93,11 @@ fn the_sway_is_the_frame_rolling_on_the_rear_tyre_under_the_torso() {
 /// than 2 %.
 #[test]
 fn the_sway_frequency_follows_the_rear_tyre() {
-    let base = hz(sway_at_5(&sweep(&bundled("paper-test-bicycle.toml")).1));
+    let base = hz(sway_at_5(
+        &sweep(&bundled("paper-test-bicycle-unidentified.toml")).1,
+    ));
     let doubled = |key: &str| {
-        let mut set = bundled("paper-test-bicycle.toml");
+        let mut set = bundled("paper-test-bicycle-unidentified.toml");
         let v = set.value(key).unwrap();
         set.set_value(key, 2.0 * v, "doubled for a test").unwrap();
         hz(sway_at_5(&sweep(&set).1))

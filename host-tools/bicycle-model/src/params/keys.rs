@@ -16,6 +16,7 @@ const BODY: &[&str] = &[
     "inertia_zz",
 ];
 const SPRING: &[&str] = &["z", "stiffness", "damping"];
+const HEAD: &[&str] = &["z", "stiffness", "damping", "axis_angle"];
 const STEER: &[&str] = &["damping"];
 const TYRE: &[&str] = &[
     "cornering_stiffness",
@@ -40,9 +41,11 @@ pub fn sections(model: ModelKind) -> Vec<(&'static str, &'static [&'static str])
     if model == ModelKind::Wobble {
         s.extend([
             ("torso", BODY),
+            ("rider_legs", BODY),
+            ("seated_legs", BODY),
             ("fork", BODY),
             ("hip", SPRING),
-            ("steer_head", SPRING),
+            ("steer_head", HEAD),
             ("steer", STEER),
             ("front_tyre", TYRE),
             ("rear_tyre", TYRE),

@@ -257,6 +257,14 @@ impl ParamSet {
         self.values.insert(key.to_owned(), quantity);
     }
 
+    /// Removes every parameter of `section`, returning how many there were.
+    pub fn remove_section(&mut self, section: &str) -> usize {
+        let prefix = format!("{section}.");
+        let before = self.values.len();
+        self.values.retain(|k, _| !k.starts_with(&prefix));
+        before - self.values.len()
+    }
+
     /// The value of an existing parameter as a plain number in its file
     /// unit, or [`Problem::Unknown`].
     pub fn value(&self, key: &str) -> Result<f64, ParamError> {

@@ -5,6 +5,7 @@
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
+use wobble_model::paper::variation;
 use wobble_model::{critical_speeds, Mode, Model, ParamSet};
 
 use super::eig::describe;
@@ -20,7 +21,8 @@ use crate::CliError;
 pub struct Args {
     /// Parameter file (TOML or BicycleParameters `*Benchmark.txt`).
     pub params: PathBuf,
-    /// The parameter to vary, as named in the file (`section.key`).
+    /// The parameter to vary, as named in the file (`section.key`), or
+    /// `rider.mass` for the rider's whole mass (the file needs `[rider_legs]`).
     #[arg(long, value_name = "KEY")]
     pub param: String,
     /// Factors to scale it by, comma-separated.
@@ -34,13 +36,10 @@ pub struct Args {
     pub output: Option<PathBuf>,
 }
 
-/// One variant of the parameter set.
+/// One variant of the parameter set: a parameter of the file scaled, or
+/// the rider's whole mass (`rider.mass`, the seed paper's Figure 9).
 pub fn variant(set: &ParamSet, key: &str, factor: f64) -> Result<ParamSet, CliError> {
-    let mut v = set.clone();
-    let value = v.value(key).map_err(|e| param_error(&e))?;
-    v.set_value(key, value * factor, &format!("{factor} x the file's value"))
-        .map_err(|e| param_error(&e))?;
-    Ok(v)
+    variation::scaled_key(set, key, factor).map_err(|e| param_error(&e))
 }
 
 /// Runs `wobblog model sweep`.
@@ -95,7 +94,11 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         let figure = EigenFigure {
             title: format!("{}: {} x {:?}", set.name, args.param, args.factors),
             layers,
-            modes: vec![Mode::Wobble, Mode::Weave],
+            modes: if args.param.starts_with("hip.") {
+                vec![Mode::Wobble, Mode::Weave, Mode::Lean]
+            } else {
+                vec![Mode::Wobble, Mode::Weave]
+            },
             measured: Vec::new(),
         };
         render(&figure, out)?;
@@ -104,6 +107,10 @@ pub fn run(args: &Args) -> Result<(), CliError> {
 }
 
 fn value_text(set: &ParamSet, key: &str, factor: f64) -> String {
+    if key == variation::RIDER_MASS {
+        return variation::rider_mass_kg(set)
+            .map_or_else(|_| String::new(), |m| format!("{} kg", m * factor));
+    }
     set.quantity(key)
         .map_or_else(String::new, |q| format!("{} {}", q.value * factor, q.unit))
 }
