@@ -287,46 +287,30 @@ fn tyre_effect(s: &mut Study, mode: Mode) -> Result<(f64, f64), StudyError> {
     ))
 }
 
-fn tyres_destabilise_wobble(s: &mut Study) -> Result<Verdict, StudyError> {
-    let (least, _) = tyre_effect(s, Mode::Wobble)?;
-    let (t, n) = (s.bicycle()?.wobble_speed(), s.no_slip()?.wobble_speed());
-    Ok(verdict(
-        least > -INVISIBLE_PER_S,
-        format!(
-            "real part higher by at least {least:.2} 1/s at 1-14 m/s; wobble speed {} (no slip: {})",
-            mps(t),
-            mps(n)
-        ),
-    ))
-}
-
-fn tyres_destabilise_weave(s: &mut Study) -> Result<Verdict, StudyError> {
-    let (least, _) = tyre_effect(s, Mode::Weave)?;
+/// Figure 4's verdict on `mode`: the tyre model destabilises it (its real
+/// part not lower than without slip) or stabilises it, at every speed;
+/// `critical` names the mode's critical speed in the figures.
+fn tyres_move_mode(
+    s: &mut Study,
+    mode: Mode,
+    destabilise: bool,
+    critical: (bool, &str),
+) -> Result<Verdict, StudyError> {
+    let (least, largest) = tyre_effect(s, mode)?;
+    let (unstable_above, words) = critical;
     let (t, n) = (
-        s.bicycle()?.speed(Mode::Weave, false),
-        s.no_slip()?.speed(Mode::Weave, false),
+        s.bicycle()?.speed(mode, unstable_above),
+        s.no_slip()?.speed(mode, unstable_above),
     );
+    let (agrees, by, way) = if destabilise {
+        (least > -INVISIBLE_PER_S, least, "higher")
+    } else {
+        (largest < INVISIBLE_PER_S, -largest, "lower")
+    };
     Ok(verdict(
-        least > -INVISIBLE_PER_S,
+        agrees,
         format!(
-            "real part higher by at least {least:.2} 1/s at 1-14 m/s; weave stable from {} (no slip: {})",
-            mps(t),
-            mps(n)
-        ),
-    ))
-}
-
-fn tyres_stabilise_capsize(s: &mut Study) -> Result<Verdict, StudyError> {
-    let (_, largest) = tyre_effect(s, Mode::Capsize)?;
-    let (t, n) = (
-        s.bicycle()?.speed(Mode::Capsize, true),
-        s.no_slip()?.speed(Mode::Capsize, true),
-    );
-    Ok(verdict(
-        largest < INVISIBLE_PER_S,
-        format!(
-            "real part lower by at least {:.2} 1/s at 1-14 m/s; capsize unstable from {} (no slip: {})",
-            -largest,
+            "real part {way} by at least {by:.2} 1/s at 1-14 m/s; {words} {} (no slip: {})",
             mps(t),
             mps(n)
         ),
@@ -719,15 +703,15 @@ claims! {
     "2a", "2, Fig. 4", Direction,
     "against non-holonomic contacts the tyre model destabilises the wobble",
     "real part of the wobble with tyres not lower (by more than 0.05 1/s) at any speed of 1-14 m/s",
-    tyres_destabilise_wobble;
+    |s| tyres_move_mode(s, Mode::Wobble, true, (true, "wobble speed"));
     "2b", "2, Fig. 4", Direction,
     "and the weave",
     "real part of the weave with tyres not lower (by more than 0.05 1/s) at any speed of 1-14 m/s",
-    tyres_destabilise_weave;
+    |s| tyres_move_mode(s, Mode::Weave, true, (false, "weave stable from"));
     "2c", "2, Fig. 4", Direction,
     "and stabilises the capsize, at all speeds",
     "real part of the capsize with tyres not higher (by more than 0.05 1/s) at any speed of 1-14 m/s",
-    tyres_stabilise_capsize;
+    |s| tyres_move_mode(s, Mode::Capsize, false, (true, "capsize unstable from"));
     "2d", "2, Fig. 4", Measured,
     "the wobble frequency lies between 6 and 9 Hz",
     "within 5.9-9.1 Hz at 3-14 m/s",
