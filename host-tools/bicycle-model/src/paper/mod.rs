@@ -345,12 +345,17 @@ fn front_cornering_destabilises(s: &mut Study) -> Result<Verdict, StudyError> {
     ))
 }
 
-fn front_cornering_raises_frequency(s: &mut Study) -> Result<Verdict, StudyError> {
-    let (_, hz) = halved_doubled(s, FRONT_C)?;
-    let up =
-        (0..3).all(|i| hz[2][i] - hz[1][i] > DIRECTION_HZ && hz[1][i] - hz[0][i] > DIRECTION_HZ);
+/// The frequency at 4, 8 and 12 m/s of `keys` x0.5, x1 and x2: whether
+/// each doubling step `d` (x0.5 to x1, x1 to x2) passes `rises(d)`.
+fn frequency_steps(
+    s: &mut Study,
+    keys: &[&str],
+    rises: fn(f64) -> bool,
+) -> Result<Verdict, StudyError> {
+    let (_, hz) = halved_doubled(s, keys)?;
+    let ok = (0..3).all(|i| rises(hz[1][i] - hz[0][i]) && rises(hz[2][i] - hz[1][i]));
     Ok(verdict(
-        up,
+        ok,
         format!(
             "at 4 / 8 / 12 m/s: {} (x0.5), {} (x1), {} (x2)",
             hz3(hz[0]),
@@ -594,21 +599,6 @@ fn load_lowers_frequency(
     ))
 }
 
-fn head_stiffness_sets_frequency(s: &mut Study) -> Result<Verdict, StudyError> {
-    let (_, hz) = halved_doubled(s, HEAD_K)?;
-    let ok = (0..3)
-        .all(|i| hz[1][i] - hz[0][i] >= CONSIDERABLE_HZ && hz[2][i] - hz[1][i] >= CONSIDERABLE_HZ);
-    Ok(verdict(
-        ok,
-        format!(
-            "at 4 / 8 / 12 m/s: {} (x0.5), {} (x1), {} (x2)",
-            hz3(hz[0]),
-            hz3(hz[1]),
-            hz3(hz[2])
-        ),
-    ))
-}
-
 fn head_stiffness_spares_weave_capsize(s: &mut Study) -> Result<Verdict, StudyError> {
     let w = weave_speeds(s, HEAD_K)?;
     let c = [
@@ -739,7 +729,7 @@ claims! {
     "4.1b", "4.1, Fig. 7", Direction,
     "and raises its frequency",
     "front cornering stiffness x0.5 / x2: frequency down / up at 4, 8, 12 m/s",
-    front_cornering_raises_frequency;
+    |s| frequency_steps(s, FRONT_C, |d| d > DIRECTION_HZ);
     "4.1c", "4.1", Direction,
     "the front cornering stiffness is the tyre parameter that affects the wobble most",
     "x0.5 and x2: its largest wobble speed change exceeds those of the rear cornering stiffness, the camber stiffnesses, each relaxation length",
@@ -823,7 +813,7 @@ claims! {
     "4.4a", "4.4, Fig. 11", Direction,
     "the steering head's stiffness changes the wobble frequency considerably",
     "head stiffness x0.5 / x2: frequency down / up by 0.5 Hz or more at 4, 8, 12 m/s",
-    head_stiffness_sets_frequency;
+    |s| frequency_steps(s, HEAD_K, |d| d >= CONSIDERABLE_HZ);
     "4.4b", "4.4, Fig. 11", Direction,
     "but the weave and the capsize only marginally",
     "head stiffness x0.5 / x2: the weave's and the capsize's critical speeds within 0.5 m/s",
