@@ -287,6 +287,7 @@ fn episodes_columns() -> Vec<Column<EpisodesRow>> {
         number!(EpisodesRow, "peak_s", r => Some(r.episode.peak_s)),
         number!(EpisodesRow, "freq_hz", r => Some(r.episode.freq_hz)),
         number!(EpisodesRow, "sigma_per_s", r => Some(r.episode.sigma_per_s)),
+        number!(EpisodesRow, "sigma_sd_per_s", r => r.episode.sigma_sd_per_s),
         number!(EpisodesRow, "peak_amp_deg", r => Some(r.episode.peak_amp_deg)),
         number!(EpisodesRow, "speed_at_onset_mps", r => Some(r.episode.speed_at_onset_mps)),
         Column {
@@ -298,6 +299,11 @@ fn episodes_columns() -> Vec<Column<EpisodesRow>> {
                     Stability::Unstable => "unstable",
                 }))
             },
+        },
+        Column {
+            name: "source",
+            kind: Kind::Label,
+            value: |r| Value::Label(Some(r.episode.source.as_str())),
         },
         Column {
             name: "censored",

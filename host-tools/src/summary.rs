@@ -279,6 +279,12 @@ impl SummaryBuilder {
         self.summary.frame_rate_hz()
     }
 
+    /// The config lines the log has given so far (its header's).
+    #[must_use]
+    pub fn config(&self) -> &[String] {
+        &self.summary.config
+    }
+
     fn period_us(&self) -> u64 {
         1_000_000 / u64::from(self.summary.sample_rate_hz.unwrap_or(100).max(1))
     }

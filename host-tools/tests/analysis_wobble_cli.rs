@@ -51,7 +51,7 @@ fn known_wobble_is_measured() {
         text.contains("peak_amp_deg  speed_at_onset_mps  stability"),
         "{text}"
     );
-    assert!(text.trim_end().ends_with("unstable"), "{text}");
+    assert!(text.trim_end().ends_with("unstable   episode"), "{text}");
 }
 
 #[test]

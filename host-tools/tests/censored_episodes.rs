@@ -190,9 +190,11 @@ fn a_log_cut_short_reports_the_episode_censored_in_json_table_and_summary() {
     assert_eq!(e["cut_at_end"], "data_end");
     assert_eq!(e["cut_at_start"], Value::Null);
     let table = stdout_of(wobblog().arg("wobble").arg(&log));
-    assert!(table.contains("stability  censored"), "{table}");
+    assert!(table.contains("stability  source     censored"), "{table}");
     assert!(
-        table.trim_end().ends_with("unstable   end: data_end"),
+        table
+            .trim_end()
+            .ends_with("unstable   episode    end: data_end"),
         "{table}"
     );
 

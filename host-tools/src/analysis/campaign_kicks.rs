@@ -158,11 +158,10 @@ impl CampaignKick {
         }
     }
 
-    /// A card record alone; without a recorded speed the run's mean wheel
-    /// speed over the 2 s after the kick stands in. `None` when neither
-    /// gives a speed.
-    fn from_card(card: CardKick, run: &Run) -> Option<Self> {
-        let speed = card.speed_mps.or_else(|| mean_speed(run, card.t_s, 2.0))?;
+    /// A card record alone; without a recorded speed `speed_after` of
+    /// its time stands in. `None` when neither gives a speed.
+    fn from_card(card: CardKick, speed_after: impl Fn(f64) -> Option<f64>) -> Option<Self> {
+        let speed = card.speed_mps.or_else(|| speed_after(card.t_s))?;
         Some(Self {
             source: Source::Card,
             t_s: card.t_s,
@@ -189,20 +188,35 @@ fn mean_speed(run: &Run, from: f64, span: f64) -> Option<f64> {
     (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64)
 }
 
-/// The kicks of `run` (in time order), taken as `prefer` says.
+/// The kicks of `run` (in time order), taken as `prefer` says. A card
+/// record without a speed takes the run's mean wheel speed over the 2 s
+/// after it.
 #[must_use]
 pub fn campaign_kicks(run: &Run, wheel_circumference_m: f64, prefer: Prefer) -> Vec<CampaignKick> {
-    let cards: Vec<CardKick> = run
-        .summary
-        .kick_records
-        .iter()
-        .map(CardKick::from)
-        .collect();
     let host = if prefer == Prefer::Card {
         Vec::new()
     } else {
         find_kicks(run, wheel_circumference_m)
     };
+    combine(host, &run.summary.kick_records, prefer, |t| {
+        mean_speed(run, t, 2.0)
+    })
+}
+
+/// The kicks of a log (in time order) from the host's measurements `host`
+/// (from [`find_kicks`] or a [`super::kicks::KickSearch`]) and the card's
+/// `records`, taken as `prefer` says: where both saw a kick (within
+/// [`MATCH_S`]), the host's values with the card's record beside them. A
+/// card record without a speed takes `speed_after` of its time, and is
+/// left out when that gives none.
+#[must_use]
+pub fn combine(
+    host: Vec<Kick>,
+    records: &[KickRingDown],
+    prefer: Prefer,
+    speed_after: impl Fn(f64) -> Option<f64>,
+) -> Vec<CampaignKick> {
+    let cards: Vec<CardKick> = records.iter().map(CardKick::from).collect();
     let mut out: Vec<CampaignKick> = match prefer {
         Prefer::Host => host
             .into_iter()
@@ -210,7 +224,7 @@ pub fn campaign_kicks(run: &Run, wheel_circumference_m: f64, prefer: Prefer) -> 
             .collect(),
         Prefer::Card => cards
             .into_iter()
-            .filter_map(|c| CampaignKick::from_card(c, run))
+            .filter_map(|c| CampaignKick::from_card(c, &speed_after))
             .collect(),
         Prefer::Best => {
             let mut taken = vec![false; cards.len()];
@@ -236,7 +250,7 @@ pub fn campaign_kicks(run: &Run, wheel_circumference_m: f64, prefer: Prefer) -> 
                     .into_iter()
                     .zip(taken)
                     .filter(|(_, t)| !t)
-                    .filter_map(|(c, _)| CampaignKick::from_card(c, run)),
+                    .filter_map(|(c, _)| CampaignKick::from_card(c, &speed_after)),
             );
             out
         }

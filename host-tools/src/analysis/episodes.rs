@@ -37,6 +37,7 @@ use std::ops::Range;
 
 use serde::Serialize;
 
+use super::campaign_kicks::Source;
 use super::censor::{Cut, Edge};
 use super::filter::{wobble_band, wobble_band_causal, Biquad, Pass};
 use super::run::Run;
@@ -109,6 +110,37 @@ pub enum Stability {
     Unstable,
 }
 
+/// Where an episode's frequency and growth rate come from; written as its
+/// name ([`Measured::as_str`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Measured {
+    /// The episode's own fit (below): an unstable episode, or a stable one
+    /// that is no kick `wobblog margin` uses.
+    Episode,
+    /// A stable episode that is a kick: the kick's values as `wobblog
+    /// margin` takes them (see [`super::kick_episodes`]), measured as this
+    /// says (`host`, `card-host` or `card`).
+    Kick(Source),
+}
+
+impl Measured {
+    /// The name JSON and the tables use: `episode`, or the kick's source
+    /// (`host`, `card-host`, `card`) as `wobblog margin` names it.
+    #[must_use]
+    pub const fn as_str(self) -> &'static str {
+        match self {
+            Self::Episode => "episode",
+            Self::Kick(source) => source.as_str(),
+        }
+    }
+}
+
+impl Serialize for Measured {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        serializer.serialize_str(self.as_str())
+    }
+}
+
 /// One wobble episode.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Episode {
@@ -123,6 +155,11 @@ pub struct Episode {
     /// Real part of the mode: growth (> 0) or decay (< 0) rate of the
     /// envelope, 1/s.
     pub sigma_per_s: f64,
+    /// Standard uncertainty of `sigma_per_s`, 1/s: the kick's where the
+    /// episode is a kick (see `source`); `None` for the episode's own fit.
+    pub sigma_sd_per_s: Option<f64>,
+    /// Where `freq_hz`, `sigma_per_s` and `sigma_sd_per_s` come from.
+    pub source: Measured,
     /// Largest envelope (zero to peak), degrees.
     pub peak_amp_deg: f64,
     /// Wheel speed at onset, m/s.
@@ -433,6 +470,8 @@ impl<'a> Span<'a> {
             peak_s: t[top],
             freq_hz,
             sigma_per_s: mode.sigma_per_s,
+            sigma_sd_per_s: None,
+            source: Measured::Episode,
             peak_amp_deg,
             speed_at_onset_mps: speed_around(&self.frames, onset_s, SPEED_HALF_WIDTH_S),
             stability,

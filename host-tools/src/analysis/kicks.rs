@@ -54,7 +54,7 @@ use std::f64::consts::TAU;
 
 use serde::Serialize;
 
-use super::filter::{contiguous_spans, wobble_band};
+use super::filter::{follows, wobble_band};
 use super::run::Run;
 use super::sinefit::fit_mode;
 
@@ -139,26 +139,124 @@ pub struct Kick {
     pub residual_rel: f64,
 }
 
-/// Every kick of `run`, in time order. Each evenly sampled stretch between
-/// gaps is searched alone, so no fit reaches across a gap.
+/// Frames a stretch is searched in at most: a longer one (between gaps) is
+/// searched in pieces of this many frames, each overlapping the one before
+/// by [`PIECE_OVERLAP_S`], so that the search holds no more than this
+/// however long the log (43.7 min at 100 Hz).
+pub const PIECE_FRAMES: usize = super::search::MAX_WINDOW_FRAMES;
+/// Consecutive pieces of a stretch share this much, s: more than a kick's
+/// rise, skip and longest fit ([`MAX_RISE_S`] + [`SKIP_AFTER_PEAK_S`] +
+/// [`MAX_FIT_S`]) and the band-pass's settling at the piece's end. A piece
+/// gives the kicks rising before its shared end; the next one, those
+/// rising after. Each piece has its own background.
+pub const PIECE_OVERLAP_S: f64 = 10.0;
+
+/// Every kick of `run`, in time order: the frames go through a
+/// [`KickSearch`], as when a command streams a log.
 #[must_use]
 pub fn find_kicks(run: &Run, wheel_circumference_m: f64) -> Vec<Kick> {
-    let fs = run.sample_rate_hz();
-    if fs.is_nan() || fs <= 0.0 {
-        return Vec::new();
+    let mut search = KickSearch::new(run.sample_rate_hz(), wheel_circumference_m);
+    for i in 0..run.len() {
+        search.push(run.t_s[i], run.steer_deg[i], run.speed_mps[i]);
     }
-    contiguous_spans(&run.t_s, 1.0 / fs)
-        .into_iter()
-        .flat_map(|span| {
-            let stretch = Stretch {
-                t_s: &run.t_s[span.clone()],
-                steer_deg: &run.steer_deg[span.clone()],
-                speed_mps: &run.speed_mps[span],
-                fs,
-            };
-            stretch.kicks(wheel_circumference_m)
-        })
-        .collect()
+    search.finish()
+}
+
+/// The kicks of a stream of frames, in memory that does not grow with the
+/// run: each evenly sampled stretch between gaps is searched alone (no fit
+/// reaches across a gap), in pieces of at most [`PIECE_FRAMES`].
+pub struct KickSearch {
+    fs: f64,
+    circumference_m: f64,
+    piece: usize,
+    overlap: usize,
+    t_s: Vec<f64>,
+    steer_deg: Vec<f64>,
+    speed_mps: Vec<f64>,
+    kicks: Vec<Kick>,
+}
+
+impl KickSearch {
+    /// A search over frames nominally `fs_hz` apart, on a wheel of
+    /// `wheel_circumference_m` (its harmonics are fitted beside a ring).
+    #[must_use]
+    pub fn new(fs_hz: f64, wheel_circumference_m: f64) -> Self {
+        Self::with_piece(fs_hz, wheel_circumference_m, PIECE_FRAMES)
+    }
+
+    /// A search in pieces of `piece` frames (at least twice the overlap;
+    /// tests use short pieces).
+    #[must_use]
+    pub fn with_piece(fs_hz: f64, wheel_circumference_m: f64, piece: usize) -> Self {
+        let overlap = if fs_hz.is_finite() && fs_hz > 0.0 {
+            (PIECE_OVERLAP_S * fs_hz).ceil() as usize
+        } else {
+            0
+        };
+        Self {
+            fs: fs_hz,
+            circumference_m: wheel_circumference_m,
+            piece: piece.max(2 * overlap).max(1),
+            overlap,
+            t_s: Vec::new(),
+            steer_deg: Vec::new(),
+            speed_mps: Vec::new(),
+            kicks: Vec::new(),
+        }
+    }
+
+    /// Takes the next frame in file order: time, steering angle, speed.
+    pub fn push(&mut self, t_s: f64, steer_deg: f64, speed_mps: f64) {
+        if !(self.fs.is_finite() && self.fs > 0.0) {
+            return;
+        }
+        if let Some(&last) = self.t_s.last() {
+            if !follows(last, t_s, 1.0 / self.fs) {
+                self.search(None);
+                self.clear(self.t_s.len());
+            }
+        }
+        self.t_s.push(t_s);
+        self.steer_deg.push(steer_deg);
+        self.speed_mps.push(speed_mps);
+        if self.t_s.len() >= self.piece {
+            let shared = self.t_s.len() - self.overlap;
+            self.search(Some(shared));
+            self.clear(shared);
+        }
+    }
+
+    /// Every kick, in time order.
+    #[must_use]
+    pub fn finish(mut self) -> Vec<Kick> {
+        self.search(None);
+        self.kicks
+    }
+
+    /// Searches the frames held, keeping the kicks that rise before frame
+    /// `until` (all of them without it).
+    fn search(&mut self, until: Option<usize>) {
+        let stretch = Stretch {
+            t_s: &self.t_s,
+            steer_deg: &self.steer_deg,
+            speed_mps: &self.speed_mps,
+            fs: self.fs,
+        };
+        let until_s = until.map_or(f64::INFINITY, |i| self.t_s[i]);
+        self.kicks.extend(
+            stretch
+                .kicks(self.circumference_m)
+                .into_iter()
+                .filter(|k| k.t_s < until_s),
+        );
+    }
+
+    /// Forgets the first `n` frames held.
+    fn clear(&mut self, n: usize) {
+        self.t_s.drain(..n);
+        self.steer_deg.drain(..n);
+        self.speed_mps.drain(..n);
+    }
 }
 
 /// One evenly sampled stretch.

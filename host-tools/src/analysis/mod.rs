@@ -5,6 +5,7 @@ pub mod campaign_kicks;
 pub mod censor;
 pub mod episodes;
 pub mod filter;
+pub mod kick_episodes;
 pub mod kicks;
 pub mod margin;
 pub mod ride;
@@ -14,7 +15,7 @@ pub mod search;
 pub mod sinefit;
 
 pub use censor::Cut;
-pub use episodes::{find_episodes, wobble_speed_mps, Episode, Stability};
+pub use episodes::{find_episodes, wobble_speed_mps, Episode, Measured, Stability};
 pub use kicks::{find_kicks, Kick};
 pub use ride::Ride;
 pub use roll::estimate_roll_deg;

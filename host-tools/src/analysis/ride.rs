@@ -1,14 +1,18 @@
 //! What the commands over many logs (`wobble`, `summary`, the model fits
-//! and the data set) take from each: its summary, wobble episodes, distance
-//! and top speed, found in one pass over the log in bounded memory.
+//! and the data set) take from each: its summary, wobble episodes (a kick's
+//! with the kick's values, as `margin` has them), distance and top speed,
+//! found in one pass over the log in bounded memory.
 
 use std::path::{Path, PathBuf};
 
 use super::filter::follows;
+use super::kick_episodes::give_kick_values;
+use super::kicks::KickSearch;
 use super::run::{log_name, stream_rows};
 use super::search::EpisodeSearch;
 use super::{Episode, Run};
-use crate::summary::Summary;
+use crate::cmd::detect::wheel_circumference_m;
+use crate::summary::{Summary, SummaryBuilder};
 use crate::CliError;
 
 /// One run, analysed.
@@ -18,7 +22,9 @@ pub struct Ride {
     pub path: PathBuf,
     /// What `wobblog info` says about it.
     pub summary: Summary,
-    /// Every wobble episode, in time order.
+    /// Every wobble episode, in time order; those that are kicks with the
+    /// kick's values as `wobblog margin` takes them
+    /// ([`super::kick_episodes`]).
     pub episodes: Vec<Episode>,
     /// Wheel distance over the frames present (trapezoids within each
     /// stretch without a gap), m.
@@ -30,7 +36,8 @@ pub struct Ride {
 impl Ride {
     /// Reads and analyses the log at `path`, streaming its frames.
     pub fn load(path: &Path) -> Result<Self, CliError> {
-        let (summary, analyser) = stream_rows(path, Analyser::new, |a, row| {
+        let make = |told: &SummaryBuilder| Analyser::new(told.frame_rate_hz(), told.config());
+        let (summary, analyser) = stream_rows(path, make, |a, row| {
             a.push(row.t_s, row.steer_deg, row.speed_mps);
         })?;
         Ok(analyser.finish(path, summary))
@@ -39,7 +46,7 @@ impl Ride {
     /// Analyses a run held in memory: the same analysis as [`Self::load`].
     #[must_use]
     pub fn of(run: &Run) -> Self {
-        let mut a = Analyser::new(run.sample_rate_hz());
+        let mut a = Analyser::new(run.sample_rate_hz(), &run.summary.config);
         for i in 0..run.len() {
             a.push(run.t_s[i], run.steer_deg[i], run.speed_mps[i]);
         }
@@ -57,6 +64,9 @@ impl Ride {
 struct Analyser {
     period_s: f64,
     search: EpisodeSearch,
+    /// The kicks, as `wobblog margin` finds them (`None` when the log's
+    /// config gives no wheel: margin then takes no kick from the log).
+    kicks: Option<KickSearch>,
     distance_m: f64,
     max_speed_mps: f64,
     /// Time and speed of the frame before.
@@ -64,10 +74,15 @@ struct Analyser {
 }
 
 impl Analyser {
-    fn new(fs_hz: f64) -> Self {
+    /// An analysis of frames `fs_hz` apart, from a log whose header has
+    /// `config` lines.
+    fn new(fs_hz: f64, config: &[String]) -> Self {
         Self {
             period_s: 1.0 / fs_hz,
             search: EpisodeSearch::new(fs_hz),
+            kicks: wheel_circumference_m(config)
+                .ok()
+                .map(|wheel_m| KickSearch::new(fs_hz, wheel_m)),
             distance_m: 0.0,
             max_speed_mps: 0.0,
             last: None,
@@ -81,12 +96,19 @@ impl Analyser {
         self.last = Some((t_s, speed_mps));
         self.max_speed_mps = self.max_speed_mps.max(speed_mps);
         self.search.push(t_s, steer_deg, speed_mps);
+        if let Some(kicks) = &mut self.kicks {
+            kicks.push(t_s, steer_deg, speed_mps);
+        }
     }
 
     fn finish(self, path: &Path, summary: Summary) -> Ride {
+        let mut episodes = self.search.finish(&summary.losses);
+        if let Some(kicks) = self.kicks {
+            give_kick_values(&mut episodes, kicks.finish(), &summary.kick_records);
+        }
         Ride {
             path: path.to_path_buf(),
-            episodes: self.search.finish(&summary.losses),
+            episodes,
             summary,
             distance_m: self.distance_m,
             max_speed_mps: self.max_speed_mps,

@@ -74,7 +74,7 @@ impl Run {
     /// its losses are in `summary.losses`, and the analyses split the run at
     /// the gaps.
     pub fn load(path: &Path) -> Result<Self, CliError> {
-        let empty = |_| Self {
+        let empty = |_: &SummaryBuilder| Self {
             path: path.to_path_buf(),
             ..Self::default()
         };
@@ -109,13 +109,14 @@ impl Run {
 }
 
 /// Reads the log at `path` in one pass, in bounded memory, into an analysis
-/// that `make` creates at the first frame from the frame rate known then
-/// (the header is the log's first record): `visit` gets every frame as a
-/// row, in file order. Returns what `wobblog info` says about the log, and
-/// the analysis. A log without a frame is an error.
+/// that `make` creates at the first frame from what the log has said by
+/// then (its header: the frame rate and config lines, the log's first
+/// records): `visit` gets every frame as a row, in file order. Returns what
+/// `wobblog info` says about the log, and the analysis. A log without a
+/// frame is an error.
 pub fn stream_rows<A>(
     path: &Path,
-    make: impl Fn(f64) -> A,
+    make: impl Fn(&SummaryBuilder) -> A,
     mut visit: impl FnMut(&mut A, &Row),
 ) -> Result<(Summary, A), CliError> {
     let mut builder = SummaryBuilder::new();
@@ -124,14 +125,14 @@ pub fn stream_rows<A>(
     let stats = read_log(path, |event| {
         builder.observe(&event);
         if let Event::Record(record) = event {
-            let rate_hz = builder.frame_rate_hz();
+            let told = &builder;
             rows.push(&record, &mut |row: &Row| {
-                visit(analysis.get_or_insert_with(|| make(rate_hz)), row);
+                visit(analysis.get_or_insert_with(|| make(told)), row);
             });
         }
     })?;
-    let rate_hz = builder.frame_rate_hz();
-    rows.finish(&mut |row: &Row| visit(analysis.get_or_insert_with(|| make(rate_hz)), row));
+    let told = &builder;
+    rows.finish(&mut |row: &Row| visit(analysis.get_or_insert_with(|| make(told)), row));
     let summary = builder.finish(&stats);
     match analysis {
         Some(analysis) => Ok((summary, analysis)),

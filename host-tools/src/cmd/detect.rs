@@ -368,6 +368,14 @@ pub fn log_config(header_lines: &[String], set: &[String]) -> Result<Config, Cli
     Ok(loaded.config)
 }
 
+/// The circumference of the wheel a log was recorded with, m: its config
+/// lines' `wheel.circumference_m` (the default where they do not set it).
+pub fn wheel_circumference_m(header_lines: &[String]) -> Result<f64, CliError> {
+    Ok(f64::from(
+        log_config(header_lines, &[])?.wheel.circumference_m,
+    ))
+}
+
 fn csv_error(path: &Path, e: &csv::Error) -> CliError {
     let line = e.position().map(csv::Position::line);
     let what = match e.kind() {

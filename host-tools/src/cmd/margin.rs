@@ -10,7 +10,7 @@ use serde::Serialize;
 use crate::analysis::campaign_kicks::{campaign_kicks, CampaignKick, Prefer};
 use crate::analysis::margin::{predict_with, KickPoint, Margin, Trend, RIDE_MARGIN};
 use crate::analysis::Run;
-use crate::cmd::detect::log_config;
+use crate::cmd::detect::wheel_circumference_m;
 use crate::cmd::logs::{for_each_log, print, warn_losses};
 use crate::cmd::margin_model::{estimate, ModelEstimate, DEFAULT_PARAMS};
 use crate::cmd::summary::logs_in;
@@ -152,12 +152,8 @@ fn expand(inputs: &[PathBuf]) -> Result<Vec<PathBuf>, CliError> {
 fn kicks_of(log: &Path, prefer: Prefer) -> Result<Vec<CampaignKick>, CliError> {
     let run = Run::load(log)?;
     warn_losses(log, &run.summary);
-    let config = log_config(&run.summary.config, &[])?;
-    Ok(campaign_kicks(
-        &run,
-        f64::from(config.wheel.circumference_m),
-        prefer,
-    ))
+    let wheel_m = wheel_circumference_m(&run.summary.config)?;
+    Ok(campaign_kicks(&run, wheel_m, prefer))
 }
 
 /// Gathers the kicks of `logs` behind a progress bar; a log that cannot be

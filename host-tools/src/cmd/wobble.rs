@@ -136,7 +136,7 @@ fn render_text(r: &RunEpisodes) -> String {
     if !r.episodes.is_empty() {
         let _ = writeln!(
             o,
-            "  onset_s  onset_utc                   end_s  freq_hz  sigma_per_s  peak_amp_deg  speed_at_onset_mps  stability  censored"
+            "  onset_s  onset_utc                   end_s  freq_hz  sigma_per_s  peak_amp_deg  speed_at_onset_mps  stability  source     censored"
         );
     }
     for EpisodeUtc {
@@ -149,7 +149,7 @@ fn render_text(r: &RunEpisodes) -> String {
             Stability::Unstable => "unstable",
         };
         let line = format!(
-            "  {:7.2}  {:<24}  {:7.2}  {:7.2}  {:11.2}  {:12.2}  {:18.2}  {stability:<9}  {}",
+            "  {:7.2}  {:<24}  {:7.2}  {:7.2}  {:11.2}  {:12.2}  {:18.2}  {stability:<9}  {:<9}  {}",
             e.onset_s,
             onset_utc.as_deref().unwrap_or("-"),
             e.end_s,
@@ -157,6 +157,7 @@ fn render_text(r: &RunEpisodes) -> String {
             e.sigma_per_s,
             e.peak_amp_deg,
             e.speed_at_onset_mps,
+            e.source.as_str(),
             e.cuts_text(),
         );
         let _ = writeln!(o, "{}", line.trim_end());

@@ -73,7 +73,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
 
 fn residual_table(found: &[LoggedEpisode], wobble: &[wobble_model::Complex<f64>]) -> String {
     let mut o = String::from(
-        "log            onset_s  speed_mps  freq_hz  model_hz  d_freq_hz  sigma_per_s  model_per_s  d_sigma_per_s  censored\n",
+        "log            onset_s  speed_mps  freq_hz  model_hz  d_freq_hz  sigma_per_s  model_per_s  d_sigma_per_s  source     censored\n",
     );
     let (mut sf, mut ss, mut n) = (0.0, 0.0, 0usize);
     for (e, w) in found.iter().zip(wobble) {
@@ -86,7 +86,7 @@ fn residual_table(found: &[LoggedEpisode], wobble: &[wobble_model::Complex<f64>]
         }
         let _ = writeln!(
             o,
-            "{:<13} {:8.2}  {:9.2}  {:7.2}  {:8.2}  {:9.2}  {:11.2}  {:11.2}  {:13.2}  {}",
+            "{:<13} {:8.2}  {:9.2}  {:7.2}  {:8.2}  {:9.2}  {:11.2}  {:11.2}  {:13.2}  {:<9}  {}",
             e.log,
             e.episode.onset_s,
             e.episode.speed_at_onset_mps,
@@ -96,6 +96,7 @@ fn residual_table(found: &[LoggedEpisode], wobble: &[wobble_model::Complex<f64>]
             e.episode.sigma_per_s,
             w.re,
             ds,
+            e.episode.source.as_str(),
             if e.censored() { "yes" } else { "no" }
         );
     }
