@@ -60,3 +60,124 @@ fn kick_of(episode: &Episode, kicks: &[CampaignKick], taken: &[bool]) -> Option<
         .filter(|&i| !taken[i] && struck.contains(&kicks[i].t_s))
         .max_by(|&a, &b| kicks[a].t_s.total_cmp(&kicks[b].t_s))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::analysis::campaign_kicks::{card_sd, Source};
+
+    /// An episode from `onset_s` to `end_s` whose own fit (sigma -3 1/s,
+    /// 7 Hz) starts at `fit_from_s`.
+    fn episode(stability: Stability, onset_s: f64, fit_from_s: f64, end_s: f64) -> Episode {
+        Episode {
+            onset_s,
+            end_s,
+            peak_s: fit_from_s,
+            freq_hz: 7.0,
+            sigma_per_s: -3.0,
+            sigma_sd_per_s: None,
+            source: Measured::Episode,
+            peak_amp_deg: 1.0,
+            speed_at_onset_mps: 3.0,
+            stability,
+            fit_s: [fit_from_s, end_s - 0.5],
+            censored: false,
+            cut_at_start: None,
+            cut_at_end: None,
+        }
+    }
+
+    /// A host kick rising at `t_s` with sigma `sigma`.
+    fn host(t_s: f64, sigma: f64) -> Kick {
+        Kick {
+            t_s,
+            speed_mps: 3.1,
+            freq_hz: 6.4,
+            sigma_per_s: sigma,
+            sigma_sd_per_s: 0.04,
+            sigma_se_fit_per_s: 0.01,
+            amp_deg: 1.0,
+            fit_s: [t_s + 0.5, t_s + 4.0],
+            residual_rel: 0.1,
+        }
+    }
+
+    /// A card record of a kick at `t_s`: 6.9 Hz, sigma -1.1 +- 0.05.
+    fn record(t_s: f64, speed_mm_s: Option<u16>) -> KickRingDown {
+        KickRingDown {
+            t_us: (t_s * 1e6) as u64,
+            speed_mm_s,
+            freq_chz: 690,
+            sigma_milli_per_s: -1100,
+            sigma_se_milli_per_s: 50,
+            amp_cdeg: 140,
+            segments: 9,
+        }
+    }
+
+    #[test]
+    fn a_stable_episode_struck_by_a_kick_takes_the_kicks_values() {
+        let mut episodes = vec![
+            episode(Stability::Stable, 10.0, 10.3, 15.0),
+            episode(Stability::Unstable, 20.0, 20.5, 25.0),
+        ];
+        give_kick_values(&mut episodes, vec![host(9.6, -0.4), host(21.0, -0.5)], &[]);
+        let kick = &episodes[0];
+        assert_eq!(
+            (kick.freq_hz, kick.sigma_per_s, kick.sigma_sd_per_s),
+            (6.4, -0.4, Some(0.04))
+        );
+        assert_eq!(kick.source, Measured::Kick(Source::Host));
+        assert_eq!(kick.source.as_str(), "host");
+        // Its own times and speed stay.
+        assert_eq!((kick.onset_s, kick.speed_at_onset_mps), (10.0, 3.0));
+        // A growing wobble is no kick, whatever lies in it.
+        assert_eq!(episodes[1], episode(Stability::Unstable, 20.0, 20.5, 25.0));
+        assert_eq!(episodes[1].source.as_str(), "episode");
+    }
+
+    #[test]
+    fn a_kick_outside_the_strike_leaves_the_episode_its_own_fit() {
+        // Too early (over 0.5 s before the onset), and too late (over
+        // 0.5 s after its own fit starts: a knock during the ring-down).
+        for t in [9.45, 10.85] {
+            let mut episodes = vec![episode(Stability::Stable, 10.0, 10.3, 15.0)];
+            give_kick_values(&mut episodes, vec![host(t, -0.4)], &[]);
+            assert_eq!(episodes[0].source, Measured::Episode, "{t}");
+            assert_eq!(episodes[0].sigma_per_s, -3.0);
+        }
+        let mut episodes = vec![episode(Stability::Stable, 10.0, 10.3, 15.0)];
+        give_kick_values(&mut episodes, vec![host(10.75, -0.4)], &[]);
+        assert_eq!(episodes[0].sigma_per_s, -0.4);
+    }
+
+    #[test]
+    fn of_two_kicks_the_episode_is_the_last_struck_before_its_fit() {
+        let mut episodes = vec![episode(Stability::Stable, 10.0, 10.9, 15.0)];
+        give_kick_values(
+            &mut episodes,
+            vec![host(10.0, -0.4), host(10.8, -0.6), host(11.5, -0.7)],
+            &[],
+        );
+        assert_eq!(episodes[0].sigma_per_s, -0.6);
+    }
+
+    #[test]
+    fn a_card_record_gives_its_values_where_the_host_found_no_kick() {
+        let mut episodes = vec![
+            episode(Stability::Stable, 10.0, 10.3, 15.0),
+            episode(Stability::Stable, 20.0, 20.3, 25.0),
+        ];
+        // The card saw both kicks, the host only the second (and a record
+        // without a speed is still a kick within an episode).
+        let records = [record(9.8, None), record(19.9, Some(3000))];
+        give_kick_values(&mut episodes, vec![host(20.1, -0.5)], &records);
+        let card = &episodes[0];
+        assert_eq!(card.source.as_str(), "card");
+        assert!((card.freq_hz - 6.9).abs() < 1e-6 && card.sigma_per_s == -1.1);
+        assert_eq!(card.sigma_sd_per_s, Some(card_sd(0.05)));
+        let both = &episodes[1];
+        assert_eq!(both.source.as_str(), "card-host");
+        assert_eq!((both.sigma_per_s, both.sigma_sd_per_s), (-0.5, Some(0.04)));
+    }
+}

@@ -174,6 +174,8 @@ pub struct KickSearch {
     steer_deg: Vec<f64>,
     speed_mps: Vec<f64>,
     kicks: Vec<Kick>,
+    /// Most frames held at once.
+    most_held: usize,
 }
 
 impl KickSearch {
@@ -202,6 +204,7 @@ impl KickSearch {
             steer_deg: Vec::new(),
             speed_mps: Vec::new(),
             kicks: Vec::new(),
+            most_held: 0,
         }
     }
 
@@ -219,11 +222,19 @@ impl KickSearch {
         self.t_s.push(t_s);
         self.steer_deg.push(steer_deg);
         self.speed_mps.push(speed_mps);
+        self.most_held = self.most_held.max(self.t_s.len());
         if self.t_s.len() >= self.piece {
             let shared = self.t_s.len() - self.overlap;
             self.search(Some(shared));
             self.clear(shared);
         }
+    }
+
+    /// Most frames held at once so far: at most a piece, whatever the
+    /// run's length.
+    #[must_use]
+    pub fn most_held(&self) -> usize {
+        self.most_held
     }
 
     /// Every kick, in time order.
