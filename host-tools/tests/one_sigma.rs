@@ -13,8 +13,11 @@ use analysis_support::{stdout_of, wobblog, Extras, Ride};
 use parquet::file::reader::{FileReader, SerializedFileReader};
 use parquet::record::Field;
 use serde_json::Value;
+use wobble_core::format::{KickRingDown, Record};
 use wobble_model::fit::{fit, Observation, Weights};
+use wobblog::analysis::campaign_kicks::{campaign_kicks, load_campaign_kicks, Prefer, Source};
 use wobblog::analysis::{find_episodes, Episode, Run, Stability};
+use wobblog::cmd::detect::wheel_circumference_m;
 
 /// The kick: struck at this time, s since boot...
 const KICK_S: f64 = 20.0;
@@ -250,4 +253,62 @@ fn a_kick_has_margins_sigma_in_every_command() {
     own[1].sigma_per_s = own_kick.sigma_per_s;
     let own_value = fit(&set, &keys, &own, weights).unwrap().estimates[0].value;
     assert_ne!(format!("{value:.6}"), format!("{own_value:.6}"));
+}
+
+/// A card record of a kick at `t_s` (6.9 Hz, sigma -1.1 +- 0.05 1/s),
+/// with the speed the board measured, if any.
+fn record(t_s: f64, speed_mm_s: Option<u16>) -> Record<'static> {
+    Record::Kick(KickRingDown {
+        t_us: (t_s * 1e6).round() as u64,
+        speed_mm_s,
+        freq_chz: 690,
+        sigma_milli_per_s: -1100,
+        sigma_se_milli_per_s: 50,
+        amp_cdeg: 140,
+        segments: 9,
+    })
+}
+
+/// `margin` reads a log's kicks as it streams by (in bounded memory): the
+/// same kicks as the run loaded whole gives, a card record without a speed
+/// taking the mean wheel speed over the 2 s after it.
+#[test]
+fn streamed_kicks_are_the_whole_runs() {
+    let dir = tempfile::tempdir().unwrap();
+    let log = dir.path().join("RUN00001.WBL");
+    let mut ride = ride();
+    // Speeding up from 2 m/s at 0.1 m/s per second.
+    for (t, v) in ride.t_s.iter().zip(&mut ride.speed_mps) {
+        *v = 2.0 + 0.1 * t;
+    }
+    let extras = Extras {
+        // One record beside the host's kick, two alone (one without a
+        // speed).
+        records: vec![
+            record(KICK_S, Some(4000)),
+            record(8.0, None),
+            record(30.0, Some(5000)),
+        ],
+        ..Extras::default()
+    };
+    analysis_support::write_log(&log, &ride, &extras);
+    for prefer in [Prefer::Best, Prefer::Card, Prefer::Host] {
+        let (summary, streamed) = load_campaign_kicks(&log, prefer).unwrap();
+        let run = Run::load(&log).unwrap();
+        assert_eq!(summary.kick_records, run.summary.kick_records);
+        let wheel_m = wheel_circumference_m(&run.summary.config).unwrap();
+        let whole = campaign_kicks(&run, wheel_m, prefer);
+        assert_eq!(streamed, whole, "{prefer:?}");
+    }
+    let (_, kicks) = load_campaign_kicks(&log, Prefer::Best).unwrap();
+    let sources: Vec<Source> = kicks.iter().map(|k| k.source).collect();
+    // The growing wobble at 14 s is no kick.
+    assert_eq!(sources, [Source::Card, Source::CardHost, Source::Card]);
+    // 2 + 0.1 t over 8-10 s, frames 10 ms apart, speeds in mm/s.
+    let frames: Vec<f64> = (800..=1000)
+        .map(|i| 2.0 + 0.1 * f64::from(i) / 100.0)
+        .collect();
+    let mean = frames.iter().sum::<f64>() / frames.len() as f64;
+    assert!((kicks[0].speed_mps - mean).abs() < 1e-3, "{:?}", kicks[0]);
+    assert!((mean - 2.9).abs() < 1e-9);
 }

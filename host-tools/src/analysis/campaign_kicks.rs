@@ -10,11 +10,16 @@
 //! overlapping demodulation segments as independent and cannot see the
 //! road's share; the host states [`card_sd`] of it (see there).
 
+use std::path::Path;
+
 use serde::Serialize;
 use wobble_core::format::KickRingDown;
 
-use super::kicks::{find_kicks, Kick};
-use super::run::Run;
+use super::kicks::{find_kicks, Kick, KickSearch};
+use super::run::{read_rows, stream_rows, Run};
+use crate::cmd::detect::wheel_circumference_m;
+use crate::summary::{Summary, SummaryBuilder};
+use crate::CliError;
 
 /// A card record and a host measurement within this of each other are the
 /// same kick, s (the card dates a kick from its impulse, the host from its
@@ -176,21 +181,64 @@ impl CampaignKick {
     }
 }
 
-/// Mean wheel speed of `run` over `[from, from + span]`, s.
-fn mean_speed(run: &Run, from: f64, span: f64) -> Option<f64> {
-    let v: Vec<f64> = run
-        .t_s
-        .iter()
-        .zip(&run.speed_mps)
-        .filter(|(t, _)| (from..=from + span).contains(*t))
-        .map(|(_, v)| *v)
-        .collect();
-    (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64)
+/// A card record without a speed takes the mean wheel speed over this long
+/// after it, s.
+pub const CARD_SPEED_SPAN_S: f64 = 2.0;
+
+/// The mean wheel speed over `[t, t + CARD_SPEED_SPAN_S]` for each of some
+/// times `t`, gathered from frames in file order (a log's or a run's).
+struct SpeedsAfter {
+    /// Each time, the sum of the speeds in its span and their count, in
+    /// time order.
+    spans: Vec<(f64, f64, usize)>,
+}
+
+impl SpeedsAfter {
+    /// The speeds after the card records of `records` that have none.
+    fn for_records(records: &[KickRingDown]) -> Self {
+        let mut times: Vec<f64> = records
+            .iter()
+            .map(CardKick::from)
+            .filter(|c| c.speed_mps.is_none())
+            .map(|c| c.t_s)
+            .collect();
+        times.sort_by(f64::total_cmp);
+        times.dedup();
+        Self {
+            spans: times.into_iter().map(|t| (t, 0.0, 0)).collect(),
+        }
+    }
+
+    fn is_empty(&self) -> bool {
+        self.spans.is_empty()
+    }
+
+    /// Takes a frame at `t_s` with wheel speed `speed_mps`.
+    fn push(&mut self, t_s: f64, speed_mps: f64) {
+        // Every span holding `t_s` starts at or before it and less than a
+        // span (and rounding) before it.
+        let first = self
+            .spans
+            .partition_point(|s| s.0 < t_s - CARD_SPEED_SPAN_S - 1e-6);
+        for span in self.spans[first..].iter_mut().take_while(|s| s.0 <= t_s) {
+            if (span.0..=span.0 + CARD_SPEED_SPAN_S).contains(&t_s) {
+                span.1 += speed_mps;
+                span.2 += 1;
+            }
+        }
+    }
+
+    /// The mean speed over the span after `t_s` (`None`: no frame in it).
+    fn after(&self, t_s: f64) -> Option<f64> {
+        let i = self.spans.partition_point(|s| s.0 < t_s);
+        let &(from, sum, n) = self.spans.get(i)?;
+        (from == t_s && n > 0).then(|| sum / n as f64)
+    }
 }
 
 /// The kicks of `run` (in time order), taken as `prefer` says. A card
-/// record without a speed takes the run's mean wheel speed over the 2 s
-/// after it.
+/// record without a speed takes the run's mean wheel speed over the
+/// [`CARD_SPEED_SPAN_S`] after it.
 #[must_use]
 pub fn campaign_kicks(run: &Run, wheel_circumference_m: f64, prefer: Prefer) -> Vec<CampaignKick> {
     let host = if prefer == Prefer::Card {
@@ -198,9 +246,49 @@ pub fn campaign_kicks(run: &Run, wheel_circumference_m: f64, prefer: Prefer) -> 
     } else {
         find_kicks(run, wheel_circumference_m)
     };
-    combine(host, &run.summary.kick_records, prefer, |t| {
-        mean_speed(run, t, 2.0)
-    })
+    let mut speeds = SpeedsAfter::for_records(&run.summary.kick_records);
+    if !speeds.is_empty() {
+        for (&t, &v) in run.t_s.iter().zip(&run.speed_mps) {
+            speeds.push(t, v);
+        }
+    }
+    combine(host, &run.summary.kick_records, prefer, |t| speeds.after(t))
+}
+
+/// The kicks of the log at `path` (in time order), taken as `prefer` says,
+/// and what `wobblog info` says about the log: what [`campaign_kicks`]
+/// gives for the log loaded whole, read in memory that does not grow with
+/// the log. The host searches its frames as they stream by
+/// ([`KickSearch`], on the wheel its header's config gives); the mean
+/// speeds after card records without one take a second pass, made only
+/// when there are such records.
+///
+/// # Errors
+/// The log cannot be read or has no frames, or its config is refused.
+pub fn load_campaign_kicks(
+    path: &Path,
+    prefer: Prefer,
+) -> Result<(Summary, Vec<CampaignKick>), CliError> {
+    let make = |told: &SummaryBuilder| {
+        let wheel_m = wheel_circumference_m(told.config()).ok();
+        wheel_m
+            .filter(|_| prefer != Prefer::Card)
+            .map(|w| KickSearch::new(told.frame_rate_hz(), w))
+    };
+    let (summary, search) = stream_rows(path, make, |search, row| {
+        if let Some(search) = search {
+            search.push(row.t_s, row.steer_deg, row.speed_mps);
+        }
+    })?;
+    // A config the host refuses is an error, as for every kick command.
+    wheel_circumference_m(&summary.config)?;
+    let host = search.map(KickSearch::finish).unwrap_or_default();
+    let mut speeds = SpeedsAfter::for_records(&summary.kick_records);
+    if !speeds.is_empty() {
+        read_rows(path, |_| {}, |row| speeds.push(row.t_s, row.speed_mps))?;
+    }
+    let kicks = combine(host, &summary.kick_records, prefer, |t| speeds.after(t));
+    Ok((summary, kicks))
 }
 
 /// The kicks of a log (in time order) from the host's measurements `host`

@@ -7,10 +7,8 @@ use std::path::{Path, PathBuf};
 
 use serde::Serialize;
 
-use crate::analysis::campaign_kicks::{campaign_kicks, CampaignKick, Prefer};
+use crate::analysis::campaign_kicks::{load_campaign_kicks, CampaignKick, Prefer};
 use crate::analysis::margin::{predict_with, KickPoint, Margin, Trend, RIDE_MARGIN};
-use crate::analysis::Run;
-use crate::cmd::detect::wheel_circumference_m;
 use crate::cmd::logs::{for_each_log, print, warn_losses};
 use crate::cmd::margin_model::{estimate, ModelEstimate, DEFAULT_PARAMS};
 use crate::cmd::summary::logs_in;
@@ -150,10 +148,9 @@ fn expand(inputs: &[PathBuf]) -> Result<Vec<PathBuf>, CliError> {
 /// its steering signal with the wheel the log was recorded with, taken as
 /// `prefer` says.
 fn kicks_of(log: &Path, prefer: Prefer) -> Result<Vec<CampaignKick>, CliError> {
-    let run = Run::load(log)?;
-    warn_losses(log, &run.summary);
-    let wheel_m = wheel_circumference_m(&run.summary.config)?;
-    Ok(campaign_kicks(&run, wheel_m, prefer))
+    let (summary, kicks) = load_campaign_kicks(log, prefer)?;
+    warn_losses(log, &summary);
+    Ok(kicks)
 }
 
 /// Gathers the kicks of `logs` behind a progress bar; a log that cannot be
