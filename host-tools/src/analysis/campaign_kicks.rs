@@ -9,6 +9,11 @@
 //! stated standard error is the on-board fit's, which treats its
 //! overlapping demodulation segments as independent and cannot see the
 //! road's share; the host states [`card_sd`] of it (see there).
+//!
+//! `margin` reads a log's kicks as it streams by ([`load_campaign_kicks`]);
+//! [`campaign_kicks`] gives the same for a run held in memory, and
+//! [`combine`] pairs the host's kicks with the card's records for both and
+//! for the episodes that are kicks ([`super::kick_episodes`]).
 
 use std::path::Path;
 
@@ -436,5 +441,35 @@ mod tests {
         let plain = run_with_a_ring(Vec::new());
         assert_eq!(campaign_kicks(&plain, 2.2, Prefer::Best), host);
         assert!(campaign_kicks(&plain, 2.2, Prefer::Card).is_empty());
+    }
+
+    #[test]
+    fn a_host_kick_pairs_with_the_nearest_record() {
+        let host = Kick {
+            t_s: 3.0,
+            speed_mps: 3.0,
+            freq_hz: 7.0,
+            sigma_per_s: -1.0,
+            sigma_sd_per_s: 0.03,
+            sigma_se_fit_per_s: 0.01,
+            amp_deg: 1.0,
+            fit_s: [3.5, 6.0],
+            residual_rel: 0.1,
+        };
+        // Both within MATCH_S, the nearer after the kick or before it, and
+        // first or second in the log.
+        for (near, far) in [(3.1, 2.6), (2.9, 3.4)] {
+            for (first, second) in [(near, far), (far, near)] {
+                let records = [record(first, Some(3000)), record(second, Some(3000))];
+                let kicks = combine(vec![host.clone()], &records, Prefer::Best, |_| None);
+                let paired: Vec<f64> = kicks
+                    .iter()
+                    .filter(|k| k.source == Source::CardHost)
+                    .map(|k| k.card.as_ref().unwrap().t_s)
+                    .collect();
+                assert_eq!(paired, [near], "{kicks:?}");
+                assert_eq!(kicks.len(), 2);
+            }
+        }
     }
 }
