@@ -346,6 +346,34 @@ mod tests {
     }
 
     proptest! {
+        /// Two real eigenvalues that meet without colliding, `m(u) +/-
+        /// sqrt(s^2 (u - u0)^2 + c^2)` on a common drift `m(u) = k u` (as
+        /// the lean's fast root meets the rear tyre's lag near `-u /
+        /// sigma`), part on the sides they came from: on any grid the branch
+        /// that starts above stays above, where a straight extrapolation
+        /// across the turn carries each onto the other's path.
+        #[test]
+        fn roots_that_meet_without_colliding_keep_their_sides_on_any_grid(
+            u0 in 1.0..8.0f64,
+            slope in 1.0..8.0f64,
+            half_gap in 0.2..1.0f64,
+            drift in -6.0..0.0f64,
+            step in 0.05..1.0f64,
+        ) {
+            let matrix = |u: f64| {
+                let (d, m) = (slope * (u - u0), drift * u);
+                DMatrix::from_row_slice(2, 2, &[m + d, half_gap, half_gap, m - d])
+            };
+            let n = (10.0 / step) as u32;
+            let speeds: Vec<f64> = (0..=n).map(|i| f64::from(i) * step).collect();
+            let sweep = Sweep::run_matrices(matrix, &[StateRole::Rate; 2], &speeds, |_| {}).unwrap();
+            let (a, b) = (&sweep.branches[0].values, &sweep.branches[1].values);
+            let upper = a[0].re > b[0].re;
+            for (k, u) in speeds.iter().enumerate() {
+                prop_assert_eq!(a[k].re > b[k].re, upper, "at {} m/s: {} and {}", u, a[k], b[k]);
+            }
+        }
+
         /// Eigenvalues moving on straight lines, crossing or not, are each
         /// followed on their own line: the extrapolation carries a branch
         /// through a crossing instead of swapping it with its neighbour.

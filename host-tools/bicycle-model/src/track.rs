@@ -4,12 +4,19 @@
 //! Each branch is predicted at the next speed by linear extrapolation from
 //! its two previous values; the eigenvalues found there are assigned to the
 //! predictions greedily in order of distance, which is exact when the step is
-//! small against the gaps between eigenvalues. Where it is not (a prediction
-//! about as near another eigenvalue as the one it got) the step is halved,
-//! down to a 64th of the grid's step, so that a coarse grid follows the same
-//! branches as a fine one. Near a double root (the weave splitting into two
-//! real roots) any assignment is continuous: the two conjugates a real
-//! prediction meets there are not counted as a doubt.
+//! small against the gaps between eigenvalues. Where it is not, the step is
+//! halved, down to a 64th of the grid's step, so that a coarse grid follows
+//! the same branches as a fine one. It is not where a prediction is about as
+//! near another eigenvalue as the one it got, or where two branches moved
+//! against each other by about as much as the swapped assignment would have
+//! moved them (their difference changing by as much as its size): where a
+//! root's path turns beside another's, as two real roots that meet without
+//! colliding do, the extrapolation from before the turn lands nearer the
+//! other path, and only the step's ends, not the prediction, show it. Near
+//! a double root (the weave splitting into two real roots) any assignment is
+//! continuous: the two conjugates a real prediction meets there, and a pair
+//! that is a double root or conjugates at either end of the step, are not
+//! counted as a doubt.
 
 use nalgebra::Complex;
 
@@ -58,7 +65,11 @@ struct Scratch {
     /// Squared distances, `predicted x found`.
     dist: Vec<f64>,
     choice: Vec<usize>,
+    /// Each prediction's second nearest value.
+    runner_up: Vec<usize>,
     taken: Vec<bool>,
+    /// Each branch's move over the step.
+    moved: Vec<f64>,
 }
 
 /// The eigenvalues at a speed, given the branches' predicted values there
@@ -125,7 +136,12 @@ impl<'a> Tracker<'a> {
             Some(found) => found,
             None => self.at(u, &predicted)?,
         };
-        let doubtful = assign(&predicted, &found, &mut self.scratch);
+        let doubtful = assign(&predicted, &found, &mut self.scratch)
+            || crossed(
+                &state.last.1,
+                &self.scratch.assigned,
+                &mut self.scratch.moved,
+            );
         self.scratch.predicted = predicted;
         if doubtful && halvings > 0 {
             let mid = 0.5 * (state.last.0 + u);
@@ -145,6 +161,7 @@ fn assign(predicted: &[Complex<f64>], found: &[Complex<f64>], scratch: &mut Scra
         assigned,
         dist,
         choice,
+        runner_up,
         taken,
         ..
     } = scratch;
@@ -157,7 +174,13 @@ fn assign(predicted: &[Complex<f64>], found: &[Complex<f64>], scratch: &mut Scra
     // Each prediction's nearest value; when these are all different, they
     // are what the greedy pairing gives, without sorting every pair.
     choice.clear();
-    choice.extend((0..np).map(|i| nearest(&dist[i * nf..(i + 1) * nf])));
+    runner_up.clear();
+    for row in dist.chunks_exact(nf.max(1)).take(np) {
+        let (first, second) = nearest_two(row);
+        choice.push(first);
+        runner_up.push(second);
+    }
+    choice.resize(np, usize::MAX);
     taken.clear();
     taken.resize(nf, false);
     let mut distinct = true;
@@ -182,17 +205,29 @@ fn assign(predicted: &[Complex<f64>], found: &[Complex<f64>], scratch: &mut Scra
         if d1 <= same {
             continue;
         }
-        let rival = found
-            .iter()
-            .enumerate()
-            .filter(|&(k, f)| {
-                // The conjugate a real prediction meets is no rival: either
-                // member continues the branch.
-                let conjugate = (f - found[j].conj()).norm_sqr() <= conj_tol && p.im * p.im < d1;
-                k != j && !conjugate
-            })
-            .map(|(k, _)| dist[i * nf + k])
-            .fold(f64::INFINITY, f64::min);
+        let row = &dist[i * nf..(i + 1) * nf];
+        // The conjugate a real prediction meets is no rival: either member
+        // continues the branch.
+        let exempt =
+            |k: usize| (found[k] - found[j].conj()).norm_sqr() <= conj_tol && p.im * p.im < d1;
+        // The nearest other value (the runner-up when each prediction got
+        // its nearest), or, if that is the exempt conjugate, the nearest of
+        // the rest.
+        let other = if distinct {
+            runner_up[i]
+        } else {
+            nearest_but(row, j)
+        };
+        let rival = match other {
+            usize::MAX => f64::INFINITY,
+            k if exempt(k) => row
+                .iter()
+                .enumerate()
+                .filter(|&(k, _)| k != j && !exempt(k))
+                .map(|(_, d)| *d)
+                .fold(f64::INFINITY, f64::min),
+            k => row[k],
+        };
         if d1 > DOUBT * DOUBT * rival {
             doubtful = true;
         }
@@ -208,10 +243,72 @@ fn assign(predicted: &[Complex<f64>], found: &[Complex<f64>], scratch: &mut Scra
     doubtful
 }
 
-/// The index of the smallest of `d` (`usize::MAX` if empty).
-fn nearest(d: &[f64]) -> usize {
+/// Whether two branches moved, against each other, from `last` to
+/// `assigned` by more than [`DOUBT`] of what the swapped assignment would
+/// have moved them: two roots whose difference changes about as much as its
+/// size over the step, as where one root's path turns beside another's (two
+/// real roots that meet without colliding part on the sides they came from,
+/// and the step's straight extrapolation may carry each onto the other's
+/// path) or where two paths cross. Pairs that are a double root or
+/// conjugates at either end are no doubt: either member continues either
+/// branch there. `moved` is scratch space (each branch's squared move).
+fn crossed(last: &[Complex<f64>], assigned: &[Complex<f64>], moved: &mut Vec<f64>) -> bool {
+    moved.clear();
+    moved.extend(last.iter().zip(assigned).map(|(a, b)| (b - a).norm_sqr()));
+    // The difference changes by at most the two moves, `m`, so the sum is
+    // at least `2 |before| - m`: a doubt needs `|before| < 1.5 m`, so
+    // `|before|^2 < 4.5 (m_i^2 + m_j^2)`. Most steps have no such pair;
+    // this first pass, without branches, finds whether any has.
+    let near = |i: usize, j: usize| (last[i] - last[j]).norm_sqr() < 4.5 * (moved[i] + moved[j]);
+    let mut any_near = false;
+    for (i, (a, ma)) in last.iter().zip(moved.iter()).enumerate() {
+        for (b, mb) in last[i + 1..].iter().zip(&moved[i + 1..]) {
+            any_near |= (a - b).norm_sqr() < 4.5 * (ma + mb);
+        }
+    }
+    if !any_near {
+        return false;
+    }
+    let scale = assigned
+        .iter()
+        .chain(last)
+        .fold(1.0_f64, |m, v| m.max(v.norm_sqr()))
+        .sqrt();
+    let (same, conj_tol) = ((1e-9 * scale).powi(2), (1e-12 * scale).powi(2));
+    let mates = |a: Complex<f64>, b: Complex<f64>| (a - b.conj()).norm_sqr() <= conj_tol;
+    (0..last.len()).any(|i| {
+        (i + 1..last.len()).any(|j| {
+            let (before, after) = (last[i] - last[j], assigned[i] - assigned[j]);
+            near(i, j)
+                && before.norm_sqr() > same
+                && after.norm_sqr() > same
+                && !mates(last[i], last[j])
+                && !mates(assigned[i], assigned[j])
+                && (after - before).norm_sqr() > DOUBT * DOUBT * (after + before).norm_sqr()
+        })
+    })
+}
+
+/// The indices of the smallest of `d` (the first of equals) and of the
+/// smallest of the rest (`usize::MAX` where there is none).
+fn nearest_two(d: &[f64]) -> (usize, usize) {
+    let (mut first, mut second) = (usize::MAX, usize::MAX);
+    for (k, x) in d.iter().enumerate() {
+        if first == usize::MAX || x.total_cmp(&d[first]).is_lt() {
+            second = first;
+            first = k;
+        } else if second == usize::MAX || x.total_cmp(&d[second]).is_lt() {
+            second = k;
+        }
+    }
+    (first, second)
+}
+
+/// The index of the smallest of `d` but `d[but]` (`usize::MAX` if none).
+fn nearest_but(d: &[f64], but: usize) -> usize {
     d.iter()
         .enumerate()
+        .filter(|&(j, _)| j != but)
         .min_by(|a, b| a.1.total_cmp(b.1))
         .map_or(usize::MAX, |(j, _)| j)
 }

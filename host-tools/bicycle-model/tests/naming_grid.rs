@@ -139,6 +139,18 @@ fn names_at_single_speeds_and_short_ranges_are_the_full_sweeps() {
     );
 }
 
+/// The first test bicycle over 0.718-6.049 m/s every 0.486 m/s (a case the
+/// property test below drew): two real roots at -20 to -31 1/s, the lean's
+/// real member and the rear tyre's lag root near `-u / sigma`, meet between
+/// two asked speeds, and the coarse step named them `lean` and `other` the
+/// other way round than the fine sweep.
+#[test]
+fn a_coarse_step_across_the_lean_meeting_the_rear_lag_names_as_the_fine_sweep() {
+    let model = Model::from_set(&bundled("test-bicycle.toml")).unwrap();
+    let d = differences(&model, &grid(0.718, 6.049, 0.486));
+    assert!(d.is_empty(), "{}", d.join("\n"));
+}
+
 /// Asked for a short range around one critical speed only (as `model eig
 /// --speeds 4:5:0.05` does), every bicycle finds and names it as on the
 /// whole range, to 1e-6 m/s, and nothing it does not find there.
