@@ -128,26 +128,6 @@ impl Tyre {
     }
 }
 
-/// Mass, mass centre and inertia of two bodies as one (parallel axes).
-fn lump(a: &Body, b: &Body) -> Body {
-    let mass = a.mass + b.mass;
-    let x = (a.mass * a.x + b.mass * b.x) / mass;
-    let z = (a.mass * a.z + b.mass * b.z) / mass;
-    let sum = |f: &dyn Fn(&Body) -> f64| f(a) + f(b);
-    let (dxa, dza, dxb, dzb) = (a.x - x, a.z - z, b.x - x, b.z - z);
-    Body {
-        x,
-        z,
-        mass,
-        inertia_xx: sum(&|p| p.inertia_xx) + a.mass * dza * dza + b.mass * dzb * dzb,
-        inertia_xz: sum(&|p| p.inertia_xz) - a.mass * dxa * dza - b.mass * dxb * dzb,
-        inertia_yy: sum(&|p| p.inertia_yy)
-            + a.mass * (dxa * dxa + dza * dza)
-            + b.mass * (dxb * dxb + dzb * dzb),
-        inertia_zz: sum(&|p| p.inertia_zz) + a.mass * dxa * dxa + b.mass * dxb * dxb,
-    }
-}
-
 impl WobbleParams {
     /// The parameters of a `wobble` parameter set, checked.
     pub fn from_set(set: &ParamSet) -> Result<Self, ParamError> {
@@ -161,17 +141,14 @@ impl WobbleParams {
             rear_wheel: base.rear_wheel,
             front_wheel: base.front_wheel,
             rear_frame: match set.quantity("rider_legs.mass") {
-                Some(_) => lump(&base.rear_frame, &Body::from_set(set, "rider_legs")?),
+                Some(_) => base.rear_frame.lump(&Body::from_set(set, "rider_legs")?),
                 None => base.rear_frame,
             },
             front_frame: base.front_frame,
             // `[seated_legs]`: the legs on the hinge with the upper body,
             // the whole rider rolling on the saddle.
             torso: match set.quantity("seated_legs.mass") {
-                Some(_) => lump(
-                    &Body::from_set(set, "torso")?,
-                    &Body::from_set(set, "seated_legs")?,
-                ),
+                Some(_) => Body::from_set(set, "torso")?.lump(&Body::from_set(set, "seated_legs")?),
                 None => Body::from_set(set, "torso")?,
             },
             hip_z: get("hip.z", Unit::Length)?,
@@ -213,8 +190,8 @@ impl WobbleParams {
             steer_axis_tilt: self.steer_axis_tilt,
             gravity: self.gravity,
             rear_wheel: self.rear_wheel,
-            rear_frame: lump(&self.rear_frame, &self.torso),
-            front_frame: lump(&self.front_frame, &self.fork),
+            rear_frame: self.rear_frame.lump(&self.torso),
+            front_frame: self.front_frame.lump(&self.fork),
             front_wheel: self.front_wheel,
         }
     }

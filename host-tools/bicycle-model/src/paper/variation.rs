@@ -5,8 +5,7 @@
 //! constant fork offset and wheelbase, the rider made lighter or moved.
 
 use crate::params::{ParamError, ParamSet, Problem, Quantity, Unit};
-
-const BODY_KEYS: [&str; 4] = ["inertia_xx", "inertia_xz", "inertia_yy", "inertia_zz"];
+use crate::whipple::Body;
 
 /// `set` with each key multiplied by its factor (in its file unit).
 ///
@@ -39,81 +38,26 @@ pub fn scaled_key(set: &ParamSet, key: &str, factor: f64) -> Result<ParamSet, Pa
     }
 }
 
-/// A body's mass, mass centre and inertias in SI units.
-#[derive(Clone, Copy, Debug)]
-struct Body {
-    mass: f64,
-    x: f64,
-    z: f64,
-    /// xx, xz, yy, zz about the mass centre.
-    inertia: [f64; 4],
-}
-
-fn body(set: &ParamSet, section: &str) -> Result<Body, ParamError> {
-    let get = |k: &str, u| set.get(&format!("{section}.{k}"), u);
-    let mut inertia = [0.0; 4];
-    for (i, k) in BODY_KEYS.iter().enumerate() {
-        inertia[i] = get(k, Unit::Inertia)?;
-    }
-    Ok(Body {
-        mass: get("mass", Unit::Mass)?,
-        x: get("x", Unit::Length)?,
-        z: get("z", Unit::Length)?,
-        inertia,
-    })
-}
-
-/// Writes `b` into `section` of `set`, in SI units.
+/// Writes `b` into `section` of `set`, in SI units (the inverse of
+/// [`Body::from_set`]).
 fn put(set: &mut ParamSet, section: &str, b: &Body, why: &str) -> Result<(), ParamError> {
-    let mut write = |k: &str, v: f64, unit: Unit| {
+    for (k, v, unit) in [
+        ("mass", b.mass, Unit::Mass),
+        ("x", b.x, Unit::Length),
+        ("z", b.z, Unit::Length),
+        ("inertia_xx", b.inertia_xx, Unit::Inertia),
+        ("inertia_xz", b.inertia_xz, Unit::Inertia),
+        ("inertia_yy", b.inertia_yy, Unit::Inertia),
+        ("inertia_zz", b.inertia_zz, Unit::Inertia),
+    ] {
         let key = format!("{section}.{k}");
         let factor = set
             .quantity(&key)
             .and_then(|q| unit.factor(&q.unit))
             .ok_or_else(|| set.error(&key, Problem::Unknown))?;
-        set.set_value(&key, v / factor, why)
-    };
-    write("mass", b.mass, Unit::Mass)?;
-    write("x", b.x, Unit::Length)?;
-    write("z", b.z, Unit::Length)?;
-    for (k, v) in BODY_KEYS.iter().zip(b.inertia) {
-        write(k, v, Unit::Inertia)?;
+        set.set_value(&key, v / factor, why)?;
     }
     Ok(())
-}
-
-/// The inertia of a point mass `m` at offset `(dx, dz)` from a point:
-/// xx, xz, yy, zz (the benchmark's sign of the product of inertia).
-fn point_inertia(m: f64, dx: f64, dz: f64) -> [f64; 4] {
-    [
-        m * dz * dz,
-        -m * dx * dz,
-        m * (dx * dx + dz * dz),
-        m * dx * dx,
-    ]
-}
-
-/// Two bodies as one (parallel axes, in the plane of symmetry).
-fn lump(a: &Body, b: &Body) -> Body {
-    let mass = a.mass + b.mass;
-    let (x, z) = (
-        (a.mass * a.x + b.mass * b.x) / mass,
-        (a.mass * a.z + b.mass * b.z) / mass,
-    );
-    let (pa, pb) = (
-        point_inertia(a.mass, a.x - x, a.z - z),
-        point_inertia(b.mass, b.x - x, b.z - z),
-    );
-    let mut inertia = [0.0; 4];
-    for i in 0..4 {
-        inertia[i] = a.inertia[i] + b.inertia[i] + pa[i] + pb[i];
-    }
-    Body {
-        mass,
-        x,
-        z,
-        inertia,
-    }
 }
 
 /// `set` with a point mass of `mass_kg` at `(x, z)` (m, the benchmark's
@@ -129,17 +73,19 @@ pub fn loaded(
     z: f64,
 ) -> Result<ParamSet, ParamError> {
     let mut out = set.clone();
-    let b = body(set, section)?;
     let load = Body {
         mass: mass_kg,
         x,
         z,
-        inertia: [0.0; 4],
+        inertia_xx: 0.0,
+        inertia_xz: 0.0,
+        inertia_yy: 0.0,
+        inertia_zz: 0.0,
     };
     put(
         &mut out,
         section,
-        &lump(&b, &load),
+        &Body::from_set(set, section)?.lump(&load),
         "loaded for the parameter study",
     )?;
     Ok(out)
@@ -199,7 +145,7 @@ fn rider_sections(set: &ParamSet) -> Vec<&'static str> {
 /// # Errors
 /// When the set has no `[rider_legs]`.
 pub fn rider_on_saddle(set: &ParamSet) -> Result<ParamSet, ParamError> {
-    body(set, "rider_legs")?;
+    Body::from_set(set, "rider_legs")?;
     let mut out = set.clone();
     let legs: Vec<(String, Quantity)> = set
         .iter()
@@ -245,9 +191,15 @@ pub fn rider_of_mass(set: &ParamSet, kg: f64) -> Result<ParamSet, ParamError> {
     let k = kg / rider_mass_kg(set)?;
     let mut out = set.clone();
     for section in rider_sections(set) {
-        let mut b = body(set, section)?;
-        b.mass *= k;
-        b.inertia = b.inertia.map(|i| i * k);
+        let b = Body::from_set(set, section)?;
+        let b = Body {
+            mass: k * b.mass,
+            inertia_xx: k * b.inertia_xx,
+            inertia_xz: k * b.inertia_xz,
+            inertia_yy: k * b.inertia_yy,
+            inertia_zz: k * b.inertia_zz,
+            ..b
+        };
         put(&mut out, section, &b, &format!("rider scaled to {kg} kg"))?;
     }
     Ok(out)
@@ -260,7 +212,7 @@ pub fn rider_of_mass(set: &ParamSet, kg: f64) -> Result<ParamSet, ParamError> {
 pub fn rider_moved(set: &ParamSet, dx: f64) -> Result<ParamSet, ParamError> {
     let mut out = set.clone();
     for section in rider_sections(set) {
-        let mut b = body(set, section)?;
+        let mut b = Body::from_set(set, section)?;
         b.x += dx;
         put(
             &mut out,
@@ -313,20 +265,17 @@ pub fn head_angle(set: &ParamSet, delta_deg: f64) -> Result<ParamSet, ParamError
     // (sin lambda, cos lambda) becomes (sin lambda1, cos lambda1).
     let (s, c) = d.sin_cos();
     for section in ["front_frame", "fork"] {
-        let b = body(set, section)?;
+        let b = Body::from_set(set, section)?;
         let (dx, dz) = (b.x - w, b.z + r);
-        let [xx, xz, yy, zz] = b.inertia;
+        let (xx, xz, zz) = (b.inertia_xx, b.inertia_xz, b.inertia_zz);
+        // R I R^T with R = [[c, s], [-s, c]] on (x, z).
         let turned = Body {
-            mass: b.mass,
             x: w + dx * c + dz * s,
             z: -r - dx * s + dz * c,
-            // R I R^T with R = [[c, s], [-s, c]] on (x, z).
-            inertia: [
-                c * c * xx + 2.0 * c * s * xz + s * s * zz,
-                -c * s * xx + (c * c - s * s) * xz + c * s * zz,
-                yy,
-                s * s * xx - 2.0 * c * s * xz + c * c * zz,
-            ],
+            inertia_xx: c * c * xx + 2.0 * c * s * xz + s * s * zz,
+            inertia_xz: -c * s * xx + (c * c - s * s) * xz + c * s * zz,
+            inertia_zz: s * s * xx - 2.0 * c * s * xz + c * c * zz,
+            ..b
         };
         put(&mut out, section, &turned, &why)?;
     }
@@ -344,32 +293,6 @@ mod tests {
             &Path::new(env!("CARGO_MANIFEST_DIR")).join("params/paper-test-bicycle.toml"),
         )
         .unwrap()
-    }
-
-    /// Parallel axes by hand: 2 kg at 1 m ahead of and 1 m above a 2 kg
-    /// point body put the mass centre half way, and each mass 0.5 m off it
-    /// in x and z adds 2 x 2 x 0.25 = 1 kg m^2 to Ixx and Izz, 2 to Iyy and
-    /// -2 x 2 x (0.5 x -0.5) = +1 to Ixz.
-    #[test]
-    fn two_point_masses_lump_by_parallel_axes() {
-        let a = Body {
-            mass: 2.0,
-            x: 0.0,
-            z: 0.0,
-            inertia: [0.0; 4],
-        };
-        let b = Body {
-            mass: 2.0,
-            x: 1.0,
-            z: -1.0,
-            inertia: [0.1, 0.0, 0.2, 0.3],
-        };
-        let l = lump(&a, &b);
-        assert_eq!((l.mass, l.x, l.z), (4.0, 0.5, -0.5));
-        let want = [1.1, 1.0, 2.2, 1.3];
-        for (got, want) in l.inertia.iter().zip(want) {
-            assert!((got - want).abs() < 1e-12, "{:?}", l.inertia);
-        }
     }
 
     /// The fork offset `r sin(lambda) - c cos(lambda)` is kept: with
@@ -390,14 +313,14 @@ mod tests {
         assert!((trail - 0.0949).abs() < 5e-4, "{trail}");
         // The fork's mass centre stays as far from the axle as before.
         let dist = |s: &ParamSet| {
-            let b = body(s, "fork").unwrap();
+            let b = Body::from_set(s, "fork").unwrap();
             ((b.x - 1.095).powi(2) + (b.z + r).powi(2)).sqrt()
         };
         assert!((dist(&set) - dist(&slack)).abs() < 1e-12);
         // And an inertia tensor's trace is unchanged by the turn.
         let trace = |s: &ParamSet| {
-            let b = body(s, "front_frame").unwrap();
-            b.inertia[0] + b.inertia[3]
+            let b = Body::from_set(s, "front_frame").unwrap();
+            b.inertia_xx + b.inertia_zz
         };
         assert!((trace(&set) - trace(&slack)).abs() < 1e-12);
     }
@@ -478,12 +401,12 @@ mod tests {
     #[test]
     fn a_load_moves_the_mass_centre_towards_it() {
         let set = bicycle();
-        let b0 = body(&set, "rear_frame").unwrap();
+        let b0 = Body::from_set(&set, "rear_frame").unwrap();
         let l = loaded(&set, "rear_frame", 10.0, -0.05, -0.75).unwrap();
-        let b1 = body(&l, "rear_frame").unwrap();
+        let b1 = Body::from_set(&l, "rear_frame").unwrap();
         assert!((b1.mass - b0.mass - 10.0).abs() < 1e-9);
         let want_x = (b0.mass * b0.x - 0.5) / (b0.mass + 10.0);
         assert!((b1.x - want_x).abs() < 1e-12);
-        assert!(b1.inertia[0] > b0.inertia[0]);
+        assert!(b1.inertia_xx > b0.inertia_xx);
     }
 }
