@@ -411,3 +411,23 @@ impl Stretch<'_> {
         })
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Frames at a rate that is not a positive finite number are not
+    /// searched (and not held): a run without a usable rate has no kicks.
+    #[test]
+    fn no_rate_no_search() {
+        for fs in [0.0, -100.0, f64::NAN, f64::INFINITY] {
+            let mut search = KickSearch::new(fs, 2.18);
+            for i in 0..500 {
+                let t = f64::from(i) / 100.0;
+                search.push(t, 2.0 * (TAU * 7.0 * t).sin() * (-t).exp(), 3.0);
+            }
+            assert_eq!(search.most_held(), 0, "{fs}");
+            assert!(search.finish().is_empty(), "{fs}");
+        }
+    }
+}
