@@ -40,9 +40,9 @@ fn main() -> Result<(), String> {
     };
     println!(
         "| recipe | class | closed | coverage of closed | lower > 5 % over | lower > 10 % over | \
-         ride limit over | estimate within 5 % (closed) | median abs error | false claims |"
+         ride limit over | estimate within 5 % (closed) | median abs error | median closed width | false claims |"
     );
-    println!("|---|---|---|---|---|---|---|---|---|---|");
+    println!("|---|---|---|---|---|---|---|---|---|---|---|");
     for (name, recipe) in [
         ("scatter 0.12", Recipe::acceptance as fn(Shape) -> Recipe),
         ("scatter 0.04-0.15", Recipe::wide),
@@ -77,7 +77,7 @@ fn main() -> Result<(), String> {
 fn print_row(recipe: &str, class: &str, t: &Tally) {
     let pc = |k: usize, n: usize| format!("{:.1} %", 100.0 * k as f64 / n.max(1) as f64);
     println!(
-        "| {recipe} | {class} | {} | {} | {} | {} | {} | {} | {:.1} % | {} |",
+        "| {recipe} | {class} | {} | {} | {} | {} | {} | {} | {:.1} % | {:.0} % | {} |",
         pc(t.closed, t.n),
         pc(t.covered, t.closed),
         pc(t.lower_over_5, t.n),
@@ -85,6 +85,7 @@ fn print_row(recipe: &str, class: &str, t: &Tally) {
         pc(t.ride_over, t.n),
         pc(t.closed_within_5, t.closed),
         100.0 * t.median_abs_error,
+        100.0 * t.median_width,
         t.false_claims
     );
 }

@@ -201,6 +201,8 @@ pub struct Outcome {
     pub ride_excess: Option<f64>,
     /// The point estimate's relative error.
     pub error: Option<f64>,
+    /// A closed interval's width over the truth.
+    pub width: Option<f64>,
     /// A wobble speed claimed where there is none ahead (a point
     /// estimate or a closed interval).
     pub false_claim: bool,
@@ -239,6 +241,10 @@ pub fn score_parts(
         lower_excess: ci[0].map(|lo| lo / t - 1.0),
         ride_excess: ride_below.map(|r| r / t - 1.0),
         error: estimate.map(|e| e / t - 1.0),
+        width: match ci {
+            [Some(lo), Some(hi)] => Some((hi - lo) / t),
+            _ => None,
+        },
         false_claim: false,
     }
 }
@@ -323,6 +329,8 @@ pub struct Tally {
     pub closed_within_5: usize,
     /// Median |error| of the point estimates.
     pub median_abs_error: f64,
+    /// Median width of the closed intervals over the truth.
+    pub median_width: f64,
     /// Wobble speeds claimed where there is none ahead.
     pub false_claims: usize,
 }
@@ -332,12 +340,11 @@ impl Tally {
     #[must_use]
     pub fn of(outcomes: &[Outcome]) -> Self {
         let count = |f: &dyn Fn(&Outcome) -> bool| outcomes.iter().filter(|o| f(o)).count();
-        let mut errors: Vec<f64> = outcomes
+        let errors: Vec<f64> = outcomes
             .iter()
             .filter_map(|o| o.error)
             .map(f64::abs)
             .collect();
-        errors.sort_by(f64::total_cmp);
         Self {
             n: outcomes.len(),
             closed: count(&|o| o.closed),
@@ -345,10 +352,11 @@ impl Tally {
             lower_over_5: count(&|o| o.lower_excess.is_some_and(|e| e > 0.05)),
             lower_over_10: count(&|o| o.lower_excess.is_some_and(|e| e > 0.10)),
             ride_over: count(&|o| o.ride_excess.is_some_and(|e| e > 0.0)),
-            estimates: errors.len(),
+            estimates: outcomes.iter().filter(|o| o.error.is_some()).count(),
             within_5: count(&|o| o.error.is_some_and(|e| e.abs() <= 0.05)),
             closed_within_5: count(&|o| o.closed && o.error.is_some_and(|e| e.abs() <= 0.05)),
-            median_abs_error: errors.get(errors.len() / 2).copied().unwrap_or(f64::NAN),
+            median_abs_error: median(errors),
+            median_width: median(outcomes.iter().filter_map(|o| o.width).collect()),
             false_claims: count(&|o| o.false_claim),
         }
     }
@@ -358,4 +366,10 @@ impl Tally {
     pub fn coverage(&self) -> f64 {
         self.covered as f64 / self.closed.max(1) as f64
     }
+}
+
+/// The median of `v` (NaN when empty).
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
 }

@@ -19,12 +19,19 @@ fn tally(shape: Shape) -> Tally {
     ))
 }
 
-/// The board's lower bound allows for the same convex bends as the
-/// host's.
+/// The board's interval allows for the same bends as the host's.
 #[test]
-fn the_board_allows_for_the_hosts_convex_bend() {
-    let board = f64::from(wobble_core::detector::margin::BEND_SHAPE_SD_CONVEX);
-    assert_eq!(board, wobblog::analysis::margin::BEND_SHAPE_SD_CONVEX);
+fn the_board_allows_for_the_hosts_bends() {
+    use wobble_core::detector::margin as board;
+    use wobblog::analysis::margin as host;
+    assert_eq!(
+        f64::from(board::BEND_SHAPE_SD_CONVEX),
+        host::BEND_SHAPE_SD_CONVEX
+    );
+    assert_eq!(
+        f64::from(board::BEND_SHAPE_SD_CONCAVE),
+        host::BEND_SHAPE_SD_CONCAVE
+    );
 }
 
 /// A bicycle stable above its kicks and less so below them: no wobble

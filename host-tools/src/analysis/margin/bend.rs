@@ -14,20 +14,22 @@
 
 use serde::Serialize;
 
-/// The allowance the line makes for sigma's bend: its curvature
-/// `k` is taken as unknown, `prior_per_s_mps2` (the bend the trend is
-/// given, [`BendPrior`] at the predicted wobble speed) with standard
-/// deviation `sd_convex_per_s_mps2` towards convex bends, which bring the
-/// zero closer (it widens the interval below `split_mps`, the prediction)
-/// and `sd_concave_per_s_mps2` towards concave ones, which take it
-/// further (above `split_mps`): a two-piece prior, as a family of
-/// bicycles is not symmetric about its mean. A line fitted by least squares to `a + b u +
-/// (d/2) u^2` is off at `u` by exactly `(d/2) ((u - m)^2 - v)`, `m` and `v`
-/// the weighted mean and variance of the kicks' speeds (the line absorbs
-/// the rest); the kicks are fitted with the prior's bend taken out, so `d`
-/// is the curvature's departure from the prior and the trend's value at
-/// `u` is uncertain by that much more: in quadrature, `(sd/2) |(u - m)^2 -
-/// v|`.
+/// The allowance the line makes for sigma's bend, judged for each
+/// candidate wobble speed in turn. A line fitted by least squares to `a +
+/// b u + (d/2) u^2` is off at `u` by exactly `(d/2) ((u - m)^2 - v)`, `m`
+/// and `v` the weighted mean and variance of the kicks' speeds (the line
+/// absorbs the rest); the kicks are fitted with the prior's bend at the
+/// prediction taken out, so the trend is bent by `prior_per_s_mps2`. To
+/// ask whether the wobble speed could be `u`, the bend is the shape's
+/// curvature *for a wobble speed at `u`* (`beta D / u^2`, `D` the trend's
+/// damping at `u/2`): the trend's value there moves by the difference of
+/// the two curvatures times that lever, and is uncertain by the shape's SD
+/// times it, in quadrature: towards convex bends (which bring the zero
+/// closer) where the moved value is still below zero, towards concave ones
+/// (which take it further) where it is above. At the prediction the two
+/// curvatures agree; below it the allowance grows as `1/u^2`, so a trend
+/// that rises slowly cannot claim a high lower bound, and a trend that
+/// reaches no zero is judged at each speed on that speed's own scale.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Bend {
     /// Weighted mean speed of the kicks used, m/s.
@@ -36,27 +38,31 @@ pub struct Bend {
     pub variance_mps2: f64,
     /// The curvature the trend is bent by, 1/s per (m/s)^2.
     pub prior_per_s_mps2: f64,
-    /// Standard deviation of the curvature about it towards convex bends,
-    /// 1/s per (m/s)^2.
-    pub sd_convex_per_s_mps2: f64,
-    /// ... towards concave bends.
-    pub sd_concave_per_s_mps2: f64,
-    /// Below this speed the convex side counts, above it the concave, m/s.
-    pub split_mps: f64,
     /// The shape it was taken from.
     pub shape: BendPrior,
 }
 
 impl Bend {
-    /// The standard uncertainty it adds to the trend's value at `u`, 1/s.
+    /// Half the lever `(u - m)^2 - v` of a curvature on the line at `u`.
+    fn half_lever(&self, u: f64) -> f64 {
+        0.5 * ((u - self.mean_mps).powi(2) - self.variance_mps2)
+    }
+
+    /// If the wobble speed were `u`, the trend's value there being
+    /// `value` and its damping at `u/2` being `damping`: how far the
+    /// shape's bend moves the value, and the standard uncertainty it adds
+    /// (1/s).
     #[must_use]
-    pub fn sd_at(&self, u: f64) -> f64 {
-        let sd = if u < self.split_mps {
-            self.sd_convex_per_s_mps2
+    pub fn at(&self, u: f64, value: f64, damping: f64) -> (f64, f64) {
+        let (k, sd_convex, sd_concave) = self.shape.curvature(u, damping);
+        let lever = self.half_lever(u);
+        let shift = (k - self.prior_per_s_mps2) * lever;
+        let sd = if value + shift < 0.0 {
+            sd_convex
         } else {
-            self.sd_concave_per_s_mps2
+            sd_concave
         };
-        0.5 * sd * ((u - self.mean_mps).powi(2) - self.variance_mps2).abs()
+        (shift, sd * lever.abs())
     }
 }
 
@@ -106,6 +112,6 @@ impl BendPrior {
 /// prior").
 pub const BEND_SHAPE_MEAN: f64 = -1.0;
 /// Its standard deviation towards convex shapes.
-pub const BEND_SHAPE_SD_CONVEX: f64 = 3.0;
+pub const BEND_SHAPE_SD_CONVEX: f64 = 4.0;
 /// Its standard deviation towards concave shapes.
-pub const BEND_SHAPE_SD_CONCAVE: f64 = 0.7;
+pub const BEND_SHAPE_SD_CONCAVE: f64 = 4.0;

@@ -235,6 +235,31 @@ pub(super) fn paule_mandel(
     Some(0.5 * (lo + hi))
 }
 
+/// Siegel's repeated-median line through `(u, y)`: for each kick the
+/// median of the slopes to every other kick at another speed, the
+/// slope the median of those, the intercept the median of `y - b u`. It
+/// stands until half the kicks are outliers, where least squares falls to
+/// one kick far out at the end of the speed range (a hand on the bar at
+/// the slowest kick), so the reweighting starts from it. Written here as
+/// it is a few lines over [`median`] and no maintained crate offers it.
+pub(super) fn repeated_median(u: &[f64], y: &[f64]) -> Option<[f64; 2]> {
+    let slopes: Vec<f64> = (0..u.len())
+        .filter_map(|i| {
+            let to_others: Vec<f64> = (0..u.len())
+                .filter(|&j| (u[j] - u[i]).abs() > 1e-9)
+                .map(|j| (y[j] - y[i]) / (u[j] - u[i]))
+                .collect();
+            (!to_others.is_empty()).then(|| median(to_others))
+        })
+        .collect();
+    if slopes.len() < 2 {
+        return None;
+    }
+    let b = median(slopes);
+    let a = median(u.iter().zip(y).map(|(u, y)| y - b * u).collect());
+    (a.is_finite() && b.is_finite()).then_some([a, b])
+}
+
 /// The fit of `terms` coefficients to the kicks at speeds `u` with growth
 /// rates `y` and stated SDs `sd`, as the module says.
 pub(super) fn robust_fit(u: &[f64], y: &[f64], sd: &[f64], terms: usize) -> Option<RobustFit> {
@@ -243,8 +268,16 @@ pub(super) fn robust_fit(u: &[f64], y: &[f64], sd: &[f64], terms: usize) -> Opti
     let mut kept = vec![true; u.len()];
     for _ in 0..ROUNDS {
         let base: Vec<f64> = var.iter().map(|v| 1.0 / (v + tau2)).collect();
-        let (start, _) = weighted_poly(u, y, &base, terms)?;
-        let (start, _) = irls((u, y, &base), start, HUBER_K, huber)?;
+        // A line starts from the repeated median (high breakdown: Huber's
+        // reweighting from least squares follows a kick far out at the end
+        // of the speed range); a quadratic from least squares and Huber.
+        let start = match repeated_median(u, y) {
+            Some(line) if terms == 2 => line.to_vec(),
+            _ => {
+                let (ls, _) = weighted_poly(u, y, &base, terms)?;
+                irls((u, y, &base), ls, HUBER_K, huber)?.0
+            }
+        };
         let (_, w) = irls((u, y, &base), start, BISQUARE_C, bisquare)?;
         let now: Vec<bool> = w.iter().map(|w| *w > 0.0).collect();
         let next = paule_mandel((u, y, &var), &now, terms)?;

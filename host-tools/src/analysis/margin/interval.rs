@@ -85,16 +85,14 @@ pub(super) fn bisect(inside: impl Fn(f64) -> bool, mut lo: f64, mut hi: f64) -> 
 }
 
 /// The profile-likelihood interval around `zero`: the connected set of
-/// speeds with `f(u)^2 <= t^2 var(u)` that holds it, searched down to 0
-/// and up to `cap` on a grid of `step`; an end not found is `None`.
+/// speeds `inside` (where the trend is not significantly non-zero) that
+/// holds it, searched down to 0 and up to `cap` on a grid of `step`; an
+/// end not found is `None`.
 pub(super) fn profile_interval(
-    coef: &[f64],
-    var: impl Fn(f64) -> f64,
-    t: f64,
+    inside: impl Fn(f64) -> bool,
     zero: f64,
     (step, cap): (f64, f64),
 ) -> (Option<f64>, Option<f64>) {
-    let inside = |u: f64| value(coef, u).powi(2) <= t * t * var(u);
     let walk = |dir: f64, limit: f64| {
         let mut u = zero;
         loop {
@@ -103,7 +101,7 @@ pub(super) fn profile_interval(
                 return None;
             }
             if !inside(next) {
-                return Some(bisect(inside, u, next));
+                return Some(bisect(&inside, u, next));
             }
             u = next;
         }

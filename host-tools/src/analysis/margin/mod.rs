@@ -159,14 +159,14 @@ pub struct Margin {
 }
 
 impl Margin {
-    /// The fitted trend at `u` with its 95 % band: `(sigma, lo, hi)`.
+    /// The fitted trend at `u` with its 95 % band for a wobble speed at
+    /// `u`: `(sigma, lo, hi)`; the band is moved by the bend the shape
+    /// gives a wobble speed there ([`Bend::at`]).
     #[must_use]
     pub fn band(&self, u: f64) -> Option<(f64, f64, f64)> {
         let coef = self.coefficients.as_ref()?;
         let cov = self.covariance.as_ref()?;
-        let y = value(coef, u);
-        let half = t_975(self.dof) * total_variance(cov, self.bend.as_ref(), u).sqrt();
-        Some((y, y - half, y + half))
+        Some(band_at(coef, cov, self.bend.as_ref(), t_975(self.dof), u))
     }
 
     /// The riding limit and next pass for a riding margin of `fraction`
@@ -176,9 +176,13 @@ impl Margin {
     }
 }
 
-/// The variance of the trend's value at `u`: the fit's, plus the bend's.
-fn total_variance(cov: &[Vec<f64>], bend: Option<&Bend>, u: f64) -> f64 {
-    variance(cov, u).max(0.0) + bend.map_or(0.0, |b| b.sd_at(u).powi(2))
+/// The trend `coef` at `u` and its band of `t` standard uncertainties:
+/// the fit's, and the bend's for a wobble speed at `u` ([`Bend::at`]).
+fn band_at(coef: &[f64], cov: &[Vec<f64>], bend: Option<&Bend>, t: f64, u: f64) -> (f64, f64, f64) {
+    let y = value(coef, u);
+    let (shift, sd) = bend.map_or((0.0, 0.0), |b| b.at(u, y, -value(coef, 0.5 * u)));
+    let half = t * (variance(cov, u).max(0.0) + sd * sd).sqrt();
+    (y, y + shift - half, y + shift + half)
 }
 
 /// A prediction needs at least this many kicks.
@@ -404,24 +408,21 @@ fn estimate(kicks: &[KickPoint], usable: &[usize], prior: BendPrior, out: &mut M
             .map(|(u, w)| w * (u - mean).powi(2))
             .sum::<f64>()
             / sw;
-        // The allowance's size at the prediction, or at the end of the
-        // search when the trend reaches no zero.
-        let at = zero.unwrap_or(cap);
-        let (k, sd_convex, sd_concave) = prior.curvature(at, -value(&coef, 0.5 * at));
         out.bend = Some(Bend {
             mean_mps: mean,
             variance_mps2: var_u,
-            prior_per_s_mps2: if zero.is_some() { k } else { 2.0 * c_prior },
-            sd_convex_per_s_mps2: sd_convex,
-            sd_concave_per_s_mps2: sd_concave,
-            split_mps: at,
+            prior_per_s_mps2: 2.0 * c_prior,
             shape: prior,
         });
     }
     let bend = out.bend.clone();
-    let var = |v: f64| total_variance(&fit.cov, bend.as_ref(), v);
-    let rising = slope(&coef, hi_u);
     let t = t_975(out.dof);
+    // The speeds the data allow as the wobble speed.
+    let inside = |v: f64| {
+        let (_, lo, hi) = band_at(&coef, &fit.cov, bend.as_ref(), t, v);
+        lo <= 0.0 && 0.0 <= hi
+    };
+    let rising = slope(&coef, hi_u);
     let step = span.max(MIN_SPAN_MPS) / 400.0;
     let Some(zero) = zero else {
         if rising.is_nan() || rising <= 0.0 {
@@ -434,7 +435,6 @@ fn estimate(kicks: &[KickPoint], usable: &[usize], prior: BendPrior, out: &mut M
                 .push("the trend does not reach zero within the speeds searched".into());
             // What the data still say: the speeds from the fastest kick up
             // at which the trend could be zero.
-            let inside = |v: f64| value(&coef, v).powi(2) <= t * t * var(v);
             out.ci95_mps[0] = (0..=((cap - hi_u) / step) as usize)
                 .map(|i| hi_u + step * i as f64)
                 .find(|&v| inside(v));
@@ -456,7 +456,7 @@ fn estimate(kicks: &[KickPoint], usable: &[usize], prior: BendPrior, out: &mut M
             reach / span.max(1e-9)
         ));
     }
-    let (lo, hi) = profile_interval(&coef, var, t, zero, (step, cap));
+    let (lo, hi) = profile_interval(inside, zero, (step, cap));
     out.ci95_mps = [lo, hi.filter(|_| open.is_empty())];
     if hi.is_none() {
         // A trend within its noise puts the zero anywhere beyond the lower

@@ -1,5 +1,4 @@
 use super::fit::{bisquare, huber, median};
-use super::interval::variance;
 use super::*;
 use proptest::prelude::*;
 
@@ -119,6 +118,21 @@ fn fieller_closed_form(a: f64, b: f64, v: [f64; 3], t: f64) -> (f64, f64) {
     (x1.min(x2), x1.max(x2))
 }
 
+/// The profile interval of the trend `coef` with covariance `cov` and no
+/// bend, around `zero`, searched to 50 m/s in steps of 0.01.
+fn unbent_interval(
+    coef: &[f64],
+    cov: &[Vec<f64>],
+    t: f64,
+    zero: f64,
+) -> (Option<f64>, Option<f64>) {
+    let inside = |u: f64| {
+        let (_, lo, hi) = band_at(coef, cov, None, t, u);
+        lo <= 0.0 && 0.0 <= hi
+    };
+    profile_interval(inside, zero, (0.01, 50.0))
+}
+
 /// For a line, the profile interval is Fieller's: both bounds as the
 /// closed form gives them, for several lines and covariances; and a
 /// slope within its noise leaves the interval open above.
@@ -132,25 +146,19 @@ fn the_profile_interval_of_a_line_is_fiellers() {
         let t = 2.1;
         let cov = vec![vec![v[0], v[1]], vec![v[1], v[2]]];
         let zero = -a / b;
-        let (lo, hi) = profile_interval(&[a, b], |u| variance(&cov, u), t, zero, (0.01, 50.0));
+        let (lo, hi) = unbent_interval(&[a, b], &cov, t, zero);
         let (want_lo, want_hi) = fieller_closed_form(a, b, v, t);
         assert!((lo.unwrap() - want_lo).abs() < 1e-6, "{lo:?} {want_lo}");
         assert!((hi.unwrap() - want_hi).abs() < 1e-6, "{hi:?} {want_hi}");
     }
     let cov = vec![vec![0.01, 0.0], vec![0.0, 0.0025]];
-    let (lo, hi) = profile_interval(
-        &[-1.0, 0.05],
-        |u| variance(&cov, u),
-        2.0,
-        20.0,
-        (0.01, 50.0),
-    );
+    let (lo, hi) = unbent_interval(&[-1.0, 0.05], &cov, 2.0, 20.0);
     assert!(lo.is_some() && hi.is_none(), "{lo:?} {hi:?}");
     // An intercept within its noise: Fieller's lower root is at
     // -0.100 m/s, no speed, so the search stops at 0 with no lower end;
     // the upper is the closed form's.
     let v = [0.01, 0.0, 0.0025];
-    let (lo, hi) = profile_interval(&[-0.1, 1.0], |u| variance(&cov, u), 2.0, 0.1, (0.01, 50.0));
+    let (lo, hi) = unbent_interval(&[-0.1, 1.0], &cov, 2.0, 0.1);
     let (want_lo, want_hi) = fieller_closed_form(-0.1, 1.0, v, 2.0);
     assert!(want_lo < -0.1 && lo.is_none(), "{lo:?} {want_lo}");
     assert!((hi.unwrap() - want_hi).abs() < 1e-6, "{hi:?} {want_hi}");
@@ -206,7 +214,7 @@ fn coverage(trend: Trend, mut beta_of_draw: impl FnMut() -> f64) -> f64 {
 /// scatter twice the stated SD: a quadratic on a parabola, and the line
 /// with its bend allowance on trends whose shape is drawn as the prior
 /// says (its mean, its two-piece SD). A trend bent far beyond the
-/// allowance is covered far less.
+/// allowance (`beta` +12) is covered far less.
 #[test]
 fn the_interval_covers_at_its_stated_rate() {
     let quadratic = coverage(Trend::Quadratic, || -3.0);
@@ -222,7 +230,9 @@ fn the_interval_covers_at_its_stated_rate() {
         BEND_SHAPE_MEAN + sd * z
     });
     assert!((0.92..=0.995).contains(&line), "{line}");
-    let bent = coverage(Trend::Line, || -7.5);
+    // Three and a quarter SDs towards convex: sigma steepens so sharply
+    // that it is about flat at half the wobble speed.
+    let bent = coverage(Trend::Line, || 12.0);
     assert!(bent < 0.5, "{bent}");
 }
 
@@ -473,11 +483,16 @@ fn the_weight_functions_are_huber_and_tukey() {
 }
 
 /// The bend allowance by hand: kicks of mean speed 3 m/s and speed
-/// variance 0.25 (m/s)^2, a curvature SD of 0.02 towards convex bends
-/// (below the split at 4 m/s) and 0.04 towards concave ones (above it):
-/// at 1 m/s the trend is uncertain by `0.01 * |4 - 0.25| = 0.0375` 1/s
-/// more, at the mean by `0.01 * 0.25`, at 5 m/s by `0.02 * 3.75`; and the band at `u` is the trend's value plus and
-/// minus `t` times the square root of the fit's variance
+/// variance 0.25 (m/s)^2, the trend bent by -0.04 1/s per (m/s)^2, a shape
+/// prior of mean -1 with SD 2 towards convex bends and 4 towards concave.
+/// A wobble speed at 5 m/s with 1/s of damping at 2.5 m/s: the shape's
+/// unit is `1 / 25`, its curvature -0.04 (no shift), the half lever `((5 -
+/// 3)^2 - 0.25) / 2 = 1.875`, the trend still below zero, so the convex
+/// SD, `0.08 * 1.875 = 0.15` 1/s. At 2 m/s, the unit `1 / 4`, the
+/// curvature -0.25, the half lever `(1 - 0.25) / 2 = 0.375`: the value 0.5
+/// moves by `-0.21 * 0.375 = -0.07875`, stays above zero, so the concave
+/// SD, `1 * 0.375`. The band at `u` is the trend's value moved by the
+/// shift, plus and minus `t` times the square root of the fit's variance
 /// `Vaa + 2 u Vab + u^2 Vbb` and the bend's.
 #[test]
 fn the_bend_allowance_and_the_band_by_hand() {
@@ -485,25 +500,39 @@ fn the_bend_allowance_and_the_band_by_hand() {
         mean_mps: 3.0,
         variance_mps2: 0.25,
         prior_per_s_mps2: -0.04,
-        sd_convex_per_s_mps2: 0.02,
-        sd_concave_per_s_mps2: 0.04,
-        split_mps: 4.0,
-        shape: BendPrior::DEFAULT,
+        shape: BendPrior {
+            mean: -1.0,
+            sd_convex: 2.0,
+            sd_concave: 4.0,
+        },
     };
-    assert!((bend.sd_at(5.0) - 0.075).abs() < 1e-12);
-    assert!((bend.sd_at(3.0) - 0.0025).abs() < 1e-12);
-    assert!((bend.sd_at(1.0) - 0.0375).abs() < 1e-12);
+    let (shift, sd) = bend.at(5.0, -0.1, 1.0);
+    assert!(
+        shift.abs() < 1e-12 && (sd - 0.15).abs() < 1e-12,
+        "{shift} {sd}"
+    );
+    let (shift, sd) = bend.at(2.0, 0.5, 1.0);
+    assert!((shift + 0.07875).abs() < 1e-12, "{shift}");
+    assert!((sd - 0.375).abs() < 1e-12, "{sd}");
+    // Pushed below zero by the shift: the convex side.
+    let (_, sd) = bend.at(2.0, 0.07, 1.0);
+    assert!((sd - 0.1875).abs() < 1e-12, "{sd}");
     let mut m = predict(&[]);
+    // The trend -2 + 0.5 u - 0.02 u^2: 0 at 5 m/s, -0.875 at 2.5 m/s.
     m.coefficients = Some(vec![-2.0, 0.5, -0.02]);
     m.covariance = Some(vec![vec![0.04, -0.01], vec![-0.01, 0.003]]);
-    m.bend = Some(bend);
+    m.bend = Some(bend.clone());
     m.dof = 10;
     let (y, lo, hi) = m.band(5.0).unwrap();
-    // -2 + 2.5 - 0.5; 0.04 - 0.1 + 0.075 = 0.015; plus 0.075^2.
-    let half = t_975(10) * (0.015_f64 + 0.075 * 0.075).sqrt();
-    assert!((y - 0.0).abs() < 1e-12, "{y}");
+    // The fit's variance 0.04 - 0.1 + 0.075 = 0.015. The bend at D =
+    // 0.875: unit 0.035, k = -0.035, so the value moves by 0.005 * 1.875
+    // to above zero, and the concave SD counts: 0.14 * 1.875.
+    let shift = 0.005 * 1.875;
+    let bend_sd = 0.14 * 1.875;
+    let half = t_975(10) * (0.015_f64 + bend_sd * bend_sd).sqrt();
+    assert!(y.abs() < 1e-12, "{y}");
     assert!(
-        (lo + half).abs() < 1e-12 && (hi - half).abs() < 1e-12,
+        (lo - (shift - half)).abs() < 1e-12 && (hi - (shift + half)).abs() < 1e-12,
         "{lo} {hi}"
     );
     m.bend = None;
