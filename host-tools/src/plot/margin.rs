@@ -72,8 +72,16 @@ impl MarginPlot {
         r.start.max(0.0)..r.end
     }
 
+    /// Over the kicks the fit's own band; beyond the fastest, the band
+    /// for a wobble speed there (the bend allowed for), whose crossings of
+    /// zero are the interval.
     fn band(&self, u: f64) -> Option<(f64, f64, f64)> {
-        self.margin.band(u)
+        let top = self.kicks.iter().map(|k| k.speed_mps).fold(0.0, f64::max);
+        if u <= top {
+            self.margin.fit_band(u)
+        } else {
+            self.margin.band(u)
+        }
     }
 }
 
@@ -124,7 +132,7 @@ impl Figure for MarginPlot {
                     BAND.mix(0.6).filled(),
                 )))
                 .map_err(err)?
-                .label("fit, 95 % band")
+                .label("95 % band: the fit's; beyond the kicks, with the bend")
                 .legend(|(x, y)| Rectangle::new([(x, y - 5), (x + 20, y + 5)], BAND.filled()));
         }
         if let [Some(lo), hi] = self.margin.ci95_mps {

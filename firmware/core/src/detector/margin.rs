@@ -43,7 +43,8 @@
 //! Cost: nothing per sample but two compares; per kick with a known speed,
 //! at most [`ITERATIONS`] weighted fits and median sorts over
 //! [`MAX_KICKS`] points (`cost()`: about 25 000 operations in the worst
-//! case; 16 873 instructions measured on the emulated Cortex-M4F). Memory:
+//! case; 16 873 instructions measured on the emulated Cortex-M4F before
+//! both ends carried the bend allowance). Memory:
 //! 352 bytes.
 
 use super::math::sqrtf;

@@ -8,7 +8,8 @@
 //! (the random effect of a meta-regression), so each kick's variance is
 //! `sd^2 + tau^2`. The fit alternates two steps until neither changes:
 //!
-//! 1. outliers, with `tau^2` fixed: Huber's then Tukey's bisquare
+//! 1. outliers, with `tau^2` fixed: from Siegel's repeated-median line
+//!    ([`repeated_median`]; a quadratic from Huber's reweighting), Tukey's bisquare
 //!    reweighting on residuals in units of `sqrt(sd^2 + tau^2)`, the scale
 //!    the median absolute deviation of those (never below 1); a kick
 //!    beyond [`BISQUARE_C`] scales is rejected;

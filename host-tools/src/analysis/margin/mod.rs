@@ -14,8 +14,9 @@
 //!   one at 7 m/s) and its interval allows for a different one ([`Bend`]).
 //! - **Fit** ([`fit`]): each kick's variance is its stated `sd^2` plus the
 //!   between-kick variance `tau^2` of the true damping (a random effect,
-//!   estimated after outlier rejection); outliers rejected by Huber then
-//!   Tukey bisquare reweighting on that scale.
+//!   estimated after outlier rejection); outliers rejected by Tukey
+//!   bisquare reweighting on that scale, from Siegel's repeated-median
+//!   line (a quadratic: from Huber's).
 //! - **Interval** ([`interval`]): profile likelihood. The 95 % interval of
 //!   the zero `u*` is the set of speeds `u` at which the trend's value is
 //!   not significantly different from zero: `f(u)^2 <= t^2 x(u)^T V x(u)`,
@@ -169,6 +170,15 @@ impl Margin {
         Some(band_at(coef, cov, self.bend.as_ref(), t_975(self.dof), u))
     }
 
+    /// The fitted trend at `u` with the fit's own 95 % band, no bend
+    /// allowed for: `(sigma, lo, hi)`.
+    #[must_use]
+    pub fn fit_band(&self, u: f64) -> Option<(f64, f64, f64)> {
+        let coef = self.coefficients.as_ref()?;
+        let cov = self.covariance.as_ref()?;
+        Some(band_at(coef, cov, None, t_975(self.dof), u))
+    }
+
     /// The riding limit and next pass for a riding margin of `fraction`
     /// of the lower bound ([`advice`]).
     pub fn set_riding_margin(&mut self, fraction: f64) {
@@ -213,10 +223,14 @@ pub fn method(trend: Trend, prior: BendPrior) -> String {
         ),
         Trend::Quadratic => String::new(),
     };
+    let start = match trend {
+        Trend::Line => "a repeated-median start",
+        Trend::Quadratic => "Huber",
+    };
     format!(
         "damping extrapolation: robust {shape} of sigma against speed (weights 1/(sd^2 + tau^2), \
-         tau the between-kick SD by Paule-Mandel after Huber then Tukey bisquare rejection), its \
-         zero; 95 % interval by profile likelihood (the speeds where the trend is not \
+         tau the between-kick SD by Paule-Mandel after {start} then Tukey bisquare rejection), \
+         its zero; 95 % interval by profile likelihood (the speeds where the trend is not \
          significantly non-zero, t with n-{} dof{bend})",
         trend.terms()
     )
@@ -463,7 +477,8 @@ fn estimate(kicks: &[KickPoint], usable: &[usize], prior: BendPrior, out: &mut M
         // bound: no point estimate is given.
         out.wobble_speed_mps = None;
         open.push(
-            "the rise of sigma with speed is not significant (the band holds zero up to the \
+            "the rise of sigma with speed is not significant against its noise and the bend \
+             allowed for (the band holds zero up to the \
              end of the search): only a lower bound"
                 .into(),
         );

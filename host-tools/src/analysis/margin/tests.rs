@@ -1,4 +1,4 @@
-use super::fit::{bisquare, huber, median};
+use super::fit::{bisquare, huber, median, repeated_median};
 use super::*;
 use proptest::prelude::*;
 
@@ -693,4 +693,63 @@ proptest! {
         prop_assert!(m.kicks_rejected >= 1, "{m:?}");
         prop_assert!(m.weights[bad] == 0.0);
     }
+}
+
+/// Siegel's repeated median by hand: five points on `y = 2 u - 1` and
+/// one far off at the slowest speed. Each exact point's slopes to the
+/// other exact points are 2 (four of five), so its median is 2; the
+/// outlier's own median does not matter, nor the outlier's intercept.
+#[test]
+fn the_repeated_median_ignores_a_kick_far_out_at_the_end() {
+    let u = [1.0, 2.0, 3.0, 4.0, 5.0, 6.0];
+    let y = [-9.0, 3.0, 5.0, 7.0, 9.0, 11.0];
+    let [a, b] = repeated_median(&u, &y).unwrap();
+    assert!(
+        (b - 2.0).abs() < 1e-12 && (a + 1.0).abs() < 1e-12,
+        "{a} {b}"
+    );
+    // Least squares is pulled: its slope is far from 2.
+    let w = [1.0; 6];
+    let (ls, _) = fit::weighted_poly(&u, &y, &w, 2).unwrap();
+    assert!((ls[1] - 2.0).abs() > 0.5, "{ls:?}");
+    // No spread in speed: no line.
+    assert_eq!(repeated_median(&[2.0, 2.0], &[1.0, 3.0]), None);
+}
+
+/// A stress campaign (seed 1743 of the low-speed class): sigma falls
+/// with speed through eight kicks at 3.4-4.3 m/s (the wobble is stable
+/// above them), and two outliers: a hand on the bar at the slowest kick
+/// (-4.65 1/s at 2.67 m/s) and a ring locked to a wheel harmonic at 3.86
+/// m/s (-0.04 1/s). From least squares Huber's reweighting followed the
+/// first and claimed a wobble speed of 4.9 m/s; from the repeated median
+/// both are rejected and none is claimed.
+#[test]
+fn outliers_at_both_ends_claim_no_wobble_speed() {
+    let rows = [
+        (4.299, -1.839, 0.080),
+        (3.689, -1.656, 0.032),
+        (3.735, -1.739, 0.038),
+        (4.036, -1.819, 0.110),
+        (3.375, -1.511, 0.075),
+        (3.855, -0.035, 0.050),
+        (3.823, -1.664, 0.104),
+        (2.673, -4.649, 0.056),
+        (3.941, -1.703, 0.071),
+        (3.945, -1.808, 0.031),
+    ];
+    let pts: Vec<KickPoint> = rows
+        .iter()
+        .map(|&(u, s, sd)| KickPoint {
+            speed_mps: u,
+            sigma_per_s: s,
+            sigma_sd_per_s: sd,
+            freq_hz: 7.0,
+        })
+        .collect();
+    let m = predict(&pts);
+    assert_eq!(m.wobble_speed_mps, None, "{m:?}");
+    assert_eq!(m.ci95_mps[1], None, "{m:?}");
+    assert_eq!(m.weights[5], 0.0, "{m:?}");
+    assert_eq!(m.weights[7], 0.0, "{m:?}");
+    assert_eq!(m.kicks_used, 8);
 }
