@@ -346,6 +346,37 @@ mod tests {
     }
 
     proptest! {
+        /// Where nothing is in doubt no step is halved: real lines 30 1/s
+        /// apart and a conjugate pair close to the real axis between them,
+        /// all parallel (the pair's members within the moves of each other,
+        /// a pair no doubt), cost one evaluation per speed (the asked 0-10
+        /// m/s every `step` and the reference's beyond) and naming's 16
+        /// samples; a line crossing the pair at 5 m/s costs more.
+        #[test]
+        fn steps_are_halved_only_where_in_doubt(step in 0.2..1.0f64, slope in -8.0..-1.0f64) {
+            let n = (10.0 / step) as u32;
+            let speeds: Vec<f64> = (0..=n).map(|i| f64::from(i) * step).collect();
+            let merged = crate::naming::speeds(&speeds).count();
+            let calls = |cross: bool| {
+                let count = std::cell::Cell::new(0);
+                let matrix = |u: f64| {
+                    count.set(count.get() + 1);
+                    let m = slope * u;
+                    let last = if cross { 30.0 + m - 6.0 * u } else { 30.0 + m };
+                    DMatrix::from_row_slice(4, 4, &[
+                        m - 30.0, 0.0, 0.0, 0.0,
+                        0.0, m, -0.05, 0.0,
+                        0.0, 0.05, m, 0.0,
+                        0.0, 0.0, 0.0, last,
+                    ])
+                };
+                Sweep::run_matrices(matrix, &[StateRole::Rate; 4], &speeds, |_| {}).unwrap();
+                count.get()
+            };
+            prop_assert_eq!(calls(false), merged + crate::naming::SAMPLES);
+            prop_assert!(calls(true) > merged + crate::naming::SAMPLES);
+        }
+
         /// Two real eigenvalues that meet without colliding, `m(u) +/-
         /// sqrt(s^2 (u - u0)^2 + c^2)` on a common drift `m(u) = k u` (as
         /// the lean's fast root meets the rear tyre's lag near `-u /

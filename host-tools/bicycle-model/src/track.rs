@@ -330,3 +330,24 @@ fn greedy(dist: &[f64], np: usize, nf: usize, choice: &mut [usize], taken: &mut 
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The nearest and the runner-up by hand, the first of equals first;
+    /// the nearest but one given index; nothing where there is nothing.
+    #[test]
+    fn nearest_two_and_nearest_but_pick_by_hand() {
+        let d = [3.0, 1.0, 2.0, 1.0, 0.5];
+        assert_eq!(nearest_two(&d), (4, 1));
+        assert_eq!(nearest_two(&d[..4]), (1, 3));
+        assert_eq!(nearest_two(&[2.0, 1.0, 3.0]), (1, 0));
+        assert_eq!(nearest_two(&[7.0]), (0, usize::MAX));
+        assert_eq!(nearest_two(&[]), (usize::MAX, usize::MAX));
+        assert_eq!(nearest_but(&d, 4), 1);
+        assert_eq!(nearest_but(&d, 1), 4);
+        assert_eq!(nearest_but(&[2.0, 1.0, 3.0], 1), 0);
+        assert_eq!(nearest_but(&[7.0], 0), usize::MAX);
+    }
+}
