@@ -6,7 +6,7 @@
 //! clean log with its blocks in reverse order (decoded in sequence order),
 //! back-to-back sync markers, and markers whose length fields pass (each
 //! one a candidate block whose CRC must be checked), with a short payload
-//! and with a full one.
+//! and with a full one; and a kick campaign (a ring-down every 12 s).
 //!
 //! ```text
 //! cargo run -p wobblog --release --example absurd_logs -- OUT_DIR
@@ -23,18 +23,44 @@ use wobble_core::format::{
 const LEN: usize = 64 << 20;
 const YEAR_US: u64 = 365 * 86_400_000_000;
 
-/// Frames at 100 Hz from `t0_us`, with a 6.4 Hz steering wobble, until the
+/// A steady 1-degree 6.4 Hz steering wobble at frame `i`, degrees.
+fn wobble(i: u64) -> f64 {
+    (TAU * 6.4 * i as f64 / 100.0).sin()
+}
+
+/// A kick campaign at frame `i`, degrees: every 12 s from 5 s a 0.1 s
+/// push of 4 degrees, then a 6.5 Hz ring of 1.5 degrees decaying at
+/// 0.8/s, over 0.02 degrees of noise (a fixed-seed generator).
+fn kicked(i: u64) -> f64 {
+    let t = i as f64 / 100.0;
+    let since = (t - 5.0).rem_euclid(12.0);
+    let kick = if t < 5.0 {
+        0.0
+    } else if since < 0.1 {
+        4.0
+    } else {
+        let s = since - 0.1;
+        1.5 * (-0.8 * s).exp() * (TAU * 6.5 * s).sin()
+    };
+    // SplitMix64 of the frame number: the same noise on every run.
+    let mut z = i.wrapping_add(0x9e37_79b9_7f4a_7c15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+    let unit = ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64;
+    kick + 0.02 * (2.0 * unit - 1.0) * 3f64.sqrt()
+}
+
+/// Frames at 100 Hz from `t0_us`, steering `steer_deg(frame)`, until the
 /// file holds `len` bytes; `jump_us` is added at every new block.
-fn log(t0_us: u64, jump_us: u64, len: usize) -> Vec<u8> {
+fn log(t0_us: u64, jump_us: u64, len: usize, steer_deg: fn(u64) -> f64) -> Vec<u8> {
     let mut enc = BlockEncoder::new();
     let mut file = Vec::with_capacity(len);
     let mut t_us = t0_us;
     let mut i = 0u64;
     while file.len() < len {
-        let steer_deg = (TAU * 6.4 * i as f64 / 100.0).sin();
         let frame = Frame {
             t_us,
-            steer_cdeg: (steer_deg * f64::from(STEER_COUNTS_PER_DEG)) as i16,
+            steer_cdeg: (steer_deg(i) * f64::from(STEER_COUNTS_PER_DEG)) as i16,
             speed_mm_s: 4000,
             ..Frame::default()
         };
@@ -103,13 +129,13 @@ fn main() -> std::io::Result<()> {
     let write = |name: &str, bytes: &[u8]| {
         std::fs::File::create(dir.join(name)).and_then(|mut f| f.write_all(bytes))
     };
-    let clean = log(1_000_000, 0, LEN);
+    let clean = log(1_000_000, 0, LEN, wobble);
     write("clean.wbl", &clean)?;
     write("repeated.wbl", &clean[..512].repeat(LEN / 512))?;
-    let mut front = log(1 << 62, 0, 512);
+    let mut front = log(1 << 62, 0, 512, wobble);
     front.extend_from_slice(&clean[..LEN - 512]);
     write("front.wbl", &front)?;
-    write("jumps.wbl", &log(1_000_000, YEAR_US, LEN))?;
+    write("jumps.wbl", &log(1_000_000, YEAR_US, LEN, wobble))?;
     let reversed: Vec<u8> = clean.chunks(512).rev().flatten().copied().collect();
     write("reversed.wbl", &reversed)?;
     write("markers.wbl", &b"WBLK".repeat(LEN / 4))?;
@@ -119,5 +145,6 @@ fn main() -> std::io::Result<()> {
         "full_candidates.wbl",
         &b"WBLK\x01\x00\xe4\x01".repeat(LEN / 8),
     )?;
+    write("kicked.wbl", &log(1_000_000, 0, LEN, kicked))?;
     write("busy.wbl", &busy(LEN))
 }

@@ -42,7 +42,7 @@ use super::censor::{Cut, Edge};
 use super::filter::{wobble_band, wobble_band_causal, Biquad, Pass};
 use super::run::Run;
 use super::search::EpisodeSearch;
-use super::sinefit::{fit_mode, SineFit};
+use super::sinefit::{fit_mode, Grid, SineFit};
 use crate::losses::Losses;
 
 /// Envelope at which an unstable wobble is said to start, degrees: below
@@ -632,12 +632,15 @@ fn strongest_tone(t: &[f64], x: &[f64], near_hz: f64, fs_hz: f64) -> Option<f64>
         return None;
     }
     let steps = (2.0 * TONE_SEARCH_HZ / 0.02).round() as usize;
+    // The power does not depend on the time origin: the grid's own.
+    let grid = Grid::of(t);
     (0..=steps)
         .map(|k| TAU * (near_hz - TONE_SEARCH_HZ + 0.02 * k as f64))
         .map(|omega| {
-            let (re, im) = t.iter().zip(x).fold((0.0, 0.0), |(re, im), (ts, v)| {
-                let (s, c) = (omega * ts).sin_cos();
-                (re + v * c, im + v * s)
+            let (mut re, mut im) = (0.0, 0.0);
+            grid.for_each_sin_cos(t, omega, |i, s, c| {
+                re += x[i] * c;
+                im += x[i] * s;
             });
             (omega, re * re + im * im)
         })
