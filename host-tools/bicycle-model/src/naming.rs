@@ -523,6 +523,26 @@ mod tests {
         }
     }
 
+    /// A 15 Hz oscillation of the frame on its tyres (roll its largest angle,
+    /// the tyre lags 0.6 of it, not 4 times the roll) is the `sway` beside a
+    /// rider's lean (a group with a torso share), and without one (no rider
+    /// on a hip) no sway: the steer oscillation beside it is the wobble, it
+    /// is `other`.
+    #[test]
+    fn the_sway_is_named_only_beside_a_lean() {
+        let sway = || group(0, [0.25, 0.1, 0.0, 0.05, 0.6], 15.0, -4.0);
+        let wobble = || group(1, [0.1, 0.8, 0.0, 0.0, 0.1], 7.0, -2.0);
+        let lean = group(2, [0.3, 0.3, 0.3, 0.0, 0.1], 4.0, -9.0);
+        assert_eq!(
+            classify(&[sway(), wobble()], 2),
+            [Mode::Other, Mode::Wobble]
+        );
+        assert_eq!(
+            classify(&[sway(), wobble(), lean], 3),
+            [Mode::Sway, Mode::Wobble, Mode::Lean]
+        );
+    }
+
     /// The module's rules where two groups compete for a name, worked by
     /// hand: of three weave-like oscillations the one rolling most of its
     /// roll and steer is the weave (0.97 of them; not the one rolling most
