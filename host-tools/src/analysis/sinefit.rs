@@ -310,9 +310,10 @@ fn normal_equations(
             }
         }
     });
-    for row in 0..n {
-        for col in 0..row {
-            jtj[row][col] = jtj[col][row];
+    for row in 1..n {
+        let (upper, lower) = jtj.split_at_mut(row);
+        for (col, above) in upper.iter().enumerate() {
+            lower[0][col] = above[row];
         }
     }
     (jtj, jtr, cost)
