@@ -64,6 +64,7 @@ fn kick_of(episode: &Episode, kicks: &[CampaignKick], taken: &[bool]) -> Option<
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::analysis::campaign_kicks::tests::record;
     use crate::analysis::campaign_kicks::{card_sd, Source};
 
     /// An episode from `onset_s` to `end_s` whose own fit (sigma -3 1/s,
@@ -99,19 +100,6 @@ mod tests {
             amp_deg: 1.0,
             fit_s: [t_s + 0.5, t_s + 4.0],
             residual_rel: 0.1,
-        }
-    }
-
-    /// A card record of a kick at `t_s`: 6.9 Hz, sigma -1.1 +- 0.05.
-    fn record(t_s: f64, speed_mm_s: Option<u16>) -> KickRingDown {
-        KickRingDown {
-            t_us: (t_s * 1e6) as u64,
-            speed_mm_s,
-            freq_chz: 690,
-            sigma_milli_per_s: -1100,
-            sigma_se_milli_per_s: 50,
-            amp_cdeg: 140,
-            segments: 9,
         }
     }
 
