@@ -12,7 +12,8 @@
 //! and budget, every free parameter with its bounds and their source, and
 //! the variants, and the readings of the paper: starts (values set on the
 //! random search's best before a local search of their own) whose
-//! bicycles are written as candidates beside the outputs. The score of a
+//! bicycles are written as candidates beside the outputs and compete with
+//! the variants' best for the bundled bicycle. The score of a
 //! bicycle is ten times the summed misses of the measured figures (each in
 //! half-widths of its band, at most 3) plus the number of directional
 //! claims it does not reproduce: measured figures first, then as many
@@ -61,7 +62,8 @@ struct Spec {
 /// A start for the local search that the random search is unlikely to
 /// draw: the random search's best with some values set as a reading of the
 /// paper suggests, refined for its own budget. Its bicycle is a candidate,
-/// written to its own file beside the spec's outputs, not one of them.
+/// written to its own file beside the spec's outputs, and kept as the
+/// bundled bicycle if it scores better than every variant's best.
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct Reading {
@@ -282,8 +284,16 @@ struct Outcome {
     set: ParamSet,
     /// The verdicts, in words.
     report: String,
-    /// The readings' bicycles and where they go.
-    candidates: Vec<(PathBuf, ParamSet)>,
+    /// The readings' bicycles, where they go, their labels and scores.
+    candidates: Vec<Candidate>,
+}
+
+/// A reading's bicycle.
+struct Candidate {
+    output: PathBuf,
+    label: String,
+    score: f64,
+    set: ParamSet,
 }
 
 /// The best bicycle of one variant, and its readings' candidates.
@@ -321,18 +331,18 @@ fn identify_variant(spec: &Spec, start: &ParamSet, v: &Variant) -> Result<Outcom
     let mut candidates = Vec::new();
     for (r, cur) in readings {
         let label = format!("variant {}, {}", v.name, r.name);
-        let (_, mut candidate, text) = self::report(&p, &label, &cur.t)?;
+        let (score, set, text) = self::report(&p, &label, &cur.t)?;
         report.push_str(&text);
-        candidate.name = format!("Seed paper's test bicycle, 83 kg rider: {label} (a candidate)");
-        candidate.source = format!(
-            "seed paper Table 1 and the bodies of scripts/derive_test_bicycle.py; uncertain parameters identified by examples/identify.rs ({}, {label}) from a reading of the paper: a candidate, not the bundled bicycle (model.md)",
-            spec.name
-        );
-        candidates.push((r.output.clone(), candidate));
+        candidates.push(Candidate {
+            output: r.output.clone(),
+            label,
+            score,
+            set,
+        });
     }
     Ok(Outcome {
         score,
-        variant: v.name.clone(),
+        variant: format!("variant {}", v.name),
         set,
         report,
         candidates,
@@ -407,27 +417,40 @@ fn run(spec_path: &Path) -> Result<(), String> {
             })
             .collect()
     });
+    // The variants' best first: a reading must score better to be kept.
     let mut results = Vec::new();
+    let mut readings = Vec::new();
     for o in outcomes {
         let o = o?;
         print!("{}", o.report);
-        for (path, candidate) in &o.candidates {
-            write_whole(&dir.join(path), &header(&to_toml(candidate)))?;
-        }
         results.push((o.score, o.variant, o.set));
+        readings.extend(o.candidates);
+    }
+    for c in readings {
+        let mut set = c.set.clone();
+        set.name = format!(
+            "Seed paper's test bicycle, 83 kg rider: {} (a candidate)",
+            c.label
+        );
+        set.source = format!(
+            "seed paper Table 1 and the bodies of scripts/derive_test_bicycle.py; uncertain parameters identified by examples/identify.rs ({}, {}) from a reading of the paper (model.md)",
+            spec.name, c.label
+        );
+        write_whole(&dir.join(&c.output), &header(&to_toml(&set)))?;
+        results.push((c.score, c.label, c.set));
     }
     let (_, name, mut best) = results
         .into_iter()
         .min_by(|a, b| a.0.total_cmp(&b.0))
         .ok_or("the spec has no variant")?;
-    println!("kept: variant {name}");
-    best.name = format!("Seed paper's test bicycle, 83 kg rider (variant {name})");
+    println!("kept: {name}");
+    best.name = format!("Seed paper's test bicycle, 83 kg rider ({name})");
     best.source = format!(
-        "seed paper Table 1 and the bodies of scripts/derive_test_bicycle.py; uncertain parameters identified to the paper's claims by examples/identify.rs ({}, variant {name})",
+        "seed paper Table 1 and the bodies of scripts/derive_test_bicycle.py; uncertain parameters identified to the paper's claims by examples/identify.rs ({}, {name})",
         spec.name
     );
     let mut light = variation::rider_of_mass(&best, LIGHT_RIDER_KG).map_err(|e| e.to_string())?;
-    light.name = format!("Seed paper's test bicycle, {LIGHT_RIDER_KG} kg rider (variant {name})");
+    light.name = format!("Seed paper's test bicycle, {LIGHT_RIDER_KG} kg rider ({name})");
     write_whole(&dir.join(&spec.output), &header(&to_toml(&best)))?;
     write_whole(&dir.join(&spec.light_output), &header(&to_toml(&light)))?;
     Ok(())

@@ -24,8 +24,14 @@
 //!   whose cornering stiffness sets its frequency), under an upper body the
 //!   hip holds, or, on a rigid rider, with the upper body rolling along
 //!   (its steer then more than its roll);
+//! - of the oscillations with the twist their largest angle, the one with
+//!   the largest twist share of its angles is the `twist`, the front
+//!   assembly twisting on the head's compliance, whatever its tyre lags:
+//!   the front tyre's lateral stiffness is the twist's second spring, so
+//!   its lags grow as the relaxation length shortens (37 times the twist
+//!   at 63 Hz with a 0.08 m front relaxation length);
 //! - tyre lags more than [`TYRE_DOMINANCE`] times its largest angle: `other`;
-//! - torso the largest angle: `lean`; twist: `twist`;
+//! - torso the largest angle: `lean`;
 //! - roll or steer the largest, oscillating somewhere, with at least
 //!   [`WEAVE_MIN_ROLL_PER_STEER`] roll per steer and below 2 Hz on average: the
 //!   one with the largest roll share (of roll and steer) is the `weave` (a
@@ -423,6 +429,11 @@ fn classify(groups: &[Group], branches: usize) -> Vec<Mode> {
         |g| g.share(StateRole::Roll) / (g.share(StateRole::Roll) + g.share(StateRole::Steer)),
     );
     let wobble = pick(groups, |g| g.wobble_like() && not_lean(g), |g| -g.freq);
+    let twist = pick(
+        groups,
+        |g| g.oscillates && g.largest_angle().0 == StateRole::Twist,
+        |g| g.share(StateRole::Twist) / g.shares.0[..4].iter().sum::<f64>(),
+    );
     let capsize = pick(
         groups,
         |g| g.planar() && !g.oscillates && g.largest_angle().0 == StateRole::Roll,
@@ -442,10 +453,10 @@ fn classify(groups: &[Group], branches: usize) -> Vec<Mode> {
     for (i, g) in groups.iter().enumerate() {
         let mode = match g.largest_angle().0 {
             _ if Some(i) == lean => Mode::Lean,
+            _ if Some(i) == twist => Mode::Twist,
             _ if lean.is_some() && g.sway_like() => Mode::Sway,
             _ if g.tyre_only() => Mode::Other,
             StateRole::Torso => Mode::Lean,
-            StateRole::Twist => Mode::Twist,
             _ if Some(i) == weave => Mode::Weave,
             _ if Some(i) == wobble => Mode::Wobble,
             _ if Some(i) == capsize => Mode::Capsize,
@@ -551,8 +562,10 @@ mod tests {
     /// capsize; of two real steer modes the fastest decaying is the
     /// castering, and a weave-like oscillation steering most is no
     /// castering (it decays faster still); a real root carried by the tyre
-    /// lags, slower than either capsize candidate, is `other`, and so is
-    /// an oscillation of the tyre lags that twists the fork a little. The
+    /// lags, slower than either capsize candidate, is `other`; of two
+    /// oscillations of the tyre lags that twist the fork more than they
+    /// steer, the one twisting it most of its angles is the `twist` (a
+    /// single angle, the twist, beats three fifths), the other `other`. The
     /// losers are `other`.
     #[test]
     fn of_two_candidates_each_rule_names_the_one_the_docs_say() {
@@ -569,6 +582,7 @@ mod tests {
             group(9, [0.05, 0.0, 0.0, 0.0, 0.95], 0.0, 0.1),
             group(10, [0.0, 0.0, 0.0, 0.05, 0.95], 20.0, -3.0),
             group(11, [0.1, 0.004, 0.0, 0.0, 0.896], 0.5, -1.0),
+            group(12, [0.0, 0.02, 0.0, 0.03, 0.95], 30.0, -9.0),
         ];
         let o = Mode::Other;
         assert_eq!(
@@ -584,6 +598,7 @@ mod tests {
                 Mode::Castering,
                 o,
                 o,
+                Mode::Twist,
                 o,
                 o
             ]

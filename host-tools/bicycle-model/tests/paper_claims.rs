@@ -1,6 +1,6 @@
 //! The seed paper's claims (`wobble_model::paper::CLAIMS`, from its
 //! sections 2-4) against the bundled model of its test bicycle, as
-//! `examples/identify.rs` identified it: the measured figures are met, 23
+//! `examples/identify.rs` identified it: the measured figures are met, 24
 //! of the 28 directions agree, each row's verdict is pinned (a
 //! change that turns a row either way fails here and the table of
 //! `host-tools/docs/model.md` has to follow), and that table has exactly
@@ -22,7 +22,7 @@ const LIGHT: &str = "paper-test-bicycle-light-rider.toml";
 /// Whether the model agrees, per row: the table of `model.md`.
 const PINNED: &[(&str, bool)] = &[
     ("2a", false),
-    ("2b", true),
+    ("2b", false),
     ("2c", true),
     ("2d", true),
     ("2e", true),
@@ -41,10 +41,10 @@ const PINNED: &[(&str, bool)] = &[
     ("4.2a", true),
     ("4.2b", true),
     ("4.2c", true),
-    ("4.2d", false),
+    ("4.2d", true),
     ("4.2e", true),
     ("4.2f", true),
-    ("4.3a", false),
+    ("4.3a", true),
     ("4.3b", false),
     ("4.3c", true),
     ("4.3d", true),
@@ -92,8 +92,8 @@ fn each_claim_of_the_paper_against_the_model() {
     assert!(changed.is_empty(), "verdicts changed: {changed:?}");
 }
 
-/// The identification's reach: every measured figure met, and 23 of the
-/// 28 directions.
+/// The identification's reach: every measured figure met, and 24 of the
+/// 28 directions, the 85 % the paper's bicycle was asked to reach.
 #[test]
 fn the_measured_figures_and_most_directions_agree() {
     let verdicts = verdicts();
@@ -108,23 +108,31 @@ fn the_measured_figures_and_most_directions_agree() {
         .filter(|(c, _)| c.kind == Kind::Direction)
         .map(|(_, v)| v.agrees)
         .collect();
-    // The issue asked for 85 % (24 of 28); the identification reaches 23
-    // of 28 in every variant tried (`model.md`, where the model does not
-    // follow the paper): no fewer may agree.
     let agree = directions.iter().filter(|a| **a).count();
-    assert!(agree >= 23, "{agree} of {} directions", directions.len());
+    assert!(
+        100 * agree >= 85 * directions.len(),
+        "{agree} of {} directions",
+        directions.len()
+    );
 }
 
-/// The candidate of the identification's reading of the paper
-/// (`identify/candidates/paper-reading.toml`, `model.md`): every measured
-/// figure met, and 24 of the 28 directions, the ones `model.md` names.
+/// The bundled bicycle is the identification's best: the candidate of its
+/// reading of the paper (`identify/candidates/paper-reading.toml`,
+/// `model.md`), which scores better than every variant's random-search
+/// best; the two files hold the same values.
 #[test]
-fn the_readings_candidate_agrees_with_24_directions() {
+fn the_bundled_bicycle_is_the_readings_candidate() {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("identify/candidates/paper-reading.toml");
-    let set = wobble_model::ParamSet::load(&path).unwrap();
+    let candidate = wobble_model::ParamSet::load(&path).unwrap();
+    let bundled = bundled(BIKE);
+    let keys: Vec<&str> = bundled.iter().map(|(k, _)| k).collect();
+    assert_eq!(keys, candidate.iter().map(|(k, _)| k).collect::<Vec<_>>());
+    for (key, q) in bundled.iter() {
+        assert_eq!(candidate.value(key).unwrap(), q.value, "{key}");
+    }
     let failing: Vec<&str> = CLAIMS
         .iter()
-        .zip(verdicts_of(&set))
+        .zip(verdicts_of(&candidate))
         .filter(|(_, v)| !v.agrees)
         .map(|(c, _)| c.id)
         .collect();
@@ -193,4 +201,48 @@ fn the_light_rider_file_is_the_bicycle_with_a_lighter_rider() {
     let get = |k: &str, u| set.get(k, u).unwrap();
     assert!((get("geometry.wheelbase", Unit::Length) - 1.095).abs() < 1e-12);
     assert!((get("geometry.steer_axis_tilt", Unit::Angle).to_degrees() - 19.0).abs() < 1e-9);
+}
+
+/// Row 4.2f follows the upper body's own root, not the branch the naming
+/// calls `lean`: on the bundled bicycle's overdamped lean, at 4 m/s, that
+/// branch is a front tyre lag's root crossing the lean's (its eigenvector
+/// almost all tyre lag), while the row's root moves the torso for a third
+/// of its angle and lag states. Both checked on eigenvectors computed here.
+#[test]
+fn the_lean_row_follows_the_upper_body_not_a_crossing_branch() {
+    use wobble_model::eig::eigenvector;
+    use wobble_model::paper::Figures;
+    use wobble_model::{Mode, Model, StateRole};
+    let model = Model::from_set(&bundled(BIKE)).unwrap();
+    let speeds: Vec<f64> = (0..=140).map(|i| f64::from(i) * 0.1).collect();
+    let f = Figures::of(&model, &speeds).unwrap();
+    let a = model.state_matrix(4.0);
+    let roles = model.state_roles();
+    let shares = |v| {
+        let x = eigenvector(&a, v);
+        let of = |want: StateRole| -> f64 {
+            roles
+                .iter()
+                .zip(x.iter())
+                .filter(|(r, _)| **r == want)
+                .map(|(_, c)| c.norm_sqr())
+                .sum()
+        };
+        let all: f64 = roles
+            .iter()
+            .zip(x.iter())
+            .filter(|(r, _)| **r != StateRole::Rate)
+            .map(|(_, c)| c.norm_sqr())
+            .sum();
+        (of(StateRole::Torso) / all, of(StateRole::Tyre) / all)
+    };
+    let lean = f.lean_at(4.0).unwrap();
+    let (torso, _) = shares(lean);
+    assert!(torso > 0.3, "{lean}: torso {torso}");
+    let named = f.value(Mode::Lean, 4.0).unwrap();
+    let (torso, tyre) = shares(named);
+    assert!(
+        torso < 0.01 && tyre > 0.99,
+        "{named}: torso {torso}, tyre {tyre}"
+    );
 }

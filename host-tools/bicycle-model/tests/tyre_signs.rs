@@ -241,7 +241,7 @@ fn twist_gravity_stiffness_through_the_forced_pitch() {
 /// wheel's compliance in series with the frame's, and a steel trekking
 /// frame is softer than that racing frame, so both test bicycles' head
 /// stiffness must lie below it; with it, the fork and wheel of the test
-/// bicycles would twist at no more than about 23-26 Hz with the frame locked
+/// bicycles would twist at no more than about 23-30 Hz with the frame locked
 /// (the paper's with its compliance lower on the steer axis, nearer the wheel).
 #[test]
 fn head_stiffness_below_a_measured_stiff_frame_alone() {
@@ -259,6 +259,6 @@ fn head_stiffness_below_a_measured_stiff_frame_alone() {
         let bound = ((frame_alone + gravity) / inertia).sqrt() / std::f64::consts::TAU;
         let own = ((k + gravity) / inertia).sqrt() / std::f64::consts::TAU;
         println!("{file}: head {k} N m/rad, {own:.2} Hz frame locked; a frame as stiff as the measured one: {bound:.2} Hz");
-        assert!(own < bound && bound < 27.0, "{file}: {own} / {bound} Hz");
+        assert!(own < bound && bound < 30.0, "{file}: {own} / {bound} Hz");
     }
 }

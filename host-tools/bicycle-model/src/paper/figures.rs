@@ -6,7 +6,8 @@ use std::f64::consts::TAU;
 use nalgebra::Complex;
 
 use crate::critical::{critical_speeds, CriticalSpeed};
-use crate::model::Model;
+use crate::eig::eigen;
+use crate::model::{Model, StateRole};
 use crate::sweep::{Mode, Sweep, SweepError};
 
 /// Speeds from 0 to 14 m/s every `step` m/s (the range the paper's
@@ -24,6 +25,7 @@ pub struct Figures {
     pub sweep: Sweep,
     /// Where each named mode's real part changes sign.
     pub critical: Vec<CriticalSpeed>,
+    model: Model,
 }
 
 impl Figures {
@@ -34,7 +36,11 @@ impl Figures {
     pub fn of(model: &Model, speeds: &[f64]) -> Result<Self, SweepError> {
         let sweep = Sweep::run(model, speeds, |_| {})?;
         let critical = critical_speeds(model, &sweep);
-        Ok(Self { sweep, critical })
+        Ok(Self {
+            sweep,
+            critical,
+            model: model.clone(),
+        })
     }
 
     /// The first speed where `mode` turns unstable (`unstable_above`) or
@@ -84,6 +90,40 @@ impl Figures {
         let (lo, hi) = (s.get(k - 1)?, s.get(k)?);
         let t = (u - lo) / (hi - lo);
         Some(branch.values[k - 1] * (1.0 - t) + branch.values[k] * t)
+    }
+
+    /// The rider's lean at `u` m/s, from the state matrix rather than the
+    /// naming: of the eigenvalues there (the upper member of a pair), the
+    /// one whose eigenvector gives the torso the largest share of its angle
+    /// and tyre-lag states. An overdamped lean is real roots that a tyre
+    /// lag's root crosses, so a branch named `lean` over the sweep can be
+    /// that lag's root at a given speed; this is the upper body's own (a
+    /// share of the angles alone would take a root of the tyre lags whose
+    /// tiny angles happen to be mostly torso). `None` without a torso.
+    #[must_use]
+    pub fn lean_at(&self, u: f64) -> Option<Complex<f64>> {
+        let roles = self.model.state_roles();
+        let torso_share = |v: &nalgebra::DVector<Complex<f64>>| {
+            let (mut torso, mut all) = (0.0, 0.0);
+            for (r, c) in roles.iter().zip(v.iter()) {
+                match r {
+                    StateRole::Rate => {}
+                    StateRole::Torso => {
+                        torso += c.norm_sqr();
+                        all += c.norm_sqr();
+                    }
+                    _ => all += c.norm_sqr(),
+                }
+            }
+            torso / all.max(f64::MIN_POSITIVE)
+        };
+        eigen(&self.model.state_matrix(u))?
+            .into_iter()
+            .filter(|e| e.value.im >= 0.0)
+            .map(|e| (e.value, torso_share(&e.vector)))
+            .filter(|(_, s)| *s > 0.0)
+            .max_by(|a, b| a.1.total_cmp(&b.1))
+            .map(|(v, _)| v)
     }
 
     /// The frequency of `mode` at `u`, Hz (NaN if there is none).
