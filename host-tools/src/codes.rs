@@ -24,10 +24,12 @@ use wobble_core::gps::{
     FAULT_CHECKSUM, FAULT_FRAMING, FAULT_NO_CHECKSUM, FAULT_OUT_OF_RANGE, FAULT_OVERLONG,
     FAULT_UNPARSEABLE,
 };
-use wobble_core::logger::{FAULT_CARD_ABSENT, FAULT_CARD_FULL, FAULT_CARD_WRITE};
+use wobble_core::logger::{
+    FAULT_CARD_ABSENT, FAULT_CARD_FORMAT, FAULT_CARD_FULL, FAULT_CARD_WRITE,
+};
 
 /// Every fault code the firmware records: (source, code, meaning).
-pub const FAULT_MEANINGS: [(FaultSource, u8, &str); 36] = [
+pub const FAULT_MEANINGS: [(FaultSource, u8, &str); 37] = [
     (
         FaultSource::Imu,
         FAULT_IMU_NO_RESPONSE,
@@ -90,6 +92,11 @@ pub const FAULT_MEANINGS: [(FaultSource, u8, &str); 36] = [
     ),
     (FaultSource::Card, FAULT_CARD_WRITE, "a block write failed"),
     (FaultSource::Card, FAULT_CARD_FULL, "card full"),
+    (
+        FaultSource::Card,
+        FAULT_CARD_FORMAT,
+        "card without a FAT16 or FAT32 volume (exFAT, GPT or unformatted): format it FAT32",
+    ),
     (
         FaultSource::Config,
         FAULT_SYNTAX,

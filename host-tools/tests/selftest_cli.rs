@@ -36,6 +36,7 @@ fn a_report_is_printed_with_its_failures_named() {
         gps_rate_hz: 20,
         card_kib_s: Some((700, 1500)),
         card_free_mib: 7_000,
+        card_unusable: false,
         crystal: true,
         reset: Some(ResetCause::Watchdog),
         bor: Some(BorCheck::Level3),

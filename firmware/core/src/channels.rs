@@ -133,14 +133,37 @@ impl RecordQueue {
     }
 }
 
+/// The writer's card, as the sampler shows it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(u32)]
+pub enum CardHealth {
+    /// No file open: no card, or none that answers.
+    Absent = 0,
+    /// Logging to a file.
+    Logging = 1,
+    /// A card that answers without a FAT16 or FAT32 volume.
+    Unusable = 2,
+}
+
+impl From<crate::logger::LoggerState> for CardHealth {
+    fn from(state: crate::logger::LoggerState) -> Self {
+        use crate::logger::LoggerState;
+        match state {
+            LoggerState::NoCard => Self::Absent,
+            LoggerState::UnusableCard => Self::Unusable,
+            LoggerState::Logging { .. } => Self::Logging,
+        }
+    }
+}
+
 /// Small facts the tasks share, each a single word (no 64-bit atomics on
 /// the Cortex-M4).
 pub struct SharedStatus {
     /// Local time of the last GPS fix with a position, ms since boot; 0:
     /// none yet.
     last_fix_ms: AtomicU32,
-    /// Whether the writer has a file open on a card (0/1).
-    card_ok: AtomicU32,
+    /// Where the writer stands ([`CardHealth`] as a number).
+    card: AtomicU32,
     /// Whether the writer should close the log (0/1).
     stop: AtomicU32,
 }
@@ -157,7 +180,7 @@ impl SharedStatus {
     pub const fn new() -> Self {
         Self {
             last_fix_ms: AtomicU32::new(0),
-            card_ok: AtomicU32::new(0),
+            card: AtomicU32::new(0),
             stop: AtomicU32::new(0),
         }
     }
@@ -178,14 +201,18 @@ impl SharedStatus {
         }
     }
 
-    /// The writer reports whether it is logging to a card.
-    pub fn set_card_ok(&self, ok: bool) {
-        self.card_ok.store(u32::from(ok), Ordering::Relaxed);
+    /// The writer reports where it stands.
+    pub fn set_card(&self, health: CardHealth) {
+        self.card.store(health as u32, Ordering::Relaxed);
     }
 
-    /// Whether the writer is logging to a card.
-    pub fn card_ok(&self) -> bool {
-        self.card_ok.load(Ordering::Relaxed) != 0
+    /// Where the writer stands.
+    pub fn card(&self) -> CardHealth {
+        match self.card.load(Ordering::Relaxed) {
+            1 => CardHealth::Logging,
+            2 => CardHealth::Unusable,
+            _ => CardHealth::Absent,
+        }
     }
 
     /// Asks the writer to write what is queued, close the file and return
@@ -389,6 +416,23 @@ mod tests {
         match q.try_pop() {
             Some(Record::Dropout(d)) => assert_eq!(d.frames_lost, 1),
             other => panic!("{other:?}"),
+        }
+    }
+
+    /// The sampler sees the writer's card as the logger stands: an exFAT
+    /// card is not shown as a missing one.
+    #[test]
+    fn the_card_is_shared_as_the_logger_stands() {
+        use crate::logger::LoggerState;
+        let shared = SharedStatus::new();
+        assert_eq!(shared.card(), CardHealth::Absent);
+        for (state, want) in [
+            (LoggerState::Logging { run: 3 }, CardHealth::Logging),
+            (LoggerState::UnusableCard, CardHealth::Unusable),
+            (LoggerState::NoCard, CardHealth::Absent),
+        ] {
+            shared.set_card(state.into());
+            assert_eq!(shared.card(), want);
         }
     }
 }

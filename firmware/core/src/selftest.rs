@@ -124,6 +124,9 @@ pub struct Measurements {
     pub card_kib_s: Option<(u32, u32)>,
     /// Free space on the card, MiB.
     pub card_free_mib: u32,
+    /// The card answered but holds no FAT16 or FAT32 volume the logger can
+    /// write (exFAT, GPT, unformatted).
+    pub card_unusable: bool,
     /// Whether the crystal runs (else the HSI).
     pub crystal: bool,
     /// Why the MCU last reset.
@@ -276,6 +279,9 @@ impl Check {
                 Some(b) => write!(out, "found_baud={b} rate_hz={}", m.gps_rate_hz),
             },
             Self::Card => match m.card_kib_s {
+                None if m.card_unusable => out.write_str(
+                    "no FAT16 or FAT32 volume (exFAT, GPT or unformatted): format it FAT32",
+                ),
                 None => out.write_str("not readable"),
                 Some((w, r)) => write!(
                     out,
@@ -452,6 +458,7 @@ mod tests {
             gps_rate_hz: 20,
             card_kib_s: Some((900, 1800)),
             card_free_mib: 30_000,
+            card_unusable: false,
             crystal: true,
             reset: Some(ResetCause::PowerOn),
             bor: Some(BorCheck::Level3),
@@ -561,6 +568,32 @@ mod tests {
             text.ends_with("imu_drdy PASS pulses=100 period_us=10150 longest_gap_us=10150\n"),
             "{text}"
         );
+    }
+
+    /// An exFAT card fails the card check with what to do about it, not
+    /// as a card that cannot be read; the failure code is the card's (5).
+    #[test]
+    fn an_unusable_card_is_named_in_the_report() {
+        let unusable = Measurements {
+            card_kib_s: None,
+            card_free_mib: 0,
+            card_unusable: true,
+            ..good()
+        };
+        let mut text = String::new();
+        write_report(&unusable, &mut text).unwrap();
+        assert!(
+            text.contains("\ncard FAIL no FAT16 or FAT32 volume (exFAT, GPT or unformatted): format it FAT32\n"),
+            "{text}"
+        );
+        assert_eq!(failure_code(&unusable), 5);
+        let silent = Measurements {
+            card_unusable: false,
+            ..unusable
+        };
+        let mut text = String::new();
+        write_report(&silent, &mut text).unwrap();
+        assert!(text.contains("\ncard FAIL not readable\n"), "{text}");
     }
 
     #[test]

@@ -11,7 +11,7 @@ use wobble_core::format::{
 use wobble_core::logger::mock::MockCard;
 use wobble_core::logger::{
     CardLogger, FixedTime, HeaderSpec, LoggerConfig, LoggerState, FAULT_CARD_ABSENT,
-    FAULT_CARD_FULL, FAULT_CARD_WRITE,
+    FAULT_CARD_FORMAT, FAULT_CARD_FULL, FAULT_CARD_WRITE,
 };
 
 /// Partition start: one MBR sector, then the FAT32 volume.
@@ -259,6 +259,68 @@ fn card_absent_at_boot_is_reported_with_the_exact_loss() {
     assert_eq!(d.dropouts[0].frames_lost, 400);
     assert_eq!(d.frames.len(), 200);
     assert_eq!(d.frames[0], 400 * FRAME_PERIOD_US);
+}
+
+/// A card as an SDXC card ships: an MBR whose first partition is exFAT
+/// (type 0x07), its boot sector `EXFAT   ` (which embedded-sdmmc cannot
+/// read).
+fn exfat_image() -> Vec<u8> {
+    let mut image = vec![0u8; 1 << 20];
+    let entry = &mut image[446..462];
+    entry[4] = 0x07;
+    entry[8..12].copy_from_slice(&1u32.to_le_bytes());
+    entry[12..16].copy_from_slice(&2047u32.to_le_bytes());
+    image[510] = 0x55;
+    image[511] = 0xAA;
+    image[512 + 3..512 + 11].copy_from_slice(b"EXFAT   ");
+    image[1022] = 0x55;
+    image[1023] = 0xAA;
+    image
+}
+
+/// An exFAT card is not a missing card: the logger says the card is
+/// unusable (its own fault code and state, so the LED and the self-test can
+/// tell the rider to format it), never writes to it, and once the card is
+/// formatted FAT32 logs with the attempts and the frames lost meanwhile on
+/// record. A GPT card (protective MBR, type 0xEE) and a card without an MBR
+/// are unusable too.
+#[test]
+fn an_exfat_card_is_unusable_not_absent_and_never_written() {
+    let card = MockCard::new(exfat_image());
+    let mut log = logger(card);
+    run(&mut log, 0, 350);
+    assert_eq!(log.state(), LoggerState::UnusableCard);
+    assert_eq!(log.stats().faults[usize::from(FAULT_CARD_FORMAT) - 1], 4);
+    assert_eq!(log.stats().faults[usize::from(FAULT_CARD_ABSENT) - 1], 0);
+    log.with_device(|c| {
+        assert_eq!(c.writes(), 0);
+        assert_eq!(c.image(), exfat_image());
+        c.set_image(fat32_image());
+    });
+    run(&mut log, 350, 600);
+    assert_eq!(log.state(), LoggerState::Logging { run: 1 });
+    log.close(600 * FRAME_PERIOD_US).expect("close");
+    let image = log.with_device(|c| c.image());
+    let d = decode(&read_file(&image, "RUN00001.WBL").expect("file"));
+    assert_eq!(d.card_faults, [(FAULT_CARD_FORMAT, 4)]);
+    assert_eq!(d.dropouts[0].reason, DropoutReason::CardUnavailable);
+    assert_eq!(d.dropouts[0].frames_lost, 400);
+
+    let mut gpt = exfat_image();
+    gpt[446 + 4] = 0xEE;
+    let mut bare = exfat_image();
+    bare[510] = 0;
+    for image in [gpt, bare] {
+        let mut log = logger(MockCard::new(image));
+        run(&mut log, 0, 10);
+        assert_eq!(log.state(), LoggerState::UnusableCard);
+    }
+    // A card pulled out is still a missing card.
+    let card = MockCard::new(exfat_image());
+    card.set_removed(true);
+    let mut log = logger(card);
+    run(&mut log, 0, 10);
+    assert_eq!(log.state(), LoggerState::NoCard);
 }
 
 #[test]

@@ -225,6 +225,12 @@ pub async fn run(p: Parts) -> ! {
     m.stack_bytes = Some(crate::startup::stack_use());
     let volumes = Volumes::new_with_limits(card, FixedTime::EPOCH, 0);
     m.card_free_mib = volumes.device(|card| fat32_free_mib(card)).unwrap_or(0);
+    // The volume, opened and dropped (closed) at once: what the logger's
+    // `open_fault` calls an unusable card.
+    m.card_unusable = matches!(
+        volumes.open_volume(VolumeIdx(0)),
+        Err(embedded_sdmmc::Error::FormatError(_))
+    );
     m.card_kib_s = card_speed(&volumes);
     let mut text = heapless::String::<640>::new();
     if write_report(&m, &mut text).is_err() {

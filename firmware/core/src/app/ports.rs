@@ -116,6 +116,34 @@ pub enum LoggerHealth {
     Degraded,
     /// No card: sampling and alerting go on, nothing is recorded.
     NoCard,
+    /// A card without a FAT16 or FAT32 volume (exFAT, say): as without a
+    /// card, until it is formatted FAT32.
+    UnusableCard,
+}
+
+/// Frames per blink half-period: degraded blinks at 1 Hz, no card at 5 Hz.
+const DEGRADED_HALF_FRAMES: u32 = 50;
+const NO_CARD_HALF_FRAMES: u32 = 10;
+
+impl LoggerHealth {
+    /// Whether the status LED is lit at frame `frame` (100 per second):
+    /// steady while logging with every sensor fine, a 1 Hz blink when a
+    /// sensor fails or the GPS has no fix, 5 Hz without a card, and with a
+    /// card it cannot use two of the 5 Hz blinks, then dark to the
+    /// second's end (exFAT: format it FAT32).
+    #[must_use]
+    pub fn led_on(self, frame: u32) -> bool {
+        let blink = |half: u32| (frame / half) & 1 == 0;
+        match self {
+            Self::Ok => true,
+            Self::Degraded => blink(DEGRADED_HALF_FRAMES),
+            Self::NoCard => blink(NO_CARD_HALF_FRAMES),
+            Self::UnusableCard => {
+                frame % (10 * NO_CARD_HALF_FRAMES) < 4 * NO_CARD_HALF_FRAMES
+                    && blink(NO_CARD_HALF_FRAMES)
+            }
+        }
+    }
 }
 
 /// The status LED (separate from the alert LED of [`AlertOutput`]).
@@ -123,4 +151,48 @@ pub trait StatusLed {
     /// Shows `health`; called once per frame, so it should only act on
     /// changes.
     fn show(&mut self, health: LoggerHealth);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::LoggerHealth;
+
+    /// Lit frames of one second (100 frames), as on/off runs.
+    fn runs(health: LoggerHealth) -> std::vec::Vec<(bool, u32)> {
+        let mut out: std::vec::Vec<(bool, u32)> = std::vec::Vec::new();
+        for frame in 0..100 {
+            let on = health.led_on(frame);
+            match out.last_mut() {
+                Some((last, n)) if *last == on => *n += 1,
+                _ => out.push((on, 1)),
+            }
+        }
+        out
+    }
+
+    /// Each state has its own pattern a rider can tell apart: steady, one
+    /// 0.5 s flash a second, five 0.1 s flashes, two 0.1 s flashes; and the
+    /// pattern repeats every second.
+    #[test]
+    fn each_health_blinks_its_own_pattern() {
+        assert_eq!(runs(LoggerHealth::Ok), [(true, 100)]);
+        assert_eq!(runs(LoggerHealth::Degraded), [(true, 50), (false, 50)]);
+        assert_eq!(
+            runs(LoggerHealth::NoCard),
+            [(true, 10), (false, 10)].repeat(5)
+        );
+        assert_eq!(
+            runs(LoggerHealth::UnusableCard),
+            [(true, 10), (false, 10), (true, 10), (false, 70)]
+        );
+        for health in [
+            LoggerHealth::Degraded,
+            LoggerHealth::NoCard,
+            LoggerHealth::UnusableCard,
+        ] {
+            for frame in 0..300 {
+                assert_eq!(health.led_on(frame), health.led_on(frame + 100));
+            }
+        }
+    }
 }

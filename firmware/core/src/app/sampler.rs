@@ -17,7 +17,7 @@ use super::ports::{
     AlertOutput, ImuPort, ImuSample, LoggerHealth, MarkerInput, SensorError, StatusLed,
     SteeringPort, SteeringSample, WheelPort,
 };
-use crate::channels::{RecordQueue, SharedStatus};
+use crate::channels::{CardHealth, RecordQueue, SharedStatus};
 use crate::config::AlertConfig;
 use crate::detector::{AlertEvent, AlertPattern, Detector, MarginEvent, MarginWarning};
 use crate::faults::FaultCounter;
@@ -305,10 +305,11 @@ pub async fn run<I, S, W, M, A, L>(
             on_alert(scheduled_us, ev);
         }
         let degraded = sampler.status.0 & DEGRADED != 0;
-        ports.status_led.show(match (shared.card_ok(), degraded) {
-            (false, _) => LoggerHealth::NoCard,
-            (true, true) => LoggerHealth::Degraded,
-            (true, false) => LoggerHealth::Ok,
+        ports.status_led.show(match (shared.card(), degraded) {
+            (CardHealth::Absent, _) => LoggerHealth::NoCard,
+            (CardHealth::Unusable, _) => LoggerHealth::UnusableCard,
+            (CardHealth::Logging, true) => LoggerHealth::Degraded,
+            (CardHealth::Logging, false) => LoggerHealth::Ok,
         });
     }
 }

@@ -7,7 +7,7 @@ use embassy_time::{Instant, Timer};
 use embedded_sdmmc::{BlockDevice, TimeSource};
 
 use crate::channels::{RecordQueue, SharedStatus};
-use crate::logger::{CardLogger, CloseError, LoggerState};
+use crate::logger::{CardLogger, CloseError};
 
 /// Longest wait for a record before the logger is polled anyway (flushes
 /// and card retries happen even if the producers go quiet).
@@ -28,7 +28,7 @@ pub async fn run<D: BlockDevice, T: TimeSource>(
         // Polled before the first record too: the card is opened at boot,
         // while the queue holds what the sampler makes meanwhile.
         logger.poll(Instant::now().as_micros());
-        shared.set_card_ok(matches!(logger.state(), LoggerState::Logging { .. }));
+        shared.set_card(logger.state().into());
         let next = select(queue.pop(), Timer::after_millis(IDLE_POLL_MS)).await;
         if let Either::First(rec) = next {
             logger.push(&rec, Instant::now().as_micros());

@@ -101,6 +101,12 @@ impl MockCard {
         self.reads.get()
     }
 
+    /// Replaces the card's contents (the rider formats it elsewhere and
+    /// puts it back).
+    pub fn set_image(&self, image: Vec<u8>) {
+        *self.image.borrow_mut() = image;
+    }
+
     /// A copy of the card's contents.
     pub fn image(&self) -> Vec<u8> {
         self.image.borrow().clone()

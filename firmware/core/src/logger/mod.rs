@@ -43,17 +43,23 @@ use crate::format::{
     Block, BlockEncoder, Dropout, DropoutReason, Fault, FaultSource, LogInfo, Record, BLOCK_LEN,
 };
 
-/// Card fault 1: no usable card: none inserted, not answering, or without a
-/// FAT volume (seen when opening the card at boot or on a retry). The
-/// record's count is the number of failed attempts.
+/// Card fault 1: no card: none inserted, or one that does not answer (seen
+/// when opening the card at boot or on a retry). The record's count is the
+/// number of failed attempts.
 pub const FAULT_CARD_ABSENT: u8 = 1;
 /// Card fault 2: a write or flush failed while logging (card removed or
 /// broken). Frames not yet on the card at that moment are counted as lost.
 pub const FAULT_CARD_WRITE: u8 = 2;
 /// Card fault 3: the card is full.
 pub const FAULT_CARD_FULL: u8 = 3;
+/// Card fault 4: the card answers, but its first partition holds no FAT16
+/// or FAT32 volume the logger can write: exFAT (every SDXC card, 64 GB and
+/// up, ships so), a GPT or unpartitioned card, a damaged boot sector. It
+/// must be formatted FAT32 (`firmware/docs/board.md`). Counted per
+/// attempt, as [`FAULT_CARD_ABSENT`].
+pub const FAULT_CARD_FORMAT: u8 = 4;
 /// Number of card fault codes (`1..=FAULT_CARD_CODES`).
-pub const FAULT_CARD_CODES: usize = 3;
+pub const FAULT_CARD_CODES: usize = 4;
 
 /// Highest run number a short file name `RUNnnnnn.WBL` can hold.
 pub const MAX_RUN: u32 = 99_999;
@@ -127,6 +133,9 @@ impl TimeSource for FixedTime {
 pub enum LoggerState {
     /// No file open: waiting for the next attempt to open a card.
     NoCard,
+    /// No file open: the card answers but holds no FAT16 or FAT32 volume
+    /// ([`FAULT_CARD_FORMAT`]); tried again like a missing card.
+    UnusableCard,
     /// Writing `RUNnnnnn.WBL` with this run number.
     Logging {
         /// The run number of the open file.
@@ -193,6 +202,8 @@ pub struct CardLogger<'a, D: BlockDevice, T: TimeSource> {
     /// Fault counts not yet on a card, by code.
     faults_unreported: [u16; FAULT_CARD_CODES],
     stats: LoggerStats,
+    /// The last attempt to open the card found it unusable.
+    unusable: bool,
 }
 
 #[derive(Clone, Copy, Debug)]
@@ -201,6 +212,15 @@ struct OpenFile {
     dir: RawDirectory,
     file: RawFile,
     run: u32,
+}
+
+/// Why the card's volume could not be opened: a card that answered with
+/// something other than a FAT16 or FAT32 volume, or none that answered.
+fn open_fault<E: core::fmt::Debug + core::error::Error>(err: &FsError<E>) -> u8 {
+    match err {
+        FsError::FormatError(_) => FAULT_CARD_FORMAT,
+        _ => FAULT_CARD_ABSENT,
+    }
 }
 
 /// What made a card operation fail, reduced to the fault it stands for.
@@ -226,6 +246,7 @@ impl<'a, D: BlockDevice, T: TimeSource> CardLogger<'a, D, T> {
             frames_written: 0,
             faults_unreported: [0; FAULT_CARD_CODES],
             stats: LoggerStats::default(),
+            unusable: false,
         }
     }
 
@@ -233,6 +254,7 @@ impl<'a, D: BlockDevice, T: TimeSource> CardLogger<'a, D, T> {
     pub fn state(&self) -> LoggerState {
         match self.open {
             Some(f) => LoggerState::Logging { run: f.run },
+            None if self.unusable => LoggerState::UnusableCard,
             None => LoggerState::NoCard,
         }
     }
@@ -398,11 +420,17 @@ impl<'a, D: BlockDevice, T: TimeSource> CardLogger<'a, D, T> {
     /// then the fault and dropout records of what happened without a card.
     fn try_open(&mut self, now_us: u64) {
         let retry_at = now_us.saturating_add(u64::from(self.config.retry_period_ms) * 1000);
-        let Ok(volume) = self.fs.open_raw_volume(VolumeIdx(0)) else {
-            self.count_fault(FAULT_CARD_ABSENT);
-            self.next_try_us = retry_at;
-            return;
+        let volume = match self.fs.open_raw_volume(VolumeIdx(0)) {
+            Ok(volume) => volume,
+            Err(e) => {
+                let code = open_fault(&e);
+                self.unusable = code == FAULT_CARD_FORMAT;
+                self.count_fault(code);
+                self.next_try_us = retry_at;
+                return;
+            }
         };
+        self.unusable = false;
         let opened = self
             .fs
             .open_root_dir(volume)

@@ -34,12 +34,7 @@ impl MarkerInput for MarkerButton {
     }
 }
 
-/// Frames per blink half-period: degraded blinks at 1 Hz, no card at 5 Hz.
-const DEGRADED_HALF_FRAMES: u32 = 50;
-const NO_CARD_HALF_FRAMES: u32 = 10;
-
-/// Status LED: steady on while logging with every sensor fine, slow blink
-/// when a sensor fails or the GPS has no fix, fast blink without a card.
+/// Status LED, as [`LoggerHealth::led_on`] says.
 /// Called once per frame, it is also the sampler's watchdog heartbeat.
 pub struct StatusLight {
     /// The LED.
@@ -52,11 +47,6 @@ impl StatusLed for StatusLight {
     fn show(&mut self, health: LoggerHealth) {
         crate::watchdog::SAMPLER.beat();
         self.frames = self.frames.wrapping_add(1);
-        let on = match health {
-            LoggerHealth::Ok => true,
-            LoggerHealth::Degraded => (self.frames / DEGRADED_HALF_FRAMES) & 1 == 0,
-            LoggerHealth::NoCard => (self.frames / NO_CARD_HALF_FRAMES) & 1 == 0,
-        };
-        self.led.set_level(on.into());
+        self.led.set_level(health.led_on(self.frames).into());
     }
 }
