@@ -412,34 +412,70 @@ pub fn read_report<'a>(
     Ok(())
 }
 
-/// Free space of the card's first partition, MiB, from its FAT32 FSInfo
-/// sector: the free-cluster count the file system last recorded (kept by
-/// every FAT driver; embedded-sdmmc has no free-space query of its own).
-/// `None` for anything but a FAT32 volume with a known count.
-pub fn fat32_free_mib<D: BlockDevice>(card: &D) -> Option<u32> {
+/// Free space of the card's first partition, MiB, counted in its first
+/// FAT: the clusters whose entry is 0, FAT16 or FAT32 (embedded-sdmmc has
+/// no free-space query of its own). Not FAT32's FSInfo count: the FAT
+/// specification calls it a hint that may be stale, and a driver that
+/// filled the card may leave it anything. `None` for anything but a FAT16
+/// or FAT32 volume on 512-byte sectors, or a FAT that cannot be read. One
+/// block read per 128 (FAT32) or 256 (FAT16) clusters: some 8000 reads on
+/// a 32 GB card of 32 KiB clusters.
+pub fn fat_free_mib<D: BlockDevice>(card: &D) -> Option<u32> {
     let mut block = [Block::new()];
     let mut read = |idx: u32| -> Option<[u8; 512]> {
         card.read(&mut block, BlockIdx(idx)).ok()?;
         Some(block[0].contents)
     };
-    let u16_at = |b: &[u8; 512], at: usize| u16::from_le_bytes([b[at], b[at + 1]]);
+    let u16_at = |b: &[u8; 512], at: usize| u32::from(u16::from_le_bytes([b[at], b[at + 1]]));
     let u32_at =
         |b: &[u8; 512], at: usize| u32::from_le_bytes([b[at], b[at + 1], b[at + 2], b[at + 3]]);
     // MBR: partition entry 0 at 446, its first block at +8.
     let mbr = read(0)?;
     let start = u32_at(&mbr, 446 + 8);
     let boot = read(start)?;
-    if u16_at(&boot, 11) != 512 || boot[13] == 0 {
+    let per_cluster = u32::from(boot[13]);
+    if u16_at(&boot, 11) != 512 || per_cluster == 0 || boot[16] == 0 {
         return None;
     }
-    let sectors_per_cluster = u32::from(boot[13]);
-    let fsinfo = read(start.checked_add(u32::from(u16_at(&boot, 48)))?)?;
-    let signed = u32_at(&fsinfo, 0) == 0x4161_5252 && u32_at(&fsinfo, 484) == 0x6141_7272;
-    let free_clusters = u32_at(&fsinfo, 488);
-    if !signed || free_clusters == u32::MAX {
+    // The BIOS parameter block (FAT specification, section 3): 16-bit
+    // fields where they are not 0, else their 32-bit FAT32 successors.
+    let or32 = |small: u32, large: u32| if small != 0 { small } else { large };
+    let fat_sectors = or32(u16_at(&boot, 22), u32_at(&boot, 36));
+    let total = or32(u16_at(&boot, 19), u32_at(&boot, 32));
+    let reserved = u16_at(&boot, 14);
+    let root_sectors = (u16_at(&boot, 17) * 32).div_ceil(512);
+    let meta = reserved
+        .checked_add(u32::from(boot[16]).checked_mul(fat_sectors)?)?
+        .checked_add(root_sectors)?;
+    let clusters = total.checked_sub(meta)? / per_cluster;
+    // The type follows from the cluster count alone (section 3.5).
+    let entry_bytes: u32 = match clusters {
+        0..4085 => return None,
+        4085..65525 => 2,
+        _ => 4,
+    };
+    if u64::from(clusters + 2) * u64::from(entry_bytes) > u64::from(fat_sectors) * 512 {
         return None;
     }
-    let free_bytes = u64::from(free_clusters) * u64::from(sectors_per_cluster) * 512;
+    let fat = start.checked_add(reserved)?;
+    let mut free = 0u32;
+    let mut sector = None;
+    let mut data = [0u8; 512];
+    for cluster in 2..clusters + 2 {
+        let at = cluster * entry_bytes;
+        if sector != Some(at / 512) {
+            sector = Some(at / 512);
+            data = read(fat.checked_add(at / 512)?)?;
+        }
+        let i = (at % 512) as usize;
+        let entry = if entry_bytes == 2 {
+            u16_at(&data, i)
+        } else {
+            u32_at(&data, i) & 0x0FFF_FFFF
+        };
+        free += u32::from(entry == 0);
+    }
+    let free_bytes = u64::from(free) * u64::from(per_cluster) * 512;
     u32::try_from(free_bytes >> 20).ok()
 }
 

@@ -23,7 +23,7 @@ use wobble_core::boot::ResetCause;
 use wobble_core::detector::math::sqrtf;
 use wobble_core::logger::{FixedTime, Volumes};
 use wobble_core::selftest::{
-    failure_code, fat32_free_mib, write_report, Measurements, PulseTrain, DATA_READY_WINDOW_US,
+    failure_code, fat_free_mib, write_report, Measurements, PulseTrain, DATA_READY_WINDOW_US,
     TEST_WINDOW_US,
 };
 
@@ -224,7 +224,7 @@ pub async fn run(p: Parts) -> ! {
     m.bor = Some(crate::startup::program_bor_level3());
     m.stack_bytes = Some(crate::startup::stack_use());
     let volumes = Volumes::new_with_limits(card, FixedTime::EPOCH, 0);
-    m.card_free_mib = volumes.device(|card| fat32_free_mib(card)).unwrap_or(0);
+    m.card_free_mib = volumes.device(|card| fat_free_mib(card)).unwrap_or(0);
     // The volume, opened and dropped (closed) at once: what the logger's
     // `open_fault` calls an unusable card.
     m.card_unusable = matches!(
