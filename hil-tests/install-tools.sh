@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Installs, once, what building and running the firmware under QEMU needs:
-# the ARM target, qemu-system-arm, dosfstools (mkfs.fat, fsck.fat), llvm
+# the ARM target, qemu-system-arm, dosfstools (mkfs.fat, fsck.fat), exfatprogs
+# (mkfs.exfat), llvm
 # (llvm-objdump, for the stack bound), and
 # the Python packages the host tests read outputs with.
 # Sourced by demo.sh and test-all.sh; does nothing when all is there.
@@ -9,6 +10,7 @@ rustup target list --installed | grep -qx "$TARGET" || rustup target add "$TARGE
 missing=()
 command -v qemu-system-arm >/dev/null || missing+=(qemu-system-arm)
 { command -v mkfs.fat && command -v fsck.fat; } >/dev/null || missing+=(dosfstools)
+command -v mkfs.exfat >/dev/null || missing+=(exfatprogs)  # the card-format tests
 command -v llvm-objdump >/dev/null || missing+=(llvm)  # the stack bound
 if ((${#missing[@]})); then
     SUDO=""

@@ -143,6 +143,8 @@ pub enum CardHealth {
     Logging = 1,
     /// A card that answers without a FAT16 or FAT32 volume.
     Unusable = 2,
+    /// A full card.
+    Full = 3,
 }
 
 impl From<crate::logger::LoggerState> for CardHealth {
@@ -151,6 +153,7 @@ impl From<crate::logger::LoggerState> for CardHealth {
         match state {
             LoggerState::NoCard => Self::Absent,
             LoggerState::UnusableCard => Self::Unusable,
+            LoggerState::CardFull => Self::Full,
             LoggerState::Logging { .. } => Self::Logging,
         }
     }
@@ -211,6 +214,7 @@ impl SharedStatus {
         match self.card.load(Ordering::Relaxed) {
             1 => CardHealth::Logging,
             2 => CardHealth::Unusable,
+            3 => CardHealth::Full,
             _ => CardHealth::Absent,
         }
     }
@@ -429,6 +433,7 @@ mod tests {
         for (state, want) in [
             (LoggerState::Logging { run: 3 }, CardHealth::Logging),
             (LoggerState::UnusableCard, CardHealth::Unusable),
+            (LoggerState::CardFull, CardHealth::Full),
             (LoggerState::NoCard, CardHealth::Absent),
         ] {
             shared.set_card(state.into());

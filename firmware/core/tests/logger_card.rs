@@ -392,7 +392,8 @@ fn full_card_keeps_logging_and_counts_the_loss() {
     fill_card(&mut image, 16 * 1024);
     let mut log = logger(MockCard::new(image));
     run(&mut log, 0, 2000);
-    assert_eq!(log.state(), LoggerState::NoCard);
+    // Shown as full, not as missing (the LED's own pattern).
+    assert_eq!(log.state(), LoggerState::CardFull);
     let stats = log.stats();
     assert!(stats.faults[usize::from(FAULT_CARD_FULL) - 1] >= 1);
     let image = log.with_device(|c| c.image());
@@ -416,7 +417,9 @@ fn full_card_keeps_logging_and_counts_the_loss() {
 
 /// A card whose run numbers are used up (`RUN99999.WBL` is there) is a full
 /// card, not a missing one: each attempt to open it counts as the full-card
-/// fault, and every frame meanwhile as lost.
+/// fault, and every frame meanwhile as lost; a full card is tried again
+/// only every `FULL_RETRY_PERIODS` retry periods (each attempt walks the
+/// FAT), and a card that has room again is logged to.
 #[test]
 fn a_card_out_of_run_numbers_counts_as_full() {
     let mut image = fat32_image();
@@ -424,9 +427,11 @@ fn a_card_out_of_run_numbers_counts_as_full() {
         fs.root_dir().create_file("RUN99999.WBL").expect("create");
     });
     let mut log = logger(MockCard::new(image));
-    // Three attempts, one per retry period.
-    run(&mut log, 0, 250);
-    assert_eq!(log.state(), LoggerState::NoCard);
+    // Attempts at 0, 10 and 20 s (a retry period of 1 s, ten of them).
+    let periods = wobble_core::logger::FULL_RETRY_PERIODS;
+    assert_eq!(periods, 10);
+    run(&mut log, 0, 2500);
+    assert_eq!(log.state(), LoggerState::CardFull);
     let stats = log.stats();
     assert_eq!(
         (
@@ -435,7 +440,17 @@ fn a_card_out_of_run_numbers_counts_as_full() {
         ),
         (3, 0)
     );
-    assert_eq!(stats.frames_lost, 250);
+    assert_eq!(stats.frames_lost, 2500);
+    // Emptied (the last run deleted): logging again at the next attempt.
+    log.with_device(|c| {
+        let mut image = c.image();
+        with_fs(&mut image, |fs| {
+            fs.root_dir().remove("RUN99999.WBL").expect("remove")
+        });
+        c.set_image(image);
+    });
+    run(&mut log, 2500, 3100);
+    assert_eq!(log.state(), LoggerState::Logging { run: 1 });
 }
 
 proptest! {
@@ -454,7 +469,9 @@ proptest! {
             let now = i * FRAME_PERIOD_US;
             log.poll(now);
             log.push(&frame(i), now);
-            if log.state() == LoggerState::NoCard {
+            // The card stops answering: shown as missing or, where a
+            // failed FAT read leaves no free cluster found, as full.
+            if !matches!(log.state(), LoggerState::Logging { .. }) {
                 cut_at = Some(i + 1);
                 break;
             }

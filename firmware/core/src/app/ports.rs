@@ -119,6 +119,8 @@ pub enum LoggerHealth {
     /// A card without a FAT16 or FAT32 volume (exFAT, say): as without a
     /// card, until it is formatted FAT32.
     UnusableCard,
+    /// A full card: as without a card, until it is swapped or emptied.
+    CardFull,
 }
 
 /// Frames per blink half-period: degraded blinks at 1 Hz, no card at 5 Hz.
@@ -128,9 +130,10 @@ const NO_CARD_HALF_FRAMES: u32 = 10;
 impl LoggerHealth {
     /// Whether the status LED is lit at frame `frame` (100 per second):
     /// steady while logging with every sensor fine, a 1 Hz blink when a
-    /// sensor fails or the GPS has no fix, 5 Hz without a card, and with a
+    /// sensor fails or the GPS has no fix, 5 Hz without a card, with a
     /// card it cannot use two of the 5 Hz blinks, then dark to the
-    /// second's end (exFAT: format it FAT32).
+    /// second's end (exFAT: format it FAT32), and with a full card lit but
+    /// for 0.1 s each second.
     #[must_use]
     pub fn led_on(self, frame: u32) -> bool {
         let blink = |half: u32| (frame / half) & 1 == 0;
@@ -142,6 +145,7 @@ impl LoggerHealth {
                 frame % (10 * NO_CARD_HALF_FRAMES) < 4 * NO_CARD_HALF_FRAMES
                     && blink(NO_CARD_HALF_FRAMES)
             }
+            Self::CardFull => frame % (10 * NO_CARD_HALF_FRAMES) >= NO_CARD_HALF_FRAMES,
         }
     }
 }
@@ -171,8 +175,8 @@ mod tests {
     }
 
     /// Each state has its own pattern a rider can tell apart: steady, one
-    /// 0.5 s flash a second, five 0.1 s flashes, two 0.1 s flashes; and the
-    /// pattern repeats every second.
+    /// 0.5 s flash a second, five 0.1 s flashes, two 0.1 s flashes, lit
+    /// but for 0.1 s; and the pattern repeats every second.
     #[test]
     fn each_health_blinks_its_own_pattern() {
         assert_eq!(runs(LoggerHealth::Ok), [(true, 100)]);
@@ -185,10 +189,12 @@ mod tests {
             runs(LoggerHealth::UnusableCard),
             [(true, 10), (false, 10), (true, 10), (false, 70)]
         );
+        assert_eq!(runs(LoggerHealth::CardFull), [(false, 10), (true, 90)]);
         for health in [
             LoggerHealth::Degraded,
             LoggerHealth::NoCard,
             LoggerHealth::UnusableCard,
+            LoggerHealth::CardFull,
         ] {
             for frame in 0..300 {
                 assert_eq!(health.led_on(frame), health.led_on(frame + 100));

@@ -308,6 +308,7 @@ pub async fn run<I, S, W, M, A, L>(
         ports.status_led.show(match (shared.card(), degraded) {
             (CardHealth::Absent, _) => LoggerHealth::NoCard,
             (CardHealth::Unusable, _) => LoggerHealth::UnusableCard,
+            (CardHealth::Full, _) => LoggerHealth::CardFull,
             (CardHealth::Logging, true) => LoggerHealth::Degraded,
             (CardHealth::Logging, false) => LoggerHealth::Ok,
         });

@@ -61,6 +61,11 @@ pub const FAULT_CARD_FORMAT: u8 = 4;
 /// Number of card fault codes (`1..=FAULT_CARD_CODES`).
 pub const FAULT_CARD_CODES: usize = 4;
 
+/// Retry periods between attempts on a full card (10 s at the default
+/// period): a rider who swaps it is logging again soon, and a card left
+/// full is not walked for free clusters every second.
+pub const FULL_RETRY_PERIODS: u64 = 10;
+
 /// Highest run number a short file name `RUNnnnnn.WBL` can hold.
 pub const MAX_RUN: u32 = 99_999;
 
@@ -136,6 +141,9 @@ pub enum LoggerState {
     /// No file open: the card answers but holds no FAT16 or FAT32 volume
     /// ([`FAULT_CARD_FORMAT`]); tried again like a missing card.
     UnusableCard,
+    /// No file open: the card is full ([`FAULT_CARD_FULL`]); tried again
+    /// every [`FULL_RETRY_PERIODS`] retry periods.
+    CardFull,
     /// Writing `RUNnnnnn.WBL` with this run number.
     Logging {
         /// The run number of the open file.
@@ -202,8 +210,9 @@ pub struct CardLogger<'a, D: BlockDevice, T: TimeSource> {
     /// Fault counts not yet on a card, by code.
     faults_unreported: [u16; FAULT_CARD_CODES],
     stats: LoggerStats,
-    /// The last attempt to open the card found it unusable.
-    unusable: bool,
+    /// The last card fault counted (0: none since the file opened): what
+    /// [`Self::state`] shows while no file is open.
+    last_fault: u8,
 }
 
 #[derive(Clone, Copy, Debug)]
@@ -246,7 +255,7 @@ impl<'a, D: BlockDevice, T: TimeSource> CardLogger<'a, D, T> {
             frames_written: 0,
             faults_unreported: [0; FAULT_CARD_CODES],
             stats: LoggerStats::default(),
-            unusable: false,
+            last_fault: 0,
         }
     }
 
@@ -254,8 +263,11 @@ impl<'a, D: BlockDevice, T: TimeSource> CardLogger<'a, D, T> {
     pub fn state(&self) -> LoggerState {
         match self.open {
             Some(f) => LoggerState::Logging { run: f.run },
-            None if self.unusable => LoggerState::UnusableCard,
-            None => LoggerState::NoCard,
+            None => match self.last_fault {
+                FAULT_CARD_FORMAT => LoggerState::UnusableCard,
+                FAULT_CARD_FULL => LoggerState::CardFull,
+                _ => LoggerState::NoCard,
+            },
         }
     }
 
@@ -331,6 +343,19 @@ impl<'a, D: BlockDevice, T: TimeSource> CardLogger<'a, D, T> {
         let i = usize::from(code - 1);
         self.stats.faults[i] = self.stats.faults[i].saturating_add(1);
         self.faults_unreported[i] = self.faults_unreported[i].saturating_add(1);
+        self.last_fault = code;
+    }
+
+    /// When to try the card again after the fault just counted: a full
+    /// card waits [`FULL_RETRY_PERIODS`] periods (each attempt on it walks
+    /// the FAT for free clusters), any other one period.
+    fn retry_at(&self, now_us: u64) -> u64 {
+        let periods = if self.last_fault == FAULT_CARD_FULL {
+            FULL_RETRY_PERIODS
+        } else {
+            1
+        };
+        now_us.saturating_add(u64::from(self.config.retry_period_ms) * 1000 * periods)
     }
 
     /// Encodes `rec` and writes the block it closed, if any.
@@ -407,7 +432,7 @@ impl<'a, D: BlockDevice, T: TimeSource> CardLogger<'a, D, T> {
         self.encoder = BlockEncoder::new();
         self.stats.frames_on_card = 0;
         self.size_blocks = 0;
-        self.next_try_us = now_us.saturating_add(u64::from(self.config.retry_period_ms) * 1000);
+        self.next_try_us = self.retry_at(now_us);
     }
 
     fn release(&mut self, dir: RawDirectory, volume: RawVolume) {
@@ -419,18 +444,14 @@ impl<'a, D: BlockDevice, T: TimeSource> CardLogger<'a, D, T> {
     /// Opens the card, creates the next run's file and writes its header,
     /// then the fault and dropout records of what happened without a card.
     fn try_open(&mut self, now_us: u64) {
-        let retry_at = now_us.saturating_add(u64::from(self.config.retry_period_ms) * 1000);
         let volume = match self.fs.open_raw_volume(VolumeIdx(0)) {
             Ok(volume) => volume,
             Err(e) => {
-                let code = open_fault(&e);
-                self.unusable = code == FAULT_CARD_FORMAT;
-                self.count_fault(code);
-                self.next_try_us = retry_at;
+                self.count_fault(open_fault(&e));
+                self.next_try_us = self.retry_at(now_us);
                 return;
             }
         };
-        self.unusable = false;
         let opened = self
             .fs
             .open_root_dir(volume)
@@ -461,11 +482,12 @@ impl<'a, D: BlockDevice, T: TimeSource> CardLogger<'a, D, T> {
                     _ => FAULT_CARD_ABSENT,
                 };
                 self.count_fault(code);
-                self.next_try_us = retry_at;
+                self.next_try_us = self.retry_at(now_us);
                 return;
             }
         };
         self.open = Some(f);
+        self.last_fault = 0;
         self.stats.files_opened = self.stats.files_opened.saturating_add(1);
         self.encoder = BlockEncoder::new();
         self.stats.frames_on_card = 0;
