@@ -503,6 +503,13 @@ mod tests {
         }
     }
 
+    /// The report `write_report` makes of `m`.
+    fn report_of(m: &Measurements) -> String {
+        let mut text = String::new();
+        write_report(m, &mut text).unwrap();
+        text
+    }
+
     /// `n` pulses `period_us` apart from 5 s on, the one after pulse
     /// `missing` (if not 0) left out.
     fn pulses(n: u32, period_us: u64, missing: u32) -> PulseTrain {
@@ -590,16 +597,14 @@ mod tests {
             imu_data_ready: Some(PulseTrain::default()),
             ..good()
         };
-        let mut text = String::new();
-        write_report(&m, &mut text).unwrap();
+        let text = report_of(&m);
         assert!(
             text.ends_with("imu_drdy FAIL no pulses (INT1 to PA1)\n"),
             "{text}"
         );
         assert_eq!(failure_code(&m), 10);
         let m = good();
-        let mut text = String::new();
-        write_report(&m, &mut text).unwrap();
+        let text = report_of(&m);
         assert!(
             text.ends_with("imu_drdy PASS pulses=100 period_us=10150 longest_gap_us=10150\n"),
             "{text}"
@@ -616,8 +621,7 @@ mod tests {
             card_unusable: true,
             ..good()
         };
-        let mut text = String::new();
-        write_report(&unusable, &mut text).unwrap();
+        let text = report_of(&unusable);
         assert!(
             text.contains("\ncard FAIL no FAT16 or FAT32 volume (exFAT, GPT or unformatted): format it FAT32\n"),
             "{text}"
@@ -627,8 +631,7 @@ mod tests {
             card_unusable: false,
             ..unusable
         };
-        let mut text = String::new();
-        write_report(&silent, &mut text).unwrap();
+        let text = report_of(&silent);
         assert!(text.contains("\ncard FAIL not readable\n"), "{text}");
     }
 
@@ -651,8 +654,7 @@ mod tests {
     fn the_report_reads_back_line_for_line() {
         let mut m = good();
         m.wheel_edges = 3;
-        let mut text = String::new();
-        write_report(&m, &mut text).unwrap();
+        let text = report_of(&m);
         assert!(text.starts_with("wobble self-test 1\nimu PASS who_am_i=0x47 accel_g=1.01\n"));
         let mut lines = Vec::new();
         read_report(&text, &mut |l| lines.push(l)).unwrap();
@@ -699,8 +701,7 @@ mod tests {
                 accel_g: Some(g),
                 ..good()
             };
-            let mut text = String::new();
-            write_report(&m, &mut text).unwrap();
+            let text = report_of(&m);
             let imu = text.lines().nth(1).unwrap();
             assert!(imu.starts_with("imu FAIL") && imu.ends_with(shown), "{imu}");
         }
