@@ -6,7 +6,8 @@
 //! clean log with its blocks in reverse order (decoded in sequence order),
 //! back-to-back sync markers, and markers whose length fields pass (each
 //! one a candidate block whose CRC must be checked), with a short payload
-//! and with a full one; and a kick campaign (a ring-down every 12 s).
+//! and with a full one; a kick campaign (a ring-down every 12 s); and the
+//! clean log with a card kick record every 20 frames (131 k records).
 //!
 //! ```text
 //! cargo run -p wobblog --release --example absurd_logs -- OUT_DIR
@@ -16,7 +17,8 @@ use std::f64::consts::TAU;
 use std::io::Write;
 
 use wobble_core::format::{
-    BlockEncoder, FixMode, Frame, GpsFix, Record, UtcSync, UtcTime, STEER_COUNTS_PER_DEG,
+    BlockEncoder, FixMode, Frame, GpsFix, KickRingDown, Record, UtcSync, UtcTime,
+    STEER_COUNTS_PER_DEG,
 };
 
 /// Size of each log.
@@ -51,8 +53,15 @@ fn kicked(i: u64) -> f64 {
 }
 
 /// Frames at 100 Hz from `t0_us`, steering `steer_deg(frame)`, until the
-/// file holds `len` bytes; `jump_us` is added at every new block.
-fn log(t0_us: u64, jump_us: u64, len: usize, steer_deg: fn(u64) -> f64) -> Vec<u8> {
+/// file holds `len` bytes; `jump_us` is added at every new block; a card
+/// kick record after every `kick_every`-th frame if given.
+fn log(
+    t0_us: u64,
+    jump_us: u64,
+    len: usize,
+    steer_deg: fn(u64) -> f64,
+    kick_every: Option<u64>,
+) -> Vec<u8> {
     let mut enc = BlockEncoder::new();
     let mut file = Vec::with_capacity(len);
     let mut t_us = t0_us;
@@ -67,6 +76,20 @@ fn log(t0_us: u64, jump_us: u64, len: usize, steer_deg: fn(u64) -> f64) -> Vec<u
         if let Ok(Some(block)) = enc.push(&Record::Frame(frame)) {
             file.extend_from_slice(block);
             t_us += jump_us;
+        }
+        if kick_every.is_some_and(|k| i % k == k - 1) {
+            let kick = KickRingDown {
+                t_us,
+                speed_mm_s: Some(4000),
+                freq_chz: 650,
+                sigma_milli_per_s: -800,
+                sigma_se_milli_per_s: 50,
+                amp_cdeg: 150,
+                segments: 6,
+            };
+            if let Ok(Some(block)) = enc.push(&Record::Kick(kick)) {
+                file.extend_from_slice(block);
+            }
         }
         t_us += 10_000;
         i += 1;
@@ -129,13 +152,13 @@ fn main() -> std::io::Result<()> {
     let write = |name: &str, bytes: &[u8]| {
         std::fs::File::create(dir.join(name)).and_then(|mut f| f.write_all(bytes))
     };
-    let clean = log(1_000_000, 0, LEN, wobble);
+    let clean = log(1_000_000, 0, LEN, wobble, None);
     write("clean.wbl", &clean)?;
     write("repeated.wbl", &clean[..512].repeat(LEN / 512))?;
-    let mut front = log(1 << 62, 0, 512, wobble);
+    let mut front = log(1 << 62, 0, 512, wobble, None);
     front.extend_from_slice(&clean[..LEN - 512]);
     write("front.wbl", &front)?;
-    write("jumps.wbl", &log(1_000_000, YEAR_US, LEN, wobble))?;
+    write("jumps.wbl", &log(1_000_000, YEAR_US, LEN, wobble, None))?;
     let reversed: Vec<u8> = clean.chunks(512).rev().flatten().copied().collect();
     write("reversed.wbl", &reversed)?;
     write("markers.wbl", &b"WBLK".repeat(LEN / 4))?;
@@ -145,6 +168,10 @@ fn main() -> std::io::Result<()> {
         "full_candidates.wbl",
         &b"WBLK\x01\x00\xe4\x01".repeat(LEN / 8),
     )?;
-    write("kicked.wbl", &log(1_000_000, 0, LEN, kicked))?;
+    write("kicked.wbl", &log(1_000_000, 0, LEN, kicked, None))?;
+    write(
+        "kick_records.wbl",
+        &log(1_000_000, 0, LEN, wobble, Some(20)),
+    )?;
     write("busy.wbl", &busy(LEN))
 }

@@ -392,15 +392,6 @@ impl<'a> Span<'a> {
                 let to = (range.end + lookback).min(t.len());
                 (range.start..to, range.end..to)
             };
-            let tone = strongest_tone(&t[alone.clone()], &band[alone], f1_hz, self.fs_hz);
-            let mode = fit_mode(
-                &t[fitted.clone()],
-                &band[fitted.clone()],
-                slope,
-                TAU * f1_hz,
-                tone,
-            )?;
-            let ok = (mode.sigma_per_s > 0.0) == growing && mode.residual_rel <= MAX_RESIDUAL_REL;
             // A growth must also be there in the causally filtered signal:
             // the zero-phase band answers a push on the bar before the push
             // itself, with an oscillation growing towards it that is no
@@ -426,7 +417,19 @@ impl<'a> Span<'a> {
                 let early = before_push.saturating_sub(width).max(range.start)..before_push;
                 shows(late) && (early.len() < 2 || shows(early))
             };
-            (ok && causal_ok).then_some((fitted, mode))
+            if !causal_ok {
+                return None;
+            }
+            let tone = strongest_tone(&t[alone.clone()], &band[alone], f1_hz, self.fs_hz);
+            let mode = fit_mode(
+                &t[fitted.clone()],
+                &band[fitted.clone()],
+                slope,
+                TAU * f1_hz,
+                tone,
+            )?;
+            let ok = (mode.sigma_per_s > 0.0) == growing && mode.residual_rel <= MAX_RESIDUAL_REL;
+            ok.then_some((fitted, mode))
         };
         // Quiet before it within the stretch, or it reaches the cut.
         let starts_at_cut = region.start == 0;

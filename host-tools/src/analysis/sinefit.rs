@@ -313,22 +313,38 @@ fn normal_equations(
     p: &Vector,
     n: usize,
 ) -> (Matrix, Vector, f64) {
+    // The count as a constant lets the compiler unroll the per-sample
+    // products: most of a fit's time is here.
+    if n == MAX_PARAMS {
+        normal_equations_of::<MAX_PARAMS>(grid, t, x, p)
+    } else {
+        normal_equations_of::<4>(grid, t, x, p)
+    }
+}
+
+/// [`normal_equations`] with `N` parameters.
+fn normal_equations_of<const N: usize>(
+    grid: &Grid,
+    t: &[f64],
+    x: &[f64],
+    p: &Vector,
+) -> (Matrix, Vector, f64) {
     let mut jtj = [[0.0; MAX_PARAMS]; MAX_PARAMS];
     let mut jtr = [0.0; MAX_PARAMS];
     let mut cost = 0.0;
     grid.for_each(t, p, |i, tau, ph| {
-        let (m, j) = model_of(tau, ph, p, n);
+        let (m, j) = model_of(tau, ph, p, N);
         let r = x[i] - m;
         cost += r * r;
-        for row in 0..n {
+        for row in 0..N {
             jtr[row] += j[row] * r;
             // The upper triangle; the lower is its mirror.
-            for col in row..n {
+            for col in row..N {
                 jtj[row][col] += j[row] * j[col];
             }
         }
     });
-    for row in 1..n {
+    for row in 1..N {
         let (upper, lower) = jtj.split_at_mut(row);
         for (col, above) in upper.iter().enumerate() {
             lower[0][col] = above[row];
