@@ -51,6 +51,43 @@ pub fn json_terminal_safe(json: String) -> String {
     out
 }
 
+/// `value` as one line of JSON and a newline, written to `out` as it is
+/// serialised (a campaign's kicks make tens of megabytes: never held whole),
+/// with the characters [`json_terminal_safe`] escapes escaped the same way.
+///
+/// # Errors
+/// What writing to `out` returns, or a value that is not JSON.
+pub fn write_json_line<W: std::io::Write>(
+    mut out: W,
+    value: &impl serde::Serialize,
+) -> std::io::Result<()> {
+    let mut ser = serde_json::Serializer::with_formatter(&mut out, TerminalSafe);
+    value.serialize(&mut ser)?;
+    out.write_all(b"\n")?;
+    out.flush()
+}
+
+/// serde_json's compact format with [`needs_escape`] characters in strings
+/// written as `\uXXXX` (serde_json escapes C0 itself; these are DEL, C1
+/// and bidirectional formatting, which it leaves as they are).
+struct TerminalSafe;
+
+impl serde_json::ser::Formatter for TerminalSafe {
+    fn write_string_fragment<W: ?Sized + std::io::Write>(
+        &mut self,
+        writer: &mut W,
+        fragment: &str,
+    ) -> std::io::Result<()> {
+        let mut rest = fragment;
+        while let Some((i, c)) = rest.char_indices().find(|&(_, c)| needs_escape(c)) {
+            writer.write_all(rest[..i].as_bytes())?;
+            write!(writer, "\\u{:04x}", u32::from(c))?;
+            rest = &rest[i + c.len_utf8()..];
+        }
+        writer.write_all(rest.as_bytes())
+    }
+}
+
 /// A file name as messages show it: [`escape_controls`] of its text, so a
 /// name cannot forge lines or send a terminal commands.
 #[must_use]
@@ -62,6 +99,20 @@ pub fn shown(path: impl AsRef<std::path::Path>) -> String {
 mod tests {
     use super::*;
     use proptest::prelude::*;
+
+    #[test]
+    fn a_streamed_json_line_escapes_what_a_terminal_obeys() {
+        let mut out = Vec::new();
+        write_json_line(
+            &mut out,
+            &serde_json::json!({ "a\u{9b}": "x\u{7f}\u{1b}y\u{202e}é" }),
+        )
+        .unwrap();
+        assert_eq!(
+            String::from_utf8(out).unwrap(),
+            "{\"a\\u009b\":\"x\\u007f\\u001by\\u202eé\"}\n"
+        );
+    }
 
     #[test]
     fn escape_sequences_are_shown_not_obeyed() {
@@ -89,6 +140,16 @@ mod tests {
             prop_assert!(!safe.chars().any(needs_escape), "{}", safe);
             let back: serde_json::Value = serde_json::from_str(&safe).unwrap();
             prop_assert_eq!(back["log"].as_str(), Some(s.as_str()));
+        }
+
+        /// Written as it is serialised, the same text as escaped after.
+        #[test]
+        fn a_streamed_json_line_is_the_escaped_one(s in any::<String>(), n in 0..4usize) {
+            let value = serde_json::json!({ "log": s, "kicks": vec![s.clone(); n] });
+            let mut streamed = Vec::new();
+            write_json_line(&mut streamed, &value).unwrap();
+            let escaped = json_terminal_safe(serde_json::to_string(&value).unwrap()) + "\n";
+            prop_assert_eq!(String::from_utf8(streamed).unwrap(), escaped);
         }
     }
 }

@@ -120,3 +120,12 @@ pub fn print(mut out: Output, text: &str) -> Result<(), CliError> {
         Err(e) => Err(out.error(e)),
     }
 }
+
+/// Writes `value` to `out` as one line of JSON as it is serialised
+/// ([`crate::text::write_json_line`]), then commits it.
+pub fn print_json(mut out: Output, value: &impl serde::Serialize) -> Result<(), CliError> {
+    match crate::text::write_json_line(std::io::BufWriter::new(&mut out), value) {
+        Ok(()) => out.commit(),
+        Err(e) => Err(out.error(e)),
+    }
+}

@@ -9,7 +9,7 @@ use serde::Serialize;
 
 use crate::analysis::campaign_kicks::{load_campaign_kicks, CampaignKick, Prefer};
 use crate::analysis::margin::{predict_with, KickPoint, Margin, Trend, RIDE_MARGIN};
-use crate::cmd::logs::{for_each_log, print, warn_losses};
+use crate::cmd::logs::{for_each_log, print, print_json, warn_losses};
 use crate::cmd::margin_model::{estimate, ModelEstimate, DEFAULT_PARAMS};
 use crate::cmd::summary::logs_in;
 use crate::output::Output;
@@ -238,14 +238,11 @@ pub fn run(args: &Args) -> Result<(), CliError> {
             .collect();
         report.model = Some(estimate(params, &keys, &used, report.kicks_rejected)?);
     }
-    let text = if args.json {
-        let line = serde_json::to_string(&report)
-            .map_err(|e| CliError::Failed(format!("cannot write the report: {e}")))?;
-        crate::text::json_terminal_safe(line) + "\n"
+    let printed = if args.json {
+        print_json(stdout, &report)
     } else {
-        render_text(&report, logs.len())
+        print(stdout, &render_text(&report, logs.len()))
     };
-    let printed = print(stdout, &text);
     // Drawn only when every log was read: a failed command leaves an old
     // figure as it was.
     if let (Some(out), Ok(())) = (plot_out, &result) {
