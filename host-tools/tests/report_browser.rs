@@ -386,3 +386,77 @@ fn the_page_opens_in_chromium_with_every_view() {
         }
     }
 }
+
+/// An hour at 100 Hz with GPS, an alert and markers: the page stays small
+/// (display thinning) and opens and zooms without stalling. The figures
+/// printed are those of `firmware/docs/benchmarks.md` (Report).
+#[test]
+fn an_hours_page_is_small_and_opens_and_zooms_quickly() {
+    let dir = tempfile::tempdir().unwrap();
+    let log = dir.path().join("RUN00001.WBL");
+    let ride = analysis_support::Ride::new(3600.0, 5.0, 15.0, 2.0, 0.5);
+    let extras = Extras {
+        alerts_s: vec![(16.0, 17.5), (1800.0, 1803.0)],
+        markers_s: vec![5.0, 1200.0, 2400.0],
+        gps: true,
+        ..Extras::default()
+    };
+    write_log(&log, &ride, &extras);
+    let started = Instant::now();
+    let (page, html) = report(&[log.as_os_str()], dir.path());
+    let written = started.elapsed();
+    let mb = html.len() as f64 / 1e6;
+    eprintln!("one hour: page {mb:.2} MB, written in {written:?}");
+    assert!(mb < 4.0, "{mb} MB");
+    let Some(browser) = chromium() else {
+        return;
+    };
+    let (test, stderr) = self_test(&browser, &page);
+    assert_eq!(test["errors"], Value::Array(vec![]), "{test}");
+    assert!(console_errors(&stderr).is_empty(), "{stderr}");
+    let view = &test["views"][1];
+    let (build, zoom) = (
+        view["build_ms"].as_f64().unwrap(),
+        view["zoom_ms"].as_f64().unwrap(),
+    );
+    eprintln!("one hour: ride view built in {build:.0} ms, zoom step {zoom:.0} ms");
+    // Generous bounds for a loaded test machine: a stall is seconds.
+    assert!(build < 3000.0 && zoom < 1000.0, "{view}");
+}
+
+#[test]
+fn a_model_puts_figure_8_over_its_wobble_mode_and_its_fit_in_words() {
+    let dir = campaign();
+    let params =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("bicycle-model/params/test-bicycle.toml");
+    let (_, html) = report(
+        &[
+            dir.path().as_os_str(),
+            "--model".as_ref(),
+            params.as_os_str(),
+        ],
+        dir.path(),
+    );
+    let margin: Value = serde_json::from_str(&stdout_of(
+        wobblog()
+            .arg("margin")
+            .arg(dir.path())
+            .arg("--model")
+            .arg(&params)
+            .arg("--json"),
+    ))
+    .unwrap();
+    // The fitted model's answer as the JSON has it (none when the fitted
+    // model's wobble never turns unstable).
+    let model = margin["model"]["wobble_speed_mps"]
+        .as_f64()
+        .map_or("none".to_owned(), |v| format!("{v:.2} m/s"));
+    let lo = margin["model"]["ci95_mps"][0]
+        .as_f64()
+        .map_or("none".to_owned(), |v| format!("{v:.2} m/s"));
+    let words =
+        format!("The model fitted to the kicks: wobble speed {model}, 95 % interval {lo} to");
+    assert!(html.contains(&words), "{words}");
+    assert!(html.contains("Figure 8: every episode over the model of test-bicycle.toml"));
+    assert!(html.contains("wobble mode and measured episodes"));
+}

@@ -38,7 +38,7 @@ pub struct Campaign {
     pub margin_svg: Result<String, String>,
     /// Figure 8, SVG (over the model when one is given).
     pub modes_svg: Result<String, String>,
-    /// The parameter file, when given.
+    /// The parameter file's name, when given.
     pub model_file: Option<String>,
 }
 
@@ -74,7 +74,7 @@ impl Campaign {
             margin_words,
             margin_svg,
             modes_svg,
-            model_file: params.map(|p| p.display().to_string()),
+            model_file: params.map(crate::analysis::run::log_name),
         })
     }
 

@@ -260,6 +260,15 @@ fn speed_words(m: &crate::cmd::margin::Report) -> String {
         }
         None => s.push_str(" No riding limit: stay at speeds already kicked."),
     }
+    if let Some(model) = &m.model {
+        let _ = write!(
+            s,
+            " The model fitted to the kicks: wobble speed {}, 95 % interval {} to {}.",
+            opt(model.wobble_speed_mps, "m/s"),
+            opt(model.ci95_mps[0], "m/s"),
+            model.ci95_mps[1].map_or_else(|| "unbounded".to_owned(), |v| format!("{v:.2} m/s"))
+        );
+    }
     s
 }
 
@@ -364,7 +373,7 @@ fn ride_view(o: &mut String, k: usize, r: &RideView) {
     }
     let _ = write!(
         o,
-        "</section>\n<section data-section=\"config\"><h3>Configuration</h3><pre>{}</pre>\
+        "</section>\n<section data-section=\"config\"><h3>Configuration</h3><pre class=\"config\">{}</pre>\
          <p class=\"hint\">Firmware {}, device {}, run {}, {} Hz.</p></section></div>\n",
         if s.config.is_empty() {
             "(no configuration lines in the log: the firmware's defaults)".to_owned()
