@@ -460,3 +460,19 @@ fn a_model_puts_figure_8_over_its_wobble_mode_and_its_fit_in_words() {
     assert!(html.contains("Figure 8: every episode over the model of test-bicycle.toml"));
     assert!(html.contains("wobble mode and measured episodes"));
 }
+
+#[test]
+fn names_from_the_card_are_text_not_markup() {
+    let dir = tempfile::tempdir().unwrap();
+    let log = dir.path().join("RUN<b>&\"1'.WBL");
+    standard_log(&log);
+    let (_, html) = report(&[log.as_os_str()], dir.path());
+    check_markup(&html);
+    assert!(html.contains("<h2>RUN&lt;b&gt;&amp;&quot;1&#39;.WBL</h2>"));
+    // Raw only in the data block, which is script text, not markup.
+    let data_start = html.find("<script type=\"application/json\"").unwrap();
+    let data_end = data_start + html[data_start..].find("</script>").unwrap();
+    assert!(html[data_start..data_end].contains("RUN<b>"));
+    let markup = format!("{}{}", &html[..data_start], &html[data_end..]);
+    assert!(!markup.contains("RUN<b>"));
+}

@@ -48,10 +48,9 @@ impl Campaign {
     /// missed a run would mislead.
     pub fn load(logs: &[PathBuf], params: Option<&Path>) -> Result<Self, CliError> {
         let mut rides = Vec::new();
+        // The losses are warned of once, as `margin` reads the kicks below.
         for_each_log(logs, "reading", |log| {
-            let ride = RideView::load(log)?;
-            crate::cmd::logs::warn_losses(log, &ride.summary);
-            rides.push(ride);
+            rides.push(RideView::load(log)?);
             Ok(())
         })?;
         let (margin, prediction, read) =
