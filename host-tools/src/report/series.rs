@@ -29,7 +29,7 @@ pub const CHANNELS: [&str; 9] = [
 pub const OVERVIEW_ROWS: usize = 16_000;
 /// Time in close-look stretches kept at full rate, at most, s: beyond it
 /// the later stretches are thinned like the rest.
-pub const DETAIL_BUDGET_S: f64 = 600.0;
+pub const DETAIL_BUDGET_S: f64 = 300.0;
 
 /// The display columns. `None` breaks the line (a gap in the data).
 #[derive(Clone, Debug, Default, Serialize)]

@@ -14,6 +14,10 @@ const PAD: f64 = 24.0;
 const M_PER_DEG: f64 = 111_195.0;
 /// Fixes further apart in time than this are not joined, s.
 const GAP_S: f64 = 5.0;
+/// Points of the line at most: an hour of 20 Hz fixes is thinned to one
+/// in eighteen (a few metres apart at riding speed, under a pixel of the
+/// drawing of a long route).
+const MAX_POINTS: usize = 4000;
 
 /// The SVG of `fixes` (in time order), with a dot at each of `onsets_s`
 /// (the fix nearest in time); `None` without a fix.
@@ -58,7 +62,14 @@ pub fn track_svg(fixes: &[Fix], onsets_s: &[f64]) -> Option<String> {
     );
     let mut line = String::new();
     let mut last_t: Option<f64> = None;
-    for &(t, x, y) in &metres {
+    let step = metres.len().div_ceil(MAX_POINTS).max(1);
+    let last = metres.len() - 1;
+    let drawn = metres
+        .iter()
+        .enumerate()
+        .filter(|(i, _)| i % step == 0 || *i == last)
+        .map(|(_, p)| p);
+    for &(t, x, y) in drawn {
         if last_t.is_some_and(|l| t - l > GAP_S) {
             flush_line(&mut svg, &mut line);
         }
@@ -140,6 +151,23 @@ mod tests {
             .collect();
         // y of the last point above (smaller than) the first's.
         assert!(points[points.len() - 1] < points[1]);
+    }
+
+    #[test]
+    fn a_long_track_is_thinned_to_its_limit_with_its_end() {
+        let fixes: Vec<Fix> = (0..100_000)
+            .map(|i| (f64::from(i) * 0.05, 52.0 + f64::from(i) * 1e-7, 6.0))
+            .collect();
+        let svg = track_svg(&fixes, &[]).unwrap();
+        let points = svg
+            .split("points=\"")
+            .nth(1)
+            .unwrap()
+            .split('"')
+            .next()
+            .unwrap();
+        let n = points.split(' ').count();
+        assert!((MAX_POINTS / 2..=MAX_POINTS + 1).contains(&n), "{n} points");
     }
 
     #[test]
