@@ -267,6 +267,37 @@ fn headless(browser: &Path, profile: &Path) -> Process {
     cmd
 }
 
+/// How long a browser run may take before the test gives up on it.
+const BROWSER_DEADLINE: std::time::Duration = std::time::Duration::from_secs(120);
+
+/// Runs `cmd` to its end, its output collected through files (no pipe can
+/// fill and stall it); a browser still running after [`BROWSER_DEADLINE`]
+/// is killed and fails the test rather than hanging it.
+fn finished(mut cmd: Process) -> std::process::Output {
+    let files = tempfile::tempdir().unwrap();
+    let (out, err) = (files.path().join("out"), files.path().join("err"));
+    cmd.stdout(std::fs::File::create(&out).unwrap())
+        .stderr(std::fs::File::create(&err).unwrap());
+    let mut child = cmd.spawn().unwrap();
+    let started = Instant::now();
+    let status = loop {
+        if let Some(status) = child.try_wait().unwrap() {
+            break status;
+        }
+        if started.elapsed() > BROWSER_DEADLINE {
+            let _ = child.kill();
+            let _ = child.wait();
+            panic!("the browser ran for over {BROWSER_DEADLINE:?}: {cmd:?}");
+        }
+        std::thread::sleep(std::time::Duration::from_millis(50));
+    };
+    std::process::Output {
+        status,
+        stdout: std::fs::read(out).unwrap(),
+        stderr: std::fs::read(err).unwrap(),
+    }
+}
+
 fn url(page: &Path, view: &str) -> String {
     format!("file://{}#{view}", page.display())
 }
@@ -275,12 +306,11 @@ fn url(page: &Path, view: &str) -> String {
 /// browser's stderr.
 fn self_test(browser: &Path, page: &Path) -> (Value, String) {
     let profile = tempfile::tempdir().unwrap();
-    let out = headless(browser, profile.path())
-        .arg("--virtual-time-budget=10000")
+    let mut cmd = headless(browser, profile.path());
+    cmd.arg("--virtual-time-budget=10000")
         .arg("--dump-dom")
-        .arg(url(page, "selftest"))
-        .output()
-        .unwrap();
+        .arg(url(page, "selftest"));
+    let out = finished(cmd);
     let dom = String::from_utf8_lossy(&out.stdout);
     let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
     let start = dom
@@ -308,13 +338,12 @@ fn console_errors(stderr: &str) -> Vec<&str> {
 /// A PNG screenshot of `view` of `page`, `size` wide and high, into `out`.
 fn screenshot(browser: &Path, page: &Path, view: &str, size: (u32, u32), out: &Path) {
     let profile = tempfile::tempdir().unwrap();
-    let status = headless(browser, profile.path())
-        .arg("--virtual-time-budget=5000")
+    let mut cmd = headless(browser, profile.path());
+    cmd.arg("--virtual-time-budget=5000")
         .arg(format!("--window-size={},{}", size.0, size.1))
         .arg(format!("--screenshot={}", out.display()))
-        .arg(url(page, view))
-        .output()
-        .unwrap();
+        .arg(url(page, view));
+    let status = finished(cmd);
     assert!(
         status.status.success(),
         "{}",
