@@ -382,6 +382,7 @@ fn the_page_opens_in_chromium_with_every_view() {
     assert!(console_errors(&stderr).is_empty(), "{stderr}");
     let views = test["views"].as_array().unwrap();
     assert_eq!(views.len(), 1 + PASSES + 2);
+    assert_eq!(test["link_shows"], "ride-0", "{test}");
     let campaign = &views[0];
     assert_eq!(campaign["id"], "campaign");
     assert_eq!(campaign["sections"], serde_json::json!(CAMPAIGN_SECTIONS));
