@@ -7,7 +7,7 @@ cd "$(dirname "$0")/.."
 
 OUT="${1:-out/demo}"
 missing=0
-for f in card.img RUN00001.WBL ride.csv summary.txt summary.json ride.png; do
+for f in card.img RUN00001.WBL ride.csv summary.txt summary.json ride.png report.html; do
     if [ ! -s "$OUT/$f" ]; then
         echo "check-demo: $OUT/$f is missing or empty" >&2
         missing=1
@@ -23,6 +23,13 @@ fi
 # The PNG is a PNG.
 if [ -s "$OUT/ride.png" ] && ! head -c 8 "$OUT/ride.png" | od -An -tx1 | grep -q '89 50 4e 47'; then
     echo "check-demo: $OUT/ride.png is not a PNG" >&2
+    missing=1
+fi
+# The report is a whole page with the ride view's spectrogram.
+if [ -s "$OUT/report.html" ] && ! { head -c 15 "$OUT/report.html" | grep -q '<!DOCTYPE html>' &&
+    tail -c 20 "$OUT/report.html" | grep -q '</html>' &&
+    grep -q 'data-section="spectrogram"' "$OUT/report.html"; }; then
+    echo "check-demo: $OUT/report.html is not a whole report" >&2
     missing=1
 fi
 [ "$missing" -eq 0 ] && echo "check-demo: every result of the main job is in $OUT/"

@@ -6,7 +6,8 @@
 #
 # Results in out/demo/ (or the folder given as $1): card.img (the FAT32 SD
 # card image), RUN00001.WBL (the log), ride.csv (decoded frames), summary.txt
-# and summary.json (`wobblog info`), ride.png (`wobblog plot`).
+# and summary.json (`wobblog info`), ride.png (`wobblog plot`), report.html
+# (`wobblog report`).
 # Installs what it needs first, once: the ARM target, qemu-system-arm and
 # dosfstools.
 set -euo pipefail
@@ -38,6 +39,7 @@ LOG="$OUT/RUN00001.WBL"
 "$BIN/wobblog" info "$LOG" | tee "$OUT/summary.txt"
 "$BIN/wobblog" info "$LOG" --json > "$OUT/summary.json"
 "$BIN/wobblog" plot "$LOG" -o "$OUT/ride.png"
+"$BIN/wobblog" report "$LOG" -o "$OUT/report.html"
 echo
 echo "results in $OUT/:"
 ls -1 "$OUT"

@@ -2,7 +2,8 @@
 # Installs, once, what building and running the firmware under QEMU needs:
 # the ARM target, qemu-system-arm, dosfstools (mkfs.fat, fsck.fat), exfatprogs
 # (mkfs.exfat), llvm
-# (llvm-objdump, for the stack bound), and
+# (llvm-objdump, for the stack bound), chromium (headless, for the report's
+# browser test), and
 # the Python packages the host tests read outputs with.
 # Sourced by demo.sh and test-all.sh; does nothing when all is there.
 TARGET=thumbv7em-none-eabihf
@@ -12,6 +13,7 @@ command -v qemu-system-arm >/dev/null || missing+=(qemu-system-arm)
 { command -v mkfs.fat && command -v fsck.fat; } >/dev/null || missing+=(dosfstools)
 command -v mkfs.exfat >/dev/null || missing+=(exfatprogs)  # the card-format tests
 command -v llvm-objdump >/dev/null || missing+=(llvm)  # the stack bound
+command -v chromium >/dev/null || missing+=(chromium)  # the report's browser test
 if ((${#missing[@]})); then
     SUDO=""
     [ "$(id -u)" -eq 0 ] || SUDO=sudo

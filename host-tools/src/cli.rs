@@ -43,6 +43,8 @@ enum Command {
     Wobble(cmd::wobble::Args),
     /// Predict the wobble speed from handlebar kicks below it, with its 95 % interval.
     Margin(cmd::margin::Args),
+    /// One self-contained HTML page: the campaign, and every run zoomable with its events.
+    Report(cmd::report::Args),
     /// Write a run's GPS track as GPX.
     Gpx(cmd::gpx::Args),
     /// One row per run in a directory: duration, distance, episodes, wobble speed, losses.
@@ -79,6 +81,7 @@ pub fn main() -> ExitCode {
         Command::Plot(args) => cmd::plot::run(&args),
         Command::Wobble(args) => cmd::wobble::run(&args),
         Command::Margin(args) => cmd::margin::run(&args),
+        Command::Report(args) => cmd::report::run(&args),
         Command::Gpx(args) => cmd::gpx::run(&args),
         Command::Summary(args) => cmd::summary::run(&args),
         Command::Model(command) => cmd::model::run(&command),

@@ -18,6 +18,7 @@ pub mod output;
 pub mod owner;
 pub mod plot;
 pub mod reader;
+pub mod report;
 pub mod resample;
 pub mod rows;
 pub mod spool;

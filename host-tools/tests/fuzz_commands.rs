@@ -226,6 +226,9 @@ fn every_log_command(path: &Path, dir: &Path) {
         if let Some(plot) = TimePlot::new(&run, None, None) {
             draw(&plot, dir, "run.svg");
         }
+        let report = wobblog::report::Campaign::load(&[path.to_path_buf()], None).unwrap();
+        let html = wobblog::report::page::render(&report).unwrap();
+        assert!(html.ends_with("</html>\n"));
     }
 }
 

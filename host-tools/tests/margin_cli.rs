@@ -4,7 +4,6 @@
 
 mod analysis_support;
 
-use std::f64::consts::TAU;
 use std::path::Path;
 
 use analysis_support::{wobblog, Extras, Ride};
@@ -24,28 +23,7 @@ fn pass(path: &Path, speed: f64, seed: u32) {
 
 /// The ride of [`pass`].
 fn pass_ride(speed: f64, seed: u32) -> Ride {
-    let mut ride = Ride::new(10.0, speed, 0.0, 0.5, 0.0);
-    let sigma = 0.5 * (speed - WOBBLE_MPS);
-    let mut state = 0x9E37_79B9u32 ^ seed;
-    for (t, s) in ride.t_s.iter().zip(ride.steer_deg.iter_mut()) {
-        state ^= state << 13;
-        state ^= state >> 17;
-        state ^= state << 5;
-        let noise = 0.02 * (f64::from(state) / f64::from(u32::MAX) - 0.5);
-        let tau = t - 3.0;
-        let push = if (0.0..0.1).contains(&tau) {
-            4.0 * (TAU / 0.2 * tau).sin()
-        } else {
-            0.0
-        };
-        let ring = if tau >= 0.1 {
-            1.5 * (sigma * (tau - 0.1)).exp() * (TAU * FREQ_HZ * (tau - 0.1)).sin()
-        } else {
-            0.0
-        };
-        *s += push + ring + noise;
-    }
-    ride
+    analysis_support::kick_pass(speed, WOBBLE_MPS, FREQ_HZ, seed)
 }
 
 /// `speeds.len()` passes in a new directory.

@@ -128,7 +128,7 @@ pub struct Report {
 
 /// The logs named by `inputs`: files as given, directories' `*.WBL` files
 /// in name order.
-fn expand(inputs: &[PathBuf]) -> Result<Vec<PathBuf>, CliError> {
+pub fn expand(inputs: &[PathBuf]) -> Result<Vec<PathBuf>, CliError> {
     let mut logs = Vec::new();
     for input in inputs {
         if input.is_dir() {
@@ -222,21 +222,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
     }
     let (mut report, margin) = report(rows, args.trend, args.ride_margin / 100.0);
     if let Some(params) = &args.model {
-        let keys: Vec<String> = if args.params.is_empty() {
-            DEFAULT_PARAMS.iter().map(|k| (*k).to_owned()).collect()
-        } else {
-            args.params.clone()
-        };
-        let used: Vec<(f64, f64, f64, f64)> = report
-            .kicks
-            .iter()
-            .filter(|r| r.used)
-            .map(|r| {
-                let k = &r.kick;
-                (k.speed_mps, k.freq_hz, k.sigma_per_s, k.sigma_sd_per_s)
-            })
-            .collect();
-        report.model = Some(estimate(params, &keys, &used, report.kicks_rejected)?);
+        add_model(&mut report, params, &args.params)?;
     }
     let printed = if args.json {
         print_json(stdout, &report)
@@ -246,27 +232,74 @@ pub fn run(args: &Args) -> Result<(), CliError> {
     // Drawn only when every log was read: a failed command leaves an old
     // figure as it was.
     if let (Some(out), Ok(())) = (plot_out, &result) {
-        let figure = MarginPlot {
-            kicks: report
-                .kicks
-                .iter()
-                .map(|r| KickDot {
-                    speed_mps: r.kick.speed_mps,
-                    sigma_per_s: r.kick.sigma_per_s,
-                    sd_per_s: r.kick.sigma_sd_per_s,
-                    used: r.used,
-                })
-                .collect(),
-            margin,
-            model_curve: report.model.as_ref().map(|m| m.curve.clone()),
-            model_speed: report
-                .model
-                .as_ref()
-                .and_then(|m| m.wobble_speed_mps.map(|w| (w, m.ci95_mps))),
-        };
-        render(&figure, out)?;
+        render(&figure(&report, margin), out)?;
     }
     result.and(printed)
+}
+
+/// The campaign of `logs` as `wobblog margin` reports it (its kicks taken
+/// as `prefer` says, the trend, the riding margin as a fraction), with the
+/// model of `params` fitted when given (`keys`: the parameters to fit,
+/// empty for the default ones). The outer error is a model that cannot be
+/// fitted; the inner result says whether every log was read.
+pub fn campaign(
+    logs: &[PathBuf],
+    prefer: Prefer,
+    trend: Trend,
+    ride_margin: f64,
+    params: Option<&Path>,
+    keys: &[String],
+) -> Result<(Report, Margin, Result<(), CliError>), CliError> {
+    let (rows, result) = gather(logs, prefer);
+    let (mut report, margin) = report(rows, trend, ride_margin);
+    if let Some(params) = params {
+        add_model(&mut report, params, keys)?;
+    }
+    Ok((report, margin, result))
+}
+
+/// Fits `keys` (the default ones when empty) of the model in `params` to
+/// the kicks `report` used.
+fn add_model(report: &mut Report, params: &Path, keys: &[String]) -> Result<(), CliError> {
+    let keys: Vec<String> = if keys.is_empty() {
+        DEFAULT_PARAMS.iter().map(|k| (*k).to_owned()).collect()
+    } else {
+        keys.to_vec()
+    };
+    let used: Vec<(f64, f64, f64, f64)> = report
+        .kicks
+        .iter()
+        .filter(|r| r.used)
+        .map(|r| {
+            let k = &r.kick;
+            (k.speed_mps, k.freq_hz, k.sigma_per_s, k.sigma_sd_per_s)
+        })
+        .collect();
+    report.model = Some(estimate(params, &keys, &used, report.kicks_rejected)?);
+    Ok(())
+}
+
+/// The damping-trend figure of `report` and its prediction `margin`.
+#[must_use]
+pub fn figure(report: &Report, margin: Margin) -> MarginPlot {
+    MarginPlot {
+        kicks: report
+            .kicks
+            .iter()
+            .map(|r| KickDot {
+                speed_mps: r.kick.speed_mps,
+                sigma_per_s: r.kick.sigma_per_s,
+                sd_per_s: r.kick.sigma_sd_per_s,
+                used: r.used,
+            })
+            .collect(),
+        margin,
+        model_curve: report.model.as_ref().map(|m| m.curve.clone()),
+        model_speed: report
+            .model
+            .as_ref()
+            .and_then(|m| m.wobble_speed_mps.map(|w| (w, m.ci95_mps))),
+    }
 }
 
 /// `v` to two decimals, or `what` for none.
@@ -278,6 +311,38 @@ fn speed_text(v: Option<f64>, what: &str) -> String {
 /// Names and keys that come from files or the command line are shown with
 /// control and bidirectional characters escaped.
 fn render_text(r: &Report, logs: usize) -> String {
+    use crate::text::escape_controls;
+    use std::fmt::Write;
+    let mut o = answer_text(r, logs);
+    if !r.kicks.is_empty() {
+        let _ = writeln!(
+            o,
+            "  t_s       speed_mps  freq_hz  sigma_per_s  sigma_sd_per_s  amp_deg  source     used  log"
+        );
+    }
+    for k in &r.kicks {
+        let _ = writeln!(
+            o,
+            "  {:8.2}  {:9.2}  {:7.2}  {:11.3}  {:14.3}  {:7.2}  {:9}  {:4}  {}",
+            k.kick.t_s,
+            k.kick.speed_mps,
+            k.kick.freq_hz,
+            k.kick.sigma_per_s,
+            k.kick.sigma_sd_per_s,
+            k.kick.amp_deg,
+            k.kick.source.as_str(),
+            if k.used { "yes" } else { "no" },
+            escape_controls(&k.log)
+        );
+    }
+    o
+}
+
+/// The answer in words, as the table form begins: the kicks counted, the
+/// predicted wobble speed and its interval, the riding limit, the trend,
+/// the warnings and the model's estimate.
+#[must_use]
+pub fn answer_text(r: &Report, logs: usize) -> String {
     use crate::text::escape_controls;
     use std::fmt::Write;
     let mut o = String::new();
@@ -379,27 +444,6 @@ fn render_text(r: &Report, logs: usize) -> String {
             );
         }
         let _ = writeln!(o, "  method: {}", escape_controls(&m.method));
-    }
-    if !r.kicks.is_empty() {
-        let _ = writeln!(
-            o,
-            "  t_s       speed_mps  freq_hz  sigma_per_s  sigma_sd_per_s  amp_deg  source     used  log"
-        );
-    }
-    for k in &r.kicks {
-        let _ = writeln!(
-            o,
-            "  {:8.2}  {:9.2}  {:7.2}  {:11.3}  {:14.3}  {:7.2}  {:9}  {:4}  {}",
-            k.kick.t_s,
-            k.kick.speed_mps,
-            k.kick.freq_hz,
-            k.kick.sigma_per_s,
-            k.kick.sigma_sd_per_s,
-            k.kick.amp_deg,
-            k.kick.source.as_str(),
-            if k.used { "yes" } else { "no" },
-            escape_controls(&k.log)
-        );
     }
     o
 }

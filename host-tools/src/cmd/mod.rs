@@ -15,6 +15,7 @@ pub mod margin_model;
 pub mod model;
 pub mod nmea;
 pub mod plot;
+pub mod report;
 pub mod selftest;
 pub mod summary;
 pub mod wobble;

@@ -97,8 +97,25 @@ fn draw(figure: &impl Figure, kind: ImageKind) -> Result<Vec<u8>, String> {
     }
 }
 
+/// `figure` as SVG text to place inside a page, without the embedded font
+/// (the page names the font and the browser supplies one): a report holds
+/// several figures and would otherwise carry the font once per figure.
+///
+/// # Errors
+/// The backend's error, as text.
+pub fn svg_inline(figure: &impl Figure) -> Result<String, String> {
+    register_font();
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, figure.size_px()).into_drawing_area();
+        figure.draw(&root)?;
+        root.present().map_err(|e| e.to_string())?;
+    }
+    Ok(svg)
+}
+
 /// 8-bit RGB pixels, row by row, as a PNG file.
-fn encode_png(pixels: &[u8], (w, h): (u32, u32)) -> Result<Vec<u8>, png::EncodingError> {
+pub fn encode_png(pixels: &[u8], (w, h): (u32, u32)) -> Result<Vec<u8>, png::EncodingError> {
     let mut bytes = Vec::new();
     let mut encoder = png::Encoder::new(&mut bytes, w, h);
     encoder.set_color(png::ColorType::Rgb);

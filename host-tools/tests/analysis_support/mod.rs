@@ -468,3 +468,34 @@ pub fn python(script: &str, args: &[&std::ffi::OsStr]) -> Option<serde_json::Val
     assert!(out.status.success(), "{stderr}");
     Some(serde_json::from_slice(&out.stdout).expect("the script prints JSON"))
 }
+
+/// A 10 s pass at `speed` with one kick at 3 s: a 0.1 s push of 4 degrees,
+/// then a ring of 1.5 degrees at `freq_hz` decaying at
+/// `0.5 (speed - wobble_mps)`, plus a weave and small deterministic noise
+/// (`seed`): one pass of a kick campaign whose wobble speed is
+/// `wobble_mps`.
+#[must_use]
+pub fn kick_pass(speed: f64, wobble_mps: f64, freq_hz: f64, seed: u32) -> Ride {
+    let mut ride = Ride::new(10.0, speed, 0.0, 0.5, 0.0);
+    let sigma = 0.5 * (speed - wobble_mps);
+    let mut state = 0x9E37_79B9u32 ^ seed;
+    for (t, s) in ride.t_s.iter().zip(ride.steer_deg.iter_mut()) {
+        state ^= state << 13;
+        state ^= state >> 17;
+        state ^= state << 5;
+        let noise = 0.02 * (f64::from(state) / f64::from(u32::MAX) - 0.5);
+        let tau = t - 3.0;
+        let push = if (0.0..0.1).contains(&tau) {
+            4.0 * (TAU / 0.2 * tau).sin()
+        } else {
+            0.0
+        };
+        let ring = if tau >= 0.1 {
+            1.5 * (sigma * (tau - 0.1)).exp() * (TAU * freq_hz * (tau - 0.1)).sin()
+        } else {
+            0.0
+        };
+        *s += push + ring + noise;
+    }
+    ride
+}

@@ -56,19 +56,31 @@ pub fn run(args: &Args) -> Result<(), CliError> {
     // A log that could not be read fails the command: the figure is not
     // committed then, and an old one stays as it was.
     if let (Some(out), Ok(())) = (out, &loaded) {
-        let figure = EigenFigure {
-            title: format!("{}: wobble mode and measured episodes", set.name),
-            layers: vec![Layer {
-                label: "model".into(),
-                sweep: sweep(&model, &args.speeds.0, &args.params)?,
-                line: Line::Thick,
-            }],
-            modes: vec![Mode::Wobble],
-            measured: found.iter().map(LoggedEpisode::measured).collect(),
-        };
+        let figure = figure(&set.name, &model, &args.speeds.0, &args.params, &found)?;
         render(&figure, out)?;
     }
     loaded
+}
+
+/// Figure 8 over the model: the wobble mode of `model` (named `name`, from
+/// the file `params`) at `speeds` with every episode of `found` on it.
+pub fn figure(
+    name: &str,
+    model: &wobble_model::Model,
+    speeds: &[f64],
+    params: &Path,
+    found: &[LoggedEpisode],
+) -> Result<EigenFigure, CliError> {
+    Ok(EigenFigure {
+        title: format!("{name}: wobble mode and measured episodes"),
+        layers: vec![Layer {
+            label: "model".into(),
+            sweep: sweep(model, speeds, params)?,
+            line: Line::Thick,
+        }],
+        modes: vec![Mode::Wobble],
+        measured: found.iter().map(LoggedEpisode::measured).collect(),
+    })
 }
 
 fn residual_table(found: &[LoggedEpisode], wobble: &[wobble_model::Complex<f64>]) -> String {
