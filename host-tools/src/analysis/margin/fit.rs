@@ -251,14 +251,18 @@ pub(super) const MEDIAN_START_KICKS: usize = 1000;
 /// above [`MEDIAN_START_KICKS`] kicks it is the line of that many, taken
 /// evenly along the kicks in speed order (a hostile log holds 131 000).
 pub(super) fn repeated_median(u: &[f64], y: &[f64]) -> Option<[f64; 2]> {
-    if u.len() > MEDIAN_START_KICKS {
-        let mut order: Vec<usize> = (0..u.len()).collect();
-        order.sort_by(|&i, &j| u[i].total_cmp(&u[j]));
-        let step = u.len().div_ceil(MEDIAN_START_KICKS);
-        let (u, y): (Vec<f64>, Vec<f64>) =
-            order.iter().step_by(step).map(|&i| (u[i], y[i])).unzip();
-        return repeated_median(&u, &y);
+    if u.len() <= MEDIAN_START_KICKS {
+        return siegel(u, y);
     }
+    let mut order: Vec<usize> = (0..u.len()).collect();
+    order.sort_by(|&i, &j| u[i].total_cmp(&u[j]));
+    let step = u.len().div_ceil(MEDIAN_START_KICKS);
+    let (u, y): (Vec<f64>, Vec<f64>) = order.iter().step_by(step).map(|&i| (u[i], y[i])).unzip();
+    siegel(&u, &y)
+}
+
+/// [`repeated_median`] of every kick.
+fn siegel(u: &[f64], y: &[f64]) -> Option<[f64; 2]> {
     let slopes: Vec<f64> = (0..u.len())
         .filter_map(|i| {
             let to_others: Vec<f64> = (0..u.len())

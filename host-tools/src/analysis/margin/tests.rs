@@ -717,25 +717,33 @@ fn the_repeated_median_ignores_a_kick_far_out_at_the_end() {
 }
 
 /// Above [`fit::MEDIAN_START_KICKS`] kicks the line is that of kicks taken
-/// evenly in speed order: 20 001 kicks given in scrambled order on
-/// `y = 2 u - 1`, every fourth in speed order and the first thousand given
-/// 5 above it, keep some seven exact points in ten in the sample, so both
-/// medians are exact (the first thousand alone would put the intercept 5
-/// too high). A hostile log's 131 000 kicks would otherwise take 17
-/// billion pairwise slopes.
+/// evenly in speed order: of 20 001 kicks given in scrambled order, every
+/// 21st in speed order (the sample) lies on `y = 2 u - 1`, three in four of
+/// the others 5 above it. The sample's line is exact; over every kick the
+/// intercept would be 4 (most kicks are off), and over the first thousand
+/// given too. A hostile log's 131 000 kicks would otherwise take 17 billion
+/// pairwise slopes.
 #[test]
 fn the_repeated_median_of_many_kicks_samples_them_along_the_speeds() {
     let n = 20_001;
     let (u, y): (Vec<f64>, Vec<f64>) = (0..n)
         .map(|i| {
-            let k = (i * 7_919) % n;
-            let u = 2.0 + 0.000_1 * k as f64;
-            let off = if i < 1000 || k % 4 == 1 { 5.0 } else { 0.0 };
+            let rank = (i * 7_919) % n;
+            let u = 2.0 + 0.000_1 * rank as f64;
+            let off = if rank % 21 != 0 && rank % 4 != 0 {
+                5.0
+            } else {
+                0.0
+            };
             (u, 2.0 * u - 1.0 + off)
         })
         .unzip();
     let [a, b] = repeated_median(&u, &y).unwrap();
     assert!((b - 2.0).abs() < 1e-9 && (a + 1.0).abs() < 1e-9, "{a} {b}");
+    // Exactly as many as the sample holds: every one, as before.
+    let (u, y) = (&u[..fit::MEDIAN_START_KICKS], &y[..fit::MEDIAN_START_KICKS]);
+    let [a, _] = repeated_median(u, y).unwrap();
+    assert!((a - 4.0).abs() < 1e-9, "{a}");
 }
 
 /// A stress campaign (seed 1743 of the low-speed class): sigma falls
