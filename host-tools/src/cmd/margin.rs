@@ -128,7 +128,10 @@ pub struct Report {
 
 /// The logs named by `inputs`: files as given, directories' `*.WBL` files
 /// in name order.
-fn expand(inputs: &[PathBuf]) -> Result<Vec<PathBuf>, CliError> {
+///
+/// # Errors
+/// A directory without a log, or that cannot be listed.
+pub fn expand(inputs: &[PathBuf]) -> Result<Vec<PathBuf>, CliError> {
     let mut logs = Vec::new();
     for input in inputs {
         if input.is_dir() {
@@ -200,6 +203,33 @@ pub fn report(mut rows: Vec<KickRow>, trend: Trend, ride_margin: f64) -> (Report
     (report, margin)
 }
 
+/// The report of `rows` as `args` ask for it, the model's estimate
+/// included with `--model` (the Python package's `wobblog.margin` too).
+///
+/// # Errors
+/// The model's parameter file cannot be read or fitted.
+pub fn full_report(rows: Vec<KickRow>, args: &Args) -> Result<(Report, Margin), CliError> {
+    let (mut report, margin) = report(rows, args.trend, args.ride_margin / 100.0);
+    if let Some(params) = &args.model {
+        let keys: Vec<String> = if args.params.is_empty() {
+            DEFAULT_PARAMS.iter().map(|k| (*k).to_owned()).collect()
+        } else {
+            args.params.clone()
+        };
+        let used: Vec<(f64, f64, f64, f64)> = report
+            .kicks
+            .iter()
+            .filter(|r| r.used)
+            .map(|r| {
+                let k = &r.kick;
+                (k.speed_mps, k.freq_hz, k.sigma_per_s, k.sigma_sd_per_s)
+            })
+            .collect();
+        report.model = Some(estimate(params, &keys, &used, report.kicks_rejected)?);
+    }
+    Ok((report, margin))
+}
+
 /// Runs `wobblog margin`.
 pub fn run(args: &Args) -> Result<(), CliError> {
     if let Some(plot) = &args.plot {
@@ -220,24 +250,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
     if rows.is_empty() && result.is_err() {
         return result;
     }
-    let (mut report, margin) = report(rows, args.trend, args.ride_margin / 100.0);
-    if let Some(params) = &args.model {
-        let keys: Vec<String> = if args.params.is_empty() {
-            DEFAULT_PARAMS.iter().map(|k| (*k).to_owned()).collect()
-        } else {
-            args.params.clone()
-        };
-        let used: Vec<(f64, f64, f64, f64)> = report
-            .kicks
-            .iter()
-            .filter(|r| r.used)
-            .map(|r| {
-                let k = &r.kick;
-                (k.speed_mps, k.freq_hz, k.sigma_per_s, k.sigma_sd_per_s)
-            })
-            .collect();
-        report.model = Some(estimate(params, &keys, &used, report.kicks_rejected)?);
-    }
+    let (report, margin) = full_report(rows, args)?;
     let text = if args.json {
         let line = serde_json::to_string(&report)
             .map_err(|e| CliError::Failed(format!("cannot write the report: {e}")))?;
