@@ -6,6 +6,7 @@ use std::path::Path;
 use pyo3::prelude::*;
 use wobble_core::format::{Event, Record};
 use wobblog::export::columns::Column;
+use wobblog::losses::Losses;
 use wobblog::reader::read_log_try;
 use wobblog::rows::{Row, RowAssembler};
 use wobblog::time::TimeWindow;
@@ -17,10 +18,11 @@ use crate::table::TableBuilder;
 /// Decoder events between two looks for a pending `KeyboardInterrupt`.
 const EVENTS_PER_SIGNAL_CHECK: u32 = 1 << 16;
 
-/// The rows of the log at `path` inside `window`, in `columns`. Called
-/// without the GIL; it is taken briefly now and then to see whether
-/// Ctrl-C was pressed, which ends the decoding with `KeyboardInterrupt`.
-pub fn decode(path: &Path, columns: Vec<Column>, window: TimeWindow) -> PyResult<Table> {
+/// The rows of the log at `path` inside `window`, in `columns`, and what
+/// the log lost. Called without the GIL; it is taken briefly now and then
+/// to see whether Ctrl-C was pressed, which ends the decoding with
+/// `KeyboardInterrupt`.
+pub fn decode(path: &Path, columns: Vec<Column>, window: TimeWindow) -> PyResult<(Table, Losses)> {
     let fail = |e: CliError| crate::errors::to_py(e);
     window.check_order(path).map_err(fail)?;
     let mut table = TableBuilder::new(columns);
@@ -41,8 +43,10 @@ pub fn decode(path: &Path, columns: Vec<Column>, window: TimeWindow) -> PyResult
         }
     };
     let mut rows = RowAssembler::new();
+    let mut losses = Losses::default();
     let mut events = 0u32;
     let walked = read_log_try(path, |event| {
+        losses.observe(&event);
         if let Event::Record(record) = event {
             has_utc |= matches!(record, Record::UtcSync(_));
             rows.push(&record, &mut keep);
@@ -65,7 +69,7 @@ pub fn decode(path: &Path, columns: Vec<Column>, window: TimeWindow) -> PyResult
         ));
     }
     let (schema, batches) = table.finish().map_err(|e| arrow_error(path, &e))?;
-    Ok(Table::new(schema, batches))
+    Ok((Table::new(schema, batches), losses))
 }
 
 fn arrow_error(path: &Path, e: &arrow_schema::ArrowError) -> PyErr {

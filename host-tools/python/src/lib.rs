@@ -7,6 +7,7 @@ mod errors;
 mod frames;
 mod json;
 mod log;
+mod scan;
 mod stream;
 mod table;
 mod window;
@@ -26,6 +27,9 @@ fn open(py: Python<'_>, path: PathBuf) -> PyResult<log::Log> {
 fn _wobblog(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(open, m)?)?;
     m.add_function(wrap_pyfunction!(campaign::margin, m)?)?;
+    m.add_function(wrap_pyfunction!(scan::scan, m)?)?;
+    m.add_function(wrap_pyfunction!(scan::summary, m)?)?;
+    m.add_class::<scan::Scan>()?;
     m.add_class::<log::Log>()?;
     m.add_class::<stream::Table>()?;
     m.add("WobblogError", m.py().get_type::<errors::WobblogError>())?;

@@ -144,7 +144,9 @@ impl Log {
             .map_err(|e| WobblogError::new_err(format!("{}: {e}", self.shown())))?;
         let window = window(start.as_ref(), end.as_ref())?;
         let path = self.path.clone();
+        // Its losses were reported on opening.
         py.detach(|| crate::frames::decode(&path, chosen, window))
+            .map(|(table, _)| table)
     }
 
     /// Alerts, markers, faults, dropouts and damage in time order: one dict

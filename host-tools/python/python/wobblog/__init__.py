@@ -8,10 +8,13 @@ and DuckDB read without a copy (the Arrow PyCapsule stream interface).
 from ._wobblog import (
     DamageWarning,
     Log,
+    Scan,
     Table,
     WobblogError,
     __version__,
     open,
+    scan,
+    summary,
 )
 from ._wobblog import margin as _margin
 
@@ -48,9 +51,12 @@ __all__ = [
     "DamageWarning",
     "Log",
     "Margin",
+    "Scan",
     "Table",
     "WobblogError",
     "__version__",
     "margin",
     "open",
+    "scan",
+    "summary",
 ]

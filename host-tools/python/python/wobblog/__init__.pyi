@@ -5,10 +5,13 @@ from typing import Any, Optional, Sequence, Union
 
 from ._wobblog import DamageWarning as DamageWarning
 from ._wobblog import Log as Log
+from ._wobblog import Scan as Scan
 from ._wobblog import Table as Table
 from ._wobblog import WobblogError as WobblogError
 from ._wobblog import __version__ as __version__
 from ._wobblog import open as open
+from ._wobblog import scan as scan
+from ._wobblog import summary as summary
 
 _Path = Union[str, "os.PathLike[str]"]
 

@@ -78,6 +78,32 @@ class Log:
         """``t_s`` (s since boot) and ``roll_deg`` (deg, positive leaning right),
         the roll estimate ``wobblog plot`` draws, one row per frame."""
 
+class Scan:
+    """The frames of every log of a card or folder of cards, then ``run`` (and
+    ``card``): one Arrow stream, each log decoded when the reader gets to it."""
+
+    @property
+    def logs(self) -> list[str]: ...
+    @property
+    def column_names(self) -> list[str]: ...
+    def __arrow_c_stream__(self, requested_schema: Optional[object] = None) -> object: ...
+    def to_polars(self) -> Any: ...
+    def to_arrow(self) -> Any: ...
+
+def scan(
+    dir: _Path,
+    columns: Optional[Sequence[str]] = None,
+    start: Optional[_Time] = None,
+    end: Optional[_Time] = None,
+) -> Scan:
+    """Every log of a card (``RUNnnnnn.WBL`` at its top) or a folder of cards as
+    one table: ``Log.frames()``'s columns, then ``run`` and, for cards, ``card``
+    (the columns of ``wobblog export``'s frames dataset)."""
+
+def summary(dir: _Path) -> list[dict[str, Any]]:
+    """One row per run, as ``wobblog summary --json`` (``duration_s`` s,
+    ``distance_m`` m, ``max_speed_mps`` and ``wobble_speed_mps`` m/s, ...)."""
+
 def open(path: _Path) -> Log:
     """Opens a card log (``RUNnnnnn.WBL``), warning (``DamageWarning``) of what it lost."""
 
