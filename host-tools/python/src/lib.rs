@@ -2,6 +2,7 @@
 //! tables, and the analyses of the `wobblog` library crate (the CLI's own
 //! functions, so the numbers are the CLI's).
 
+mod arrays;
 mod campaign;
 mod errors;
 mod frames;
@@ -28,6 +29,8 @@ fn _wobblog(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(open, m)?)?;
     m.add_function(wrap_pyfunction!(campaign::margin, m)?)?;
     m.add_function(wrap_pyfunction!(scan::scan, m)?)?;
+    m.add_function(wrap_pyfunction!(arrays::episodes, m)?)?;
+    m.add_function(wrap_pyfunction!(arrays::kicks, m)?)?;
     m.add_function(wrap_pyfunction!(scan::summary, m)?)?;
     m.add_class::<scan::Scan>()?;
     m.add_class::<log::Log>()?;

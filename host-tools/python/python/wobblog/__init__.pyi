@@ -41,3 +41,18 @@ def margin(
 ) -> Margin:
     """The wobble speed predicted from the kicks of a campaign below it (m/s),
     with its 95 % interval, as ``wobblog margin --json``."""
+
+def episodes(
+    steer_deg: Any, speed_mps: Any, rate_hz: float = 100.0, t_s: Optional[Any] = None
+) -> dict[str, Any]:
+    """Wobble episodes in 100 Hz samples from any source (``steer_deg`` deg,
+    ``speed_mps`` m/s, ``t_s`` s), as ``wobblog wobble --json``."""
+
+def kicks(
+    steer_deg: Any,
+    speed_mps: Any,
+    rate_hz: float = 100.0,
+    t_s: Optional[Any] = None,
+    wheel_circumference_m: Optional[float] = None,
+) -> list[dict[str, Any]]:
+    """Kick ring-downs in 100 Hz samples from any source, as ``Log.kicks(kicks="host")``."""
