@@ -8,6 +8,7 @@ mod errors;
 mod frames;
 mod json;
 mod log;
+mod model;
 mod scan;
 mod stream;
 mod table;
@@ -31,6 +32,8 @@ fn _wobblog(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(scan::scan, m)?)?;
     m.add_function(wrap_pyfunction!(arrays::episodes, m)?)?;
     m.add_function(wrap_pyfunction!(arrays::kicks, m)?)?;
+    m.add_function(wrap_pyfunction!(model::load_model, m)?)?;
+    m.add_class::<model::Model>()?;
     m.add_function(wrap_pyfunction!(scan::summary, m)?)?;
     m.add_class::<scan::Scan>()?;
     m.add_class::<log::Log>()?;
