@@ -1,6 +1,7 @@
 """Type stubs of the native module; host-tools/docs/python.md has the API."""
 
 import os
+from pathlib import Path
 from datetime import datetime
 from typing import Any, Optional, Sequence, Union
 
@@ -42,7 +43,7 @@ class Log:
     """A card log, read once on opening; its losses are ``DamageWarning``s."""
 
     @property
-    def path(self) -> str: ...
+    def path(self) -> Path: ...
     @property
     def info(self) -> dict[str, Any]:
         """The keys and values of ``wobblog info --json`` (times in s, speeds in m/s)."""
@@ -83,7 +84,7 @@ class Scan:
     ``card``): one Arrow stream, each log decoded when the reader gets to it."""
 
     @property
-    def logs(self) -> list[str]: ...
+    def logs(self) -> list[Path]: ...
     @property
     def column_names(self) -> list[str]: ...
     def __arrow_c_stream__(self, requested_schema: Optional[object] = None) -> object: ...

@@ -1,6 +1,7 @@
 """Type stubs of wobblog.model; host-tools/docs/python.md has the API."""
 
 import os
+from pathlib import Path
 from typing import Any, Optional, Sequence, Union
 
 from ._wobblog import Table
@@ -11,7 +12,7 @@ class Model:
     """A bicycle model: a parameter file's values and the model built of them."""
 
     @property
-    def path(self) -> str: ...
+    def path(self) -> Path: ...
     @property
     def variant(self) -> str:
         """``own``, ``whipple`` or ``no-slip``."""
