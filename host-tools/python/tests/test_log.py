@@ -1,8 +1,11 @@
 """`wobblog.open`: a log's info, config and damage, as `wobblog info --json`
 and `wobblog config` give them; errors and warnings."""
 
+import os
+import threading
 import warnings
 
+import pyarrow as pa
 import pytest
 
 import wobblog
@@ -108,3 +111,24 @@ def test_inputs_are_never_written(golden, campaign, wobble_log):
             log.roll()
         wobblog.margin(campaign)
     assert [frozen(p) for p in paths] == before
+
+
+def test_a_log_from_a_pipe_is_read_like_its_file(golden, tmp_path):
+    # As the CLI: a stream (a FIFO, /dev/stdin) is copied once, then every
+    # call reads the copy.
+    fifo = tmp_path / "pipe.WBL"
+    os.mkfifo(fifo)
+    data = golden["gps"].read_bytes()
+
+    def feed():
+        with open(fifo, "wb") as f:
+            f.write(data)
+
+    writer = threading.Thread(target=feed)
+    writer.start()
+    piped = wobblog.open(fifo)
+    writer.join()
+    file = wobblog.open(golden["gps"])
+    assert piped.info == file.info
+    assert pa.table(piped.frames()).equals(pa.table(file.frames()))
+    assert piped.events() == file.events()
