@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Runs every check and test of the project on a fresh machine: installs what
 # it needs first (idempotent), then formatting, lints on the host and on the
-# MCU target, the host test suite, and the firmware build.
+# MCU target, the host test suite, the firmware build, and the Python
+# package's build and tests.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -60,3 +61,6 @@ cargo clippy -p wobble-qemu-image --target "$TARGET" -- -D warnings
 # (host-tools/docs/robustness.md, "Property tests").
 step "tests (PROPTEST_RNG_SEED=${PROPTEST_RNG_SEED:-from .cargo/config.toml})"
 cargo test
+
+step "Python package (host-tools/python): clippy, build into a virtual environment, pytest"
+hil-tests/python-tests.sh

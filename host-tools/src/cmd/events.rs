@@ -85,13 +85,15 @@ pub fn walk<E>(
 
 /// One event of the JSON lines: its time since boot, UTC, kind and fields.
 #[derive(serde::Serialize)]
-struct JsonEvent<'a> {
-    t_s: f64,
+pub struct JsonEvent<'a> {
+    /// Time since boot, s.
+    pub t_s: f64,
     /// ISO 8601, when the log has UTC there.
     #[serde(skip_serializing_if = "Option::is_none")]
-    utc: Option<String>,
+    pub utc: Option<String>,
+    /// What happened, with its fields.
     #[serde(flatten)]
-    kind: &'a crate::events::EventKind,
+    pub kind: &'a crate::events::EventKind,
 }
 
 /// The events as a table or as JSON lines.

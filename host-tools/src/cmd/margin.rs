@@ -128,6 +128,9 @@ pub struct Report {
 
 /// The logs named by `inputs`: files as given, directories' `*.WBL` files
 /// in name order.
+///
+/// # Errors
+/// A directory without a log, or that cannot be listed.
 pub fn expand(inputs: &[PathBuf]) -> Result<Vec<PathBuf>, CliError> {
     let mut logs = Vec::new();
     for input in inputs {
@@ -200,6 +203,19 @@ pub fn report(mut rows: Vec<KickRow>, trend: Trend, ride_margin: f64) -> (Report
     (report, margin)
 }
 
+/// The report of `rows` as `args` ask for it, the model's estimate
+/// included with `--model` (the Python package's `wobblog.margin` too).
+///
+/// # Errors
+/// The model's parameter file cannot be read or fitted.
+pub fn full_report(rows: Vec<KickRow>, args: &Args) -> Result<(Report, Margin), CliError> {
+    let (mut report, margin) = report(rows, args.trend, args.ride_margin / 100.0);
+    if let Some(params) = &args.model {
+        add_model(&mut report, params, &args.params)?;
+    }
+    Ok((report, margin))
+}
+
 /// Runs `wobblog margin`.
 pub fn run(args: &Args) -> Result<(), CliError> {
     if let Some(plot) = &args.plot {
@@ -220,10 +236,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
     if rows.is_empty() && result.is_err() {
         return result;
     }
-    let (mut report, margin) = report(rows, args.trend, args.ride_margin / 100.0);
-    if let Some(params) = &args.model {
-        add_model(&mut report, params, &args.params)?;
-    }
+    let (report, margin) = full_report(rows, args)?;
     let printed = if args.json {
         print_json(stdout, &report)
     } else {

@@ -90,6 +90,19 @@ impl RunRow {
     }
 }
 
+/// The row of `ride`, one of the logs of `cards`: its log named
+/// `CARD/RUNnnnnn.WBL` in a folder of cards (the Python package's
+/// `wobblog.summary` too).
+#[must_use]
+pub fn card_row(cards: &[crate::dataset::Card], ride: &Ride) -> RunRow {
+    let mut row = RunRow::of(ride);
+    let card = cards.iter().find(|(_, logs)| logs.contains(&ride.path));
+    if let Some((Some(card), _)) = card {
+        row.log = format!("{card}/{}", row.log);
+    }
+    row
+}
+
 /// The card logs in `dir`, sorted by name.
 pub fn logs_in(dir: &Path) -> Result<Vec<PathBuf>, CliError> {
     let entries = std::fs::read_dir(dir).map_err(|e| CliError::file(dir, e))?;
@@ -116,12 +129,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
     let result = for_each_log(&logs, "summarising", |log| {
         let ride = Ride::load(log)?;
         warn_losses(log, &ride.summary);
-        let mut row = RunRow::of(&ride);
-        let card = cards.iter().find(|(_, logs)| logs.iter().any(|l| l == log));
-        if let Some((Some(card), _)) = card {
-            row.log = format!("{card}/{}", row.log);
-        }
-        rows.push(row);
+        rows.push(card_row(&cards, &ride));
         Ok(())
     });
     let format = if args.json {

@@ -10,7 +10,7 @@ use crate::cmd::logs::{for_each_log, print, warn_losses};
 use crate::output::Output;
 use crate::plot::modes::ModePlot;
 use crate::plot::{render, ImageKind};
-use crate::time::{utc_text_at, WindowArgs};
+use crate::time::{utc_text_at, TimeWindow, WindowArgs};
 use crate::CliError;
 
 /// Arguments of `wobblog wobble`.
@@ -74,22 +74,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
     let result = for_each_log(&logs, "analysing", |log| {
         let ride = Ride::load(log)?;
         warn_losses(log, &ride.summary);
-        let (from, to) = args.window.window().boot_s(&ride.summary.utc_syncs, log)?;
-        let mut episodes = ride.episodes.clone();
-        episodes
-            .retain(|e| from.is_none_or(|a| e.onset_s >= a) && to.is_none_or(|b| e.onset_s <= b));
-        let pairs = &ride.summary.utc_syncs;
-        reports.push(RunEpisodes {
-            log: log.display().to_string(),
-            wobble_speed_mps: wobble_speed_mps(&episodes),
-            episodes: episodes
-                .into_iter()
-                .map(|episode| EpisodeUtc {
-                    onset_utc: utc_text_at(pairs, episode.onset_s),
-                    episode,
-                })
-                .collect(),
-        });
+        reports.push(episodes_of(&ride, &args.window.window())?);
         names.push(ride.name());
         Ok(())
     });
@@ -116,6 +101,29 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         render(&ModePlot::new(runs), out)?;
     }
     result.and(printed)
+}
+
+/// The episodes of `ride` whose onset falls in `window`, as `wobblog
+/// wobble --json` prints them (the Python package's `Log.episodes` too).
+///
+/// # Errors
+/// A UTC bound of `window` in a log without UTC.
+pub fn episodes_of(ride: &Ride, window: &TimeWindow) -> Result<RunEpisodes, CliError> {
+    let (from, to) = window.boot_s(&ride.summary.utc_syncs, &ride.path)?;
+    let mut episodes = ride.episodes.clone();
+    episodes.retain(|e| from.is_none_or(|a| e.onset_s >= a) && to.is_none_or(|b| e.onset_s <= b));
+    let pairs = &ride.summary.utc_syncs;
+    Ok(RunEpisodes {
+        log: ride.path.display().to_string(),
+        wobble_speed_mps: wobble_speed_mps(&episodes),
+        episodes: episodes
+            .into_iter()
+            .map(|episode| EpisodeUtc {
+                onset_utc: utc_text_at(pairs, episode.onset_s),
+                episode,
+            })
+            .collect(),
+    })
 }
 
 fn render_text(r: &RunEpisodes) -> String {

@@ -61,24 +61,53 @@ pub struct Args {
     pub output: Option<PathBuf>,
 }
 
-#[derive(Serialize)]
-struct Row<'a> {
-    speed_mps: f64,
-    mode: &'a str,
-    re_per_s: f64,
-    im_rad_per_s: f64,
+/// One eigenvalue: a row of the CSV and a line of the JSON lines.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Row {
+    /// Forward speed, m/s.
+    pub speed_mps: f64,
+    /// The mode it belongs to (`weave`, `capsize`, `wobble`, ...).
+    pub mode: &'static str,
+    /// Real part, 1/s.
+    pub re_per_s: f64,
+    /// Imaginary part, rad/s (0 for a real eigenvalue).
+    pub im_rad_per_s: f64,
 }
 
-/// Why writing the rows stopped.
-enum Failure {
-    Write(std::io::Error),
+/// Why handing out the rows stopped.
+pub enum Failure<E> {
+    /// The visitor's error.
+    Visit(E),
+    /// The eigenvalues could not be found.
     Sweep(SweepError),
 }
 
-impl From<SweepError> for Failure {
+impl<E> From<SweepError> for Failure<E> {
     fn from(e: SweepError) -> Self {
         Self::Sweep(e)
     }
+}
+
+/// Hands every eigenvalue of `model` at `speeds` to `visit`, speed by
+/// speed, by mode (as `survey` named them), then imaginary part: the rows
+/// of `wobblog model eig` (the Python package's `Model.eig` too).
+///
+/// # Errors
+/// The first error of `visit`, or of the eigenvalue solver.
+pub fn visit_rows<E>(
+    model: &wobble_model::Model,
+    survey: &wobble_model::Survey,
+    speeds: &[f64],
+    mut visit: impl FnMut(&Row) -> Result<(), E>,
+) -> Result<(), Failure<E>> {
+    let mut at = Vec::with_capacity(survey.modes.len());
+    survey.replay(model, speeds, |u, values| {
+        rows_at(&mut at, &survey.modes, values);
+        for &(mode, v) in &at {
+            visit(&row(u, mode, v)).map_err(Failure::Visit)?;
+        }
+        Ok(())
+    })
 }
 
 /// Runs `wobblog model eig`. The sweep is never held whole: a first pass
@@ -107,17 +136,12 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         Format::Jsonl => b"",
     };
     out.write_all(header).map_err(|e| out.error(e))?;
-    let mut at = Vec::with_capacity(survey.modes.len());
-    let written = survey.replay(&model, speeds, |u, values| {
-        rows_at(&mut at, &survey.modes, values);
-        for &(mode, v) in &at {
-            write_row(&mut out, args.format, &row(u, mode, v)).map_err(Failure::Write)?;
-        }
-        Ok(())
+    let written = visit_rows(&model, &survey, speeds, |row| {
+        write_row(&mut out, args.format, row)
     });
     match written {
         Ok(()) => {}
-        Err(Failure::Write(e)) => return Err(out.error(e)),
+        Err(Failure::Visit(e)) => return Err(out.error(e)),
         Err(Failure::Sweep(e)) => return Err(CliError::file(&args.params, e)),
     }
     let tail = match args.format {
@@ -140,7 +164,7 @@ fn rows_at(at: &mut Vec<(Mode, Complex<f64>)>, modes: &[Mode], values: &[Complex
     });
 }
 
-fn row(u: f64, mode: Mode, v: Complex<f64>) -> Row<'static> {
+fn row(u: f64, mode: Mode, v: Complex<f64>) -> Row {
     Row {
         speed_mps: u,
         mode: mode.name(),
@@ -190,17 +214,22 @@ fn write_table_tail(o: &mut dyn Write, critical: &[CriticalSpeed]) -> std::io::R
 
 fn write_jsonl_tail(o: &mut dyn Write, critical: &[CriticalSpeed]) -> std::io::Result<()> {
     for c in critical {
-        let line = serde_json::json!({
-            "critical_speed_mps": c.speed_mps,
-            "mode": c.mode.name(),
-            "unstable_above": c.unstable_above,
-            "kind": c.kind(),
-            "im_rad_per_s": c.im_rad_per_s,
-        });
-        serde_json::to_writer(&mut *o, &line)?;
+        serde_json::to_writer(&mut *o, &critical_json(c))?;
         o.write_all(b"\n")?;
     }
     Ok(())
+}
+
+/// A critical speed as a line of `wobblog model eig --format jsonl`.
+#[must_use]
+pub fn critical_json(c: &CriticalSpeed) -> serde_json::Value {
+    serde_json::json!({
+        "critical_speed_mps": c.speed_mps,
+        "mode": c.mode.name(),
+        "unstable_above": c.unstable_above,
+        "kind": c.kind(),
+        "im_rad_per_s": c.im_rad_per_s,
+    })
 }
 
 /// `weave speed 4.292382536 m/s (stable above, oscillatory, 2.97 Hz)`.

@@ -1,0 +1,116 @@
+"""Opening a long log into Polars through the package against reading the
+same frames from Parquet, in one process; prints times, ratios and peak
+memory. Usage (from the repository root, the package and polars installed):
+
+    python host-tools/python/benchmarks/frames_vs_parquet.py [--minutes 60] [--logs 20] [--scan-minutes 10]
+
+The CLI (`WOBBLOG_CLI`, else the release build in the target directory)
+encodes a synthetic ride of that length and decodes it to Parquet first.
+"""
+
+import argparse
+import math
+import os
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import polars as pl
+
+import wobblog
+
+ROOT = Path(__file__).resolve().parents[3]
+
+
+def cli():
+    if os.environ.get("WOBBLOG_CLI"):
+        return os.environ["WOBBLOG_CLI"]
+    target = Path(os.environ.get("CARGO_TARGET_DIR", ROOT / "target"))
+    return str(target / "release" / "wobblog")
+
+
+def encode(directory, minutes, run=1):
+    """A ride of `minutes` at 100 Hz with every IMU channel moving (a
+    different weave per `run`, so no two logs are copies)."""
+    csv = directory / f"ride{run}.csv"
+    weave_hz = 0.6 + 0.01 * run
+    with csv.open("w") as f:
+        f.write("t_s,ax_g,ay_g,az_g,gx_dps,gy_dps,gz_dps,steer_deg,speed_mps\n")
+        for i in range(minutes * 60 * 100):
+            t = i / 100
+            s = math.sin(2 * math.pi * 6.4 * t)
+            w = math.sin(2 * math.pi * weave_hz * t)
+            f.write(f"{t:.2f},{0.01 * s:.4f},{0.1 * w:.4f},1.0,{5 * w:.3f},"
+                    f"{2 * s:.3f},{3 * w:.3f},{s + 2 * w:.2f},{4 + 0.5 * w:.3f}\n")
+    log = directory / f"RUN{run:05d}.WBL"
+    subprocess.run([cli(), "encode", "--csv", csv, "-o", log], check=True)
+    csv.unlink()
+    return log
+
+
+def best_of(n, work):
+    times = []
+    for _ in range(n):
+        start = time.perf_counter()
+        result = work()
+        times.append(time.perf_counter() - start)
+        del result
+    return min(times)
+
+
+def peak_rss_mib(code):
+    """Peak resident memory of a fresh interpreter running `code`, MiB: its
+    VmHWM (Linux), as getrusage's maxrss carries over this large process's
+    peak into a child across exec."""
+    read_peak = ("\nprint([l.split()[1] for l in open('/proc/self/status') "
+                 "if l.startswith('VmHWM')][0])")
+    out = subprocess.run([sys.executable, "-c", code + read_peak],
+                         check=True, capture_output=True, text=True)
+    return int(out.stdout.split()[-1]) / 1024
+
+
+def main():
+    parser = argparse.ArgumentParser()
+    parser.add_argument("--minutes", type=int, default=60)
+    parser.add_argument("--logs", type=int, default=20)
+    parser.add_argument("--scan-minutes", type=int, default=10)
+    args = parser.parse_args()
+    with tempfile.TemporaryDirectory() as tmp:
+        directory = Path(tmp)
+        log = encode(directory, args.minutes)
+        parquet = directory / "ride.parquet"
+        subprocess.run([cli(), "decode", log, "-o", parquet], check=True)
+        df = wobblog.open(log).frames().to_polars()
+        assert df.equals(pl.read_parquet(parquet))
+        size_mib = df.estimated_size() / 2**20
+        ours = best_of(5, lambda: wobblog.open(log).frames().to_polars())
+        frames_only = best_of(5, lambda: wobblog.open(log))
+        theirs = best_of(5, lambda: pl.read_parquet(parquet))
+        print(f"{df.height} frames ({args.minutes} min), DataFrame {size_mib:.1f} MiB")
+        print(f"wobblog.open(p).frames().to_polars(): {ours * 1e3:.0f} ms "
+              f"(of which open: {frames_only * 1e3:.0f} ms)")
+        print(f"polars.read_parquet:                  {theirs * 1e3:.0f} ms")
+        print(f"ratio: {ours / theirs:.2f}")
+        base = peak_rss_mib("import polars, wobblog")
+        peak = peak_rss_mib(f"import polars, wobblog; "
+                            f"df = wobblog.open({str(log)!r}).frames().to_polars()")
+        print(f"peak memory above the imports: {peak - base:.1f} MiB, "
+              f"{(peak - base) / size_mib:.2f}x the DataFrame")
+        # Scans of a few and of many logs of `--scan-minutes` each: streamed,
+        # their peaks should not grow with the number of logs.
+        peaks = []
+        for n in (2, args.logs):
+            card = directory / f"card{n}"
+            card.mkdir()
+            for run in range(n):
+                encode(card, args.scan_minutes, run)
+            code = (f"import pyarrow as pa, wobblog; r = pa.RecordBatchReader.from_stream("
+                    f"wobblog.scan({str(card)!r})); n = sum(b.num_rows for b in r)")
+            peaks.append(peak_rss_mib(code) - base)
+        print(f"scan of 2 and of {args.logs} logs of {args.scan_minutes} min, streamed: "
+              f"peak {peaks[0]:.1f} and {peaks[1]:.1f} MiB above the imports")
+
+if __name__ == "__main__":
+    main()
