@@ -373,12 +373,16 @@ fn ride_view(o: &mut String, k: usize, r: &RideView) {
     }
     let _ = write!(
         o,
-        "</section>\n<section data-section=\"config\"><h3>Configuration</h3><pre class=\"config\">{}</pre>\
+        "</section>\n<section data-section=\"config\"><h3>Configuration</h3>{}\
          <p class=\"hint\">Firmware {}, device {}, run {}, {} Hz.</p></section></div>\n",
         if s.config.is_empty() {
-            "(no configuration lines in the log: the firmware's defaults)".to_owned()
+            "<p class=\"note\">No configuration lines in the log: the firmware's defaults.</p>"
+                .to_owned()
         } else {
-            escape(&s.config.join("\n"))
+            format!(
+                "<pre class=\"config\">{}</pre>",
+                escape(&s.config.join("\n"))
+            )
         },
         escape(s.firmware.as_deref().unwrap_or("?")),
         escape(s.device_id.as_deref().unwrap_or("?")),
