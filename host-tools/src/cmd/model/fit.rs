@@ -10,7 +10,7 @@ use wobble_model::fit::{fit, Weights};
 use wobble_model::params::to_toml;
 
 use super::episodes;
-use super::param_error;
+use super::{key_error, param_error};
 use crate::cmd::logs::{expand, print};
 use crate::output::Output;
 use crate::CliError;
@@ -47,7 +47,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
     }
     let set = super::load_set(&args.params)?;
     for key in &args.params_to_fit {
-        set.value(key).map_err(|e| param_error(&e))?;
+        set.value(key).map_err(|e| key_error(&set, &e))?;
     }
     let logs = crate::inputs::distinct(expand(&args.logs)?);
     let mut inputs: Vec<&Path> = logs.iter().map(PathBuf::as_path).collect();
