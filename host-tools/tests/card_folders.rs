@@ -121,6 +121,21 @@ fn plot_and_events_of_a_folder_list_its_logs() {
 }
 
 #[test]
+fn decode_gpx_and_config_of_a_folder_list_its_logs() {
+    let (dir, _) = card();
+    for command in ["decode", "gpx", "config"] {
+        let err = failure_of(wobblog().arg(command).arg(dir.path()));
+        assert!(err.contains(&dir.path().display().to_string()), "{err}");
+        assert!(
+            err.contains(&format!(
+                "`wobblog {command}` takes one log (its logs: RUN00001.WBL, RUN00002.WBL)"
+            )),
+            "{err}"
+        );
+    }
+}
+
+#[test]
 fn summary_of_a_log_points_to_info() {
     let (_dir, logs) = card();
     let err = failure_of(wobblog().arg("summary").arg(&logs[0]));
