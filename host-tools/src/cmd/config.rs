@@ -22,6 +22,8 @@ pub struct Args {
 
 /// Runs `wobblog config`.
 pub fn run(args: &Args) -> Result<(), CliError> {
+    // One log's settings, ready for one card: a folder is refused with its logs.
+    crate::cmd::logs::one_log(&args.log, "config", "pick the run whose settings to copy")?;
     let stdout = Output::stdout(&[&args.log])?;
     let header = read_header(&args.log)?;
     if header.config.is_empty() {

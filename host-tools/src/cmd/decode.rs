@@ -91,6 +91,13 @@ impl Export {
 
 /// Runs `wobblog decode`.
 pub fn run(args: &Args) -> Result<(), CliError> {
+    // One run's frames into one output: a folder is refused with its logs
+    // (`export` writes every run of a card as one dataset).
+    crate::cmd::logs::one_log(
+        &args.log,
+        "decode",
+        "decode them one by one, or `wobblog export` for every run of a card as one dataset",
+    )?;
     let resolved = Format::resolve(args.format, args.output.as_deref(), args.delimiter)?;
     let export = Export {
         format: resolved.format,

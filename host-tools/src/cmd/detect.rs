@@ -5,7 +5,7 @@
 use std::io::{self, Read};
 use std::path::{Path, PathBuf};
 
-use wobble_core::config::{Config, FAULT_REJECTED};
+use wobble_core::config::{Config, FAULT_REJECTED, FAULT_UNKNOWN_KEY};
 use wobble_core::detector::{AlertEvent, Detector, Kick, MarginEvent, MarginWarning};
 use wobble_core::format::{Event, FaultSource, MarginRecord, MarginState};
 
@@ -357,6 +357,9 @@ pub fn log_config(header_lines: &[String], set: &[String]) -> Result<Config, Cli
         .map(|f| {
             let what = crate::codes::fault_meaning(FaultSource::Config, f.code);
             match set.get(usize::from(f.line).wrapping_sub(first_set_line)) {
+                Some(line) if f.code == FAULT_UNKNOWN_KEY => {
+                    format!("--set {line}: {what}; {}", key_hint(line))
+                }
                 Some(line) => format!("--set {line}: {what}"),
                 None => format!("--set: {what}"),
             }
@@ -366,6 +369,17 @@ pub fn log_config(header_lines: &[String], set: &[String]) -> Result<Config, Cli
         return Err(CliError::Usage(bad.join("; ")));
     }
     Ok(loaded.config)
+}
+
+/// The configuration key closest to the one of `line` (`key=value`), or
+/// the list of keys, as `CONFIG.TXT` and `wobblog config` name them.
+fn key_hint(line: &str) -> String {
+    let mut text = String::new();
+    // Writing to a String cannot fail.
+    let _ = Config::default().write_lines(&mut text);
+    let known: Vec<&str> = text.lines().filter_map(|l| l.split('=').next()).collect();
+    let key = line.split('=').next().unwrap_or(line).trim();
+    crate::words::suggest(key, &known, "keys")
 }
 
 /// The circumference of the wheel a log was recorded with, m: its config

@@ -4,6 +4,7 @@
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
+use crate::cmd::logs::one_log;
 use crate::events::{EventConverter, LogEvent, TimeOrder};
 use crate::output::Output;
 use crate::reader::read_log_try;
@@ -23,6 +24,15 @@ pub struct Args {
 
 /// Runs `wobblog events`.
 pub fn run(args: &Args) -> Result<(), CliError> {
+    // One run's timeline: its times are seconds since that run's boot and
+    // its JSON lines name no log, so the runs of a folder would read as one
+    // jumbled listing. A folder is refused with its logs listed; `summary`
+    // gives every run's episodes and losses side by side.
+    one_log(
+        &args.log,
+        "events",
+        "list them one by one, or `wobblog summary` for every run's episodes and losses",
+    )?;
     let mut out = Output::stdout(&[&args.log])?;
     match list(&args.log, args.output.is_json()?, &mut out)? {
         Ok(()) => out.commit(),

@@ -33,6 +33,8 @@ const SEGMENT_GAP_US: u64 = 5_000_000;
 
 /// Runs `wobblog gpx`.
 pub fn run(args: &Args) -> Result<(), CliError> {
+    // One track into one named output: a folder is refused with its logs.
+    crate::cmd::logs::one_log(&args.log, "gpx", "write one track per log")?;
     let mut out = Output::create_or_stdout(args.output.as_deref(), &[&args.log])?;
     // Control characters are not XML: a name holding them is escaped.
     let name = args.log.file_stem().map_or_else(String::new, |s| {

@@ -1,8 +1,8 @@
 //! `wobblog info`: what a log holds and what it lost.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
-use crate::cmd::logs::print;
+use crate::cmd::logs::{expand, for_each_log, print};
 use crate::output::Output;
 use crate::reader::read_log;
 use crate::summary::{Summary, SummaryBuilder};
@@ -12,25 +12,72 @@ use crate::CliError;
 /// Arguments of `wobblog info`.
 #[derive(clap::Args)]
 pub struct Args {
-    /// The card log (`RUNnnnnn.WBL`).
-    pub log: PathBuf,
+    /// Card logs (`RUNnnnnn.WBL`) or card folders (every `*.WBL` at their
+    /// top, in name order): each log's report in turn.
+    #[arg(required = true, value_name = "LOGS|DIRS")]
+    pub logs: Vec<PathBuf>,
     /// `--json` (or `--format jsonl`) for JSON instead of text.
     #[command(flatten)]
     pub output: crate::cmd::logs::JsonArgs,
 }
 
-/// Runs `wobblog info`.
+/// One log's JSON among several: its summary with the log named first, as
+/// `wobble --json` names its log.
+#[derive(serde::Serialize)]
+struct NamedSummary<'a> {
+    log: String,
+    #[serde(flatten)]
+    summary: &'a Summary,
+}
+
+/// Runs `wobblog info`. One log is reported as ever (JSON as one indented
+/// object); several in turn, text reports apart by a blank line and JSON as
+/// JSON lines naming their log, a log that cannot be read named on stderr
+/// and the rest still reported (exit code 1), as `wobble` does.
 pub fn run(args: &Args) -> Result<(), CliError> {
-    let stdout = Output::stdout(&[&args.log])?;
-    let summary = summarise(&args.log)?;
-    let text = if args.output.is_json()? {
-        let json =
-            serde_json::to_string_pretty(&summary).map_err(|e| CliError::file(&args.log, e))?;
-        crate::text::json_terminal_safe(json) + "\n"
-    } else {
-        render(&args.log, &summary)
-    };
-    print(stdout, &text)
+    let json = args.output.is_json()?;
+    let logs = crate::inputs::distinct(expand(&args.logs)?);
+    let inputs: Vec<&Path> = logs.iter().map(PathBuf::as_path).collect();
+    let stdout = Output::stdout(&inputs)?;
+    if let [log] = logs.as_slice() {
+        let summary = summarise(log)?;
+        let text = if json {
+            let text =
+                serde_json::to_string_pretty(&summary).map_err(|e| CliError::file(log, e))?;
+            crate::text::json_terminal_safe(text) + "\n"
+        } else {
+            render(log, &summary)
+        };
+        return print(stdout, &text);
+    }
+    let mut text = String::new();
+    let result = for_each_log(&logs, "reading", |log| {
+        let summary = summarise(log)?;
+        text.push_str(&report_among(log, &summary, json, text.is_empty())?);
+        Ok(())
+    });
+    let printed = print(stdout, &text);
+    result.and(printed)
+}
+
+/// The report of one of several logs: a JSON line naming it, or its text
+/// after a blank line unless it comes `first`.
+fn report_among(
+    log: &Path,
+    summary: &Summary,
+    json: bool,
+    first: bool,
+) -> Result<String, CliError> {
+    if json {
+        let named = NamedSummary {
+            log: log.display().to_string(),
+            summary,
+        };
+        let line = serde_json::to_string(&named).map_err(|e| CliError::file(log, e))?;
+        return Ok(crate::text::json_terminal_safe(line) + "\n");
+    }
+    let gap = if first { "" } else { "\n" };
+    Ok(format!("{gap}{}", render(log, summary)))
 }
 
 /// Decodes the log at `path` into a summary.

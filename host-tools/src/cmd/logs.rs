@@ -6,10 +6,66 @@ use std::path::{Path, PathBuf};
 
 use indicatif::{ProgressBar, ProgressStyle};
 
+use crate::cmd::summary::logs_in;
 use crate::losses::Losses;
 use crate::output::Output;
 use crate::summary::Summary;
 use crate::CliError;
+
+/// The logs named by `inputs`: files as given, directories' `*.WBL` files
+/// in name order (a card folder, as `summary` and `export` list it).
+///
+/// # Errors
+/// A directory without a log, or that cannot be listed.
+pub fn expand(inputs: &[PathBuf]) -> Result<Vec<PathBuf>, CliError> {
+    let mut logs = Vec::new();
+    for input in inputs {
+        if input.is_dir() {
+            let found = logs_in(input)?;
+            if found.is_empty() {
+                return Err(CliError::file(input, "no *.WBL logs in this directory"));
+            }
+            logs.extend(found);
+        } else {
+            logs.push(input.clone());
+        }
+    }
+    Ok(logs)
+}
+
+/// Logs of a folder named in [`one_log`]'s error; the rest are counted.
+const LOGS_LISTED: usize = 10;
+
+/// Refuses a directory where a command takes one log (`command` names
+/// it): the error names the folder and lists its logs, so the user can
+/// pick one; `hint` says what to do for them all.
+///
+/// # Errors
+/// `log` is a directory, or a directory that cannot be listed.
+pub fn one_log(log: &Path, command: &str, hint: &str) -> Result<(), CliError> {
+    if !log.is_dir() {
+        return Ok(());
+    }
+    let found = logs_in(log)?;
+    let mut names: Vec<String> = found
+        .iter()
+        .filter_map(|p| p.file_name())
+        .take(LOGS_LISTED)
+        .map(crate::text::shown)
+        .collect();
+    if found.len() > LOGS_LISTED {
+        names.push(format!("and {} more", found.len() - LOGS_LISTED));
+    }
+    let listed = if names.is_empty() {
+        "it holds no *.WBL log".to_string()
+    } else {
+        format!("its logs: {}", names.join(", "))
+    };
+    Err(CliError::file(
+        log,
+        format!("a directory; `wobblog {command}` takes one log ({listed}); {hint}"),
+    ))
+}
 
 /// Calls `visit` for every log in turn behind a progress bar (drawn only on
 /// a terminal and for more than one file). A log that fails is reported on

@@ -9,9 +9,8 @@ use serde::Serialize;
 
 use crate::analysis::campaign_kicks::{load_campaign_kicks, CampaignKick, Prefer};
 use crate::analysis::margin::{predict_with, KickPoint, Margin, Trend, RIDE_MARGIN};
-use crate::cmd::logs::{for_each_log, print, print_json, warn_losses};
+use crate::cmd::logs::{expand, for_each_log, print, print_json, warn_losses};
 use crate::cmd::margin_model::{estimate, ModelEstimate, DEFAULT_PARAMS};
-use crate::cmd::summary::logs_in;
 use crate::output::Output;
 use crate::plot::margin::{KickDot, MarginPlot};
 use crate::plot::{render, ImageKind};
@@ -124,27 +123,6 @@ pub struct Report {
     /// The model-informed estimate, with `--model`.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub model: Option<ModelEstimate>,
-}
-
-/// The logs named by `inputs`: files as given, directories' `*.WBL` files
-/// in name order.
-///
-/// # Errors
-/// A directory without a log, or that cannot be listed.
-pub fn expand(inputs: &[PathBuf]) -> Result<Vec<PathBuf>, CliError> {
-    let mut logs = Vec::new();
-    for input in inputs {
-        if input.is_dir() {
-            let found = logs_in(input)?;
-            if found.is_empty() {
-                return Err(CliError::file(input, "no *.WBL logs in this directory"));
-            }
-            logs.extend(found);
-        } else {
-            logs.push(input.clone());
-        }
-    }
-    Ok(logs)
 }
 
 /// Every kick of `log`: its kick records and what the host measures from

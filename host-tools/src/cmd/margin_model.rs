@@ -12,7 +12,7 @@ use serde::Serialize;
 use wobble_model::fit::{fit, Estimate, Observation, Weights};
 use wobble_model::{sweep::mode_at, Mode, Model, ParamSet};
 
-use crate::cmd::model::{load_set, param_error};
+use crate::cmd::model::{key_error, load_set, param_error};
 use crate::CliError;
 
 /// The parameters fitted unless others are named.
@@ -96,7 +96,7 @@ pub fn estimate(
 ) -> Result<ModelEstimate, CliError> {
     let set = load_set(path)?;
     for key in keys {
-        set.value(key).map_err(|e| param_error(&e))?;
+        set.value(key).map_err(|e| key_error(&set, &e))?;
     }
     let obs: Vec<Observation> = kicks
         .iter()

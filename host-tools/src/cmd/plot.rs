@@ -4,7 +4,7 @@ use std::path::PathBuf;
 
 use crate::analysis::run::{log_name, read_rows};
 use crate::cmd::info::summarise;
-use crate::cmd::logs::warn_losses;
+use crate::cmd::logs::{one_log, warn_losses};
 use crate::output::Output;
 use crate::plot::timeplot::TimePlotBuilder;
 use crate::plot::{render, ImageKind};
@@ -34,6 +34,14 @@ pub struct Args {
 /// whatever the run's length.
 pub fn run(args: &Args) -> Result<(), CliError> {
     ImageKind::of(&args.output)?;
+    // One figure per run into one named image: a folder would need as many
+    // outputs as logs, so it is refused with its logs listed (`report`
+    // draws every run of a card on one page).
+    one_log(
+        &args.log,
+        "plot",
+        "plot them one by one, or `wobblog report` for every run on one page",
+    )?;
     let window = args.window.window();
     let out = Output::create(&args.output, &[&args.log])?;
     let summary = summarise(&args.log)?;

@@ -26,7 +26,7 @@ pub struct Args {
 
 /// Runs `wobblog report`: the page is written only when every log was read.
 pub fn run(args: &Args) -> Result<(), CliError> {
-    let logs = crate::inputs::distinct(crate::cmd::margin::expand(&args.inputs)?);
+    let logs = crate::inputs::distinct(crate::cmd::logs::expand(&args.inputs)?);
     let mut inputs: Vec<&Path> = logs.iter().map(PathBuf::as_path).collect();
     if let Some(params) = &args.model {
         inputs.push(params);

@@ -120,8 +120,22 @@ pub fn logs_in(dir: &Path) -> Result<Vec<PathBuf>, CliError> {
     Ok(logs)
 }
 
+/// Refuses a file where `summary` takes a card folder, pointing a single
+/// log to `info` (the folder listing would only say "Not a directory").
+fn card_folder(dir: &Path) -> Result<(), CliError> {
+    if dir.exists() && !dir.is_dir() {
+        return Err(CliError::file(
+            dir,
+            "not a directory: `wobblog summary` takes a card folder (or a folder of cards); \
+             `wobblog info` reports one log",
+        ));
+    }
+    Ok(())
+}
+
 /// Runs `wobblog summary`: rows for every readable log, even when some are not.
 pub fn run(args: &Args) -> Result<(), CliError> {
+    card_folder(&args.dir)?;
     let cards = crate::dataset::cards_in(&args.dir)?;
     let logs: Vec<PathBuf> = cards.iter().flat_map(|(_, logs)| logs.clone()).collect();
     let stdout = Output::stdout(&logs.iter().map(PathBuf::as_path).collect::<Vec<_>>())?;

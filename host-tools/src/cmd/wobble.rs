@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use serde::Serialize;
 
 use crate::analysis::{wobble_speed_mps, Episode, Ride, Stability};
-use crate::cmd::logs::{for_each_log, print, warn_losses};
+use crate::cmd::logs::{expand, for_each_log, print, warn_losses};
 use crate::output::Output;
 use crate::plot::modes::ModePlot;
 use crate::plot::{render, ImageKind};
@@ -16,8 +16,9 @@ use crate::CliError;
 /// Arguments of `wobblog wobble`.
 #[derive(clap::Args)]
 pub struct Args {
-    /// Card logs (`RUNnnnnn.WBL`).
-    #[arg(required = true)]
+    /// Card logs (`RUNnnnnn.WBL`) or card folders (every `*.WBL` at
+    /// their top, in name order).
+    #[arg(required = true, value_name = "LOGS|DIRS")]
     pub logs: Vec<PathBuf>,
     /// `--json` (or `--format jsonl`) for JSON instead of text.
     #[command(flatten)]
@@ -61,7 +62,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
     if let Some(plot) = &args.plot {
         ImageKind::of(plot)?;
     }
-    let logs = crate::inputs::distinct(args.logs.clone());
+    let logs = crate::inputs::distinct(expand(&args.logs)?);
     let inputs: Vec<&Path> = logs.iter().map(PathBuf::as_path).collect();
     let plot_out = args
         .plot

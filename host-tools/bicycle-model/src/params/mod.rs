@@ -192,8 +192,15 @@ impl ParamSet {
     /// Reads a parameter file: BicycleParameters' `*.txt` benchmark format
     /// by its extension, TOML otherwise.
     pub fn load(path: &Path) -> Result<Self, ParamError> {
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| ParamError::file(path, Problem::Unreadable(e.to_string())))?;
+        let text = std::fs::read_to_string(path).map_err(|e| {
+            let problem = if e.kind() == std::io::ErrorKind::InvalidData {
+                // Not text at all: a log or an image given by mistake.
+                Problem::Syntax(format!("not a parameter file: {}", toml_file::EXPECTED))
+            } else {
+                Problem::Unreadable(e.to_string())
+            };
+            ParamError::file(path, problem)
+        })?;
         let is_txt = path
             .extension()
             .is_some_and(|e| e.eq_ignore_ascii_case("txt"));

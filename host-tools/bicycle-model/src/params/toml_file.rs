@@ -18,15 +18,31 @@ use toml::{Table, Value};
 
 use super::{keys, ModelKind, ParamError, ParamSet, Problem, Quantity};
 
+/// What a parameter file is expected to be, for a file that is not one.
+pub(super) const EXPECTED: &str =
+    "expected a TOML parameter file (`name`, `model` and `source`, then \
+                        [sections] of quantities) or a BicycleParameters `*Benchmark.txt`";
+
 pub(super) fn parse(path: &Path, text: &str) -> Result<ParamSet, ParamError> {
     let syntax = |param: &str, msg: String| ParamError {
         path: path.to_path_buf(),
         param: param.to_owned(),
         problem: Problem::Syntax(msg),
     };
-    let table: Table = text
-        .parse()
-        .map_err(|e: toml::de::Error| syntax("", format!("not a TOML parameter file: {e}")))?;
+    let table: Table = text.parse().map_err(|e: toml::de::Error| {
+        syntax(
+            "",
+            format!("not a parameter file: {EXPECTED}; as TOML, {e}"),
+        )
+    })?;
+    // TOML without any of the three names (an empty file, some other
+    // program's settings) is not a parameter file missing one of them.
+    if !["name", "model", "source"]
+        .iter()
+        .any(|k| table.contains_key(*k))
+    {
+        return Err(syntax("", format!("not a parameter file: {EXPECTED}")));
+    }
     let string = |key: &str| -> Result<String, ParamError> {
         match table.get(key) {
             Some(Value::String(s)) => Ok(s.clone()),

@@ -11,7 +11,7 @@ use wobble_model::Mode;
 use super::episodes::{self, LoggedEpisode};
 use super::figure::{EigenFigure, Layer, Line};
 use super::{load, sweep, Speeds};
-use crate::cmd::logs::print;
+use crate::cmd::logs::{expand, print};
 use crate::output::Output;
 use crate::plot::{render, ImageKind};
 use crate::CliError;
@@ -21,8 +21,9 @@ use crate::CliError;
 pub struct Args {
     /// Parameter file (TOML or BicycleParameters `*Benchmark.txt`).
     pub params: PathBuf,
-    /// Card logs (`RUNnnnnn.WBL`).
-    #[arg(required = true)]
+    /// Card logs (`RUNnnnnn.WBL`) or card folders (every `*.WBL` at
+    /// their top, in name order).
+    #[arg(required = true, value_name = "LOGS|DIRS")]
     pub logs: Vec<PathBuf>,
     /// Also draw the figure into this `.png` or `.svg` file.
     #[arg(short, long)]
@@ -38,7 +39,8 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         ImageKind::of(o)?;
     }
     let (set, model) = load(&args.params, false)?;
-    let mut inputs: Vec<&Path> = args.logs.iter().map(PathBuf::as_path).collect();
+    let logs = crate::inputs::distinct(expand(&args.logs)?);
+    let mut inputs: Vec<&Path> = logs.iter().map(PathBuf::as_path).collect();
     inputs.push(&args.params);
     let out = args
         .output
@@ -46,7 +48,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         .map(|o| Output::create(o, &inputs))
         .transpose()?;
     let stdout = Output::stdout(&inputs)?;
-    let (found, loaded) = episodes::load(&crate::inputs::distinct(args.logs.clone()));
+    let (found, loaded) = episodes::load(&logs);
     let speeds: Vec<f64> = found.iter().map(|e| e.episode.speed_at_onset_mps).collect();
     let wobble = mode_at(&model, Mode::Wobble, &speeds)
         .map_err(|e| CliError::file(&args.params, e))?

@@ -10,8 +10,8 @@ use wobble_model::fit::{fit, Weights};
 use wobble_model::params::to_toml;
 
 use super::episodes;
-use super::param_error;
-use crate::cmd::logs::print;
+use super::{key_error, param_error};
+use crate::cmd::logs::{expand, print};
 use crate::output::Output;
 use crate::CliError;
 
@@ -20,8 +20,9 @@ use crate::CliError;
 pub struct Args {
     /// Parameter file (TOML).
     pub params: PathBuf,
-    /// Card logs (`RUNnnnnn.WBL`).
-    #[arg(required = true)]
+    /// Card logs (`RUNnnnnn.WBL`) or card folders (every `*.WBL` at
+    /// their top, in name order).
+    #[arg(required = true, value_name = "LOGS|DIRS")]
     pub logs: Vec<PathBuf>,
     /// A parameter to fit, as named in the file (repeat for more).
     #[arg(long = "param", required = true, value_name = "KEY")]
@@ -46,13 +47,14 @@ pub fn run(args: &Args) -> Result<(), CliError> {
     }
     let set = super::load_set(&args.params)?;
     for key in &args.params_to_fit {
-        set.value(key).map_err(|e| param_error(&e))?;
+        set.value(key).map_err(|e| key_error(&set, &e))?;
     }
-    let mut inputs: Vec<&Path> = args.logs.iter().map(PathBuf::as_path).collect();
+    let logs = crate::inputs::distinct(expand(&args.logs)?);
+    let mut inputs: Vec<&Path> = logs.iter().map(PathBuf::as_path).collect();
     inputs.push(&args.params);
     let mut out = Output::create(&args.output, &inputs)?;
     let stdout = Output::stdout(&inputs)?;
-    let (found, loaded) = episodes::load(&crate::inputs::distinct(args.logs.clone()));
+    let (found, loaded) = episodes::load(&logs);
     let obs: Vec<_> = found
         .iter()
         .filter(|e| !e.censored())

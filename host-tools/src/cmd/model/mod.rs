@@ -13,7 +13,7 @@ use std::path::Path;
 use std::str::FromStr;
 
 use indicatif::{ProgressBar, ProgressStyle};
-use wobble_model::{Model, ParamError, ParamSet, Survey, Sweep};
+use wobble_model::{Model, ParamError, ParamSet, Problem, Survey, Sweep};
 
 use crate::CliError;
 
@@ -96,6 +96,18 @@ pub fn param_error(e: &ParamError) -> CliError {
     } else {
         CliError::file(&e.path, format!("{}: {}", e.param, e.problem))
     }
+}
+
+/// [`param_error`] about a parameter of `set` named on the command line: a
+/// name the file does not have gets the closest one it has, or their list.
+#[must_use]
+pub fn key_error(set: &ParamSet, e: &ParamError) -> CliError {
+    if e.problem != Problem::Unknown || e.param.is_empty() {
+        return param_error(e);
+    }
+    let known: Vec<&str> = set.iter().map(|(k, _)| k).collect();
+    let hint = crate::words::suggest(&e.param, &known, "parameters of the file");
+    CliError::file(&e.path, format!("{}: {}; {hint}", e.param, e.problem))
 }
 
 /// Reads a parameter file, printing its notes (lines left out, defaults

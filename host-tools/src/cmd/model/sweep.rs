@@ -10,7 +10,7 @@ use wobble_model::{critical_speeds, Mode, Model, ParamSet};
 
 use super::eig::describe;
 use super::figure::{EigenFigure, Layer, Line};
-use super::{param_error, sweep, Speeds};
+use super::{key_error, param_error, sweep, Speeds};
 use crate::cmd::logs::print;
 use crate::output::Output;
 use crate::plot::{render, ImageKind};
@@ -39,7 +39,7 @@ pub struct Args {
 /// One variant of the parameter set: a parameter of the file scaled, or
 /// the rider's whole mass (`rider.mass`, the seed paper's Figure 9).
 pub fn variant(set: &ParamSet, key: &str, factor: f64) -> Result<ParamSet, CliError> {
-    variation::scaled_key(set, key, factor).map_err(|e| param_error(&e))
+    variation::scaled_key(set, key, factor).map_err(|e| key_error(set, &e))
 }
 
 /// Runs `wobblog model sweep`.
