@@ -7,7 +7,8 @@ use clap::ValueEnum;
 use pyo3::prelude::*;
 use wobblog::analysis::campaign_kicks::{load_campaign_kicks, Prefer};
 use wobblog::analysis::margin::{Trend, RIDE_MARGIN};
-use wobblog::cmd::margin::{expand, full_report, Args, KickRow};
+use wobblog::cmd::logs::expand;
+use wobblog::cmd::margin::{full_report, Args, KickRow};
 use wobblog::CliError;
 
 use crate::errors::{detached, warn_damage, WobblogError};
