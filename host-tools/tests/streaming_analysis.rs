@@ -299,3 +299,59 @@ fn kicks_do_not_depend_on_the_piece() {
         }
     }
 }
+
+/// Every kick rising before the search's settled time is among those it has
+/// found, and none after: what the episode search is given as the frames go
+/// by (`analysis::ride`) is final, across pieces and across a gap.
+#[test]
+fn kicks_found_before_the_settled_time_are_final() {
+    let run = kicked_ride();
+    // A 1 s gap at 300 s, between two kicks' rings.
+    let kept: Vec<usize> = (0..run.len())
+        .filter(|&i| !(300.0..301.0).contains(&run.t_s[i]))
+        .collect();
+    let mut search = KickSearch::with_piece(run.sample_rate_hz(), 2.18, 6000);
+    let mut seen = Vec::new();
+    for &i in &kept {
+        search.push(run.t_s[i], run.steer_deg[i], run.speed_mps[i]);
+        if seen.last().is_none_or(|&(s, _)| s != search.settled_s()) {
+            seen.push((search.settled_s(), search.found().to_vec()));
+        }
+    }
+    let all = search.finish();
+    // Pieces of 6000 frames (about 50 s each after the first) and the gap.
+    assert!(seen.len() >= 10, "{} settled times", seen.len());
+    assert!(
+        seen.iter().any(|(s, _)| *s == 301.0),
+        "the gap settles what lies before it"
+    );
+    for (settled_s, found) in &seen {
+        let before: Vec<_> = all.iter().filter(|k| k.t_s < *settled_s).cloned().collect();
+        assert_eq!(found, &before, "settled at {settled_s} s");
+    }
+}
+
+/// A stable episode that is one of the host's kicks takes the kick's values
+/// without a fit of its own: its fitted stretch is the kick's, to the
+/// sample, and its frequency and growth rate are the kick's.
+#[test]
+fn a_kicked_episode_is_the_kick_search_s_measurement() {
+    let run = kicked_ride();
+    // The wheel of the default configuration, as the run has no other.
+    let wheel_m = wobblog::cmd::detect::wheel_circumference_m(&[]).unwrap();
+    let kicks = wobblog::analysis::find_kicks(&run, wheel_m);
+    let ride = wobblog::analysis::ride::Ride::of(&run);
+    let kicked: Vec<&Episode> = ride
+        .episodes
+        .iter()
+        .filter(|e| e.stability == Stability::Stable)
+        .collect();
+    assert_eq!(kicked.len(), kicks.len(), "{:#?}", ride.episodes);
+    for (e, k) in kicked.iter().zip(&kicks) {
+        assert_eq!(e.fit_s, k.fit_s, "{e:?} {k:?}");
+        assert_eq!(e.sigma_per_s, k.sigma_per_s);
+        assert_eq!(e.freq_hz, k.freq_hz);
+        assert_eq!(e.sigma_sd_per_s, Some(k.sigma_sd_per_s));
+        assert_eq!(e.source.as_str(), "host");
+    }
+}

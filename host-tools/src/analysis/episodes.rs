@@ -37,9 +37,10 @@ use std::ops::Range;
 
 use serde::Serialize;
 
-use super::campaign_kicks::Source;
+use super::campaign_kicks::{Source, MATCH_S};
 use super::censor::{Cut, Edge};
 use super::filter::{wobble_band, wobble_band_causal, Biquad, Pass};
+use super::kicks::Kick;
 use super::run::Run;
 use super::search::EpisodeSearch;
 use super::sinefit::{fit_mode, Grid, SineFit};
@@ -217,6 +218,14 @@ pub fn find_episodes(run: &Run) -> Vec<Episode> {
     search.finish(&run.summary.losses)
 }
 
+/// Where an episode's frequency and growth rate come from.
+enum Rate<'k> {
+    /// Its own fit over a range of the samples.
+    Fit(Range<usize>, SineFit),
+    /// The host's measurement of the kick that struck it.
+    Kick(&'k Kick),
+}
+
 /// An episode as found while the frames stream by: what cuts it is known
 /// once the whole log has been read.
 pub(super) struct Found {
@@ -268,10 +277,12 @@ pub(super) struct Span<'a> {
     pub energy: Vec<f64>,
     fs_hz: f64,
     place: Place,
+    /// The host's kicks of the run, in time order (see [`Self::kick_struck`]).
+    kicks: &'a [Kick],
 }
 
 impl<'a> Span<'a> {
-    pub fn new(frames: Frames<'a>, fs_hz: f64, place: Place) -> Self {
+    pub fn new(frames: Frames<'a>, fs_hz: f64, place: Place, kicks: &'a [Kick]) -> Self {
         let band = wobble_band(frames.steer_deg, fs_hz);
         let causal = wobble_band_causal(frames.steer_deg, fs_hz);
         let mut energy: Vec<f64> = band.iter().map(|v| 2.0 * v * v).collect();
@@ -285,6 +296,7 @@ impl<'a> Span<'a> {
             energy,
             fs_hz,
             place,
+            kicks,
         }
     }
 
@@ -433,30 +445,57 @@ impl<'a> Span<'a> {
         };
         // Quiet before it within the stretch, or it reaches the cut.
         let starts_at_cut = region.start == 0;
-        let (stability, range, mode) =
+        let (stability, rate) =
             match growth_range(&clean, local.clone(), floor, ceiling).and_then(|r| fit(r, true)) {
-                Some((r, mode)) => (Stability::Unstable, r, mode),
+                Some((r, mode)) => (Stability::Unstable, Rate::Fit(r, mode)),
                 None if starts_at_cut => return None,
                 None => {
-                    // A push before the ring-down leaves the fall from the
-                    // largest swing unexplained: the fit starts later, past
-                    // the push, until it explains the ring.
                     let fall = decay_range(&clean, band, local.clone(), floor)?;
-                    let step = self.samples(PUSH_STEP_S).max(1);
-                    let (r, mode) = (0..=self.samples(PUSH_MAX_S) / step)
-                        .map(|k| fall.start + k * step..fall.end)
-                        .take_while(|r| r.end > r.start + 2)
-                        .find_map(|r| fit(r, false))?;
-                    (Stability::Stable, r, mode)
+                    // A ring the kick search measured is not fitted again:
+                    // the episode takes the kick's values in the end
+                    // (`super::kick_episodes`), and its own fits (up to
+                    // eleven starts, each with its tone search) were most
+                    // of the time a kick campaign's analysis took.
+                    let rate = match self.kick_struck(self.t_s[region.start], t[fall.start]) {
+                        Some(kick) => Rate::Kick(kick),
+                        None => {
+                            // A push before the ring-down leaves the fall
+                            // from the largest swing unexplained: the fit
+                            // starts later, past the push, until it
+                            // explains the ring.
+                            let step = self.samples(PUSH_STEP_S).max(1);
+                            let (r, mode) = (0..=self.samples(PUSH_MAX_S) / step)
+                                .map(|k| fall.start + k * step..fall.end)
+                                .take_while(|r| r.end > r.start + 2)
+                                .find_map(|r| fit(r, false))?;
+                            Rate::Fit(r, mode)
+                        }
+                    };
+                    (Stability::Stable, rate)
                 }
             };
-        let freq_hz = mode.omega_rad_s / TAU;
-        let onset_s = match stability {
-            Stability::Unstable => {
-                let level = mode.log_amp - self.level_bias(t, top, &mode, range.clone());
+        let onset_s = match (&rate, stability) {
+            (Rate::Fit(range, mode), Stability::Unstable) => {
+                let level = mode.log_amp - self.level_bias(t, top, mode, range.clone());
                 mode.t0_s + (ONSET_AMP_DEG.ln() - level) / mode.sigma_per_s
             }
-            Stability::Stable => self.t_s[region.start],
+            _ => self.t_s[region.start],
+        };
+        let (freq_hz, sigma_per_s, sigma_sd_per_s, source, fit_s) = match rate {
+            Rate::Fit(range, mode) => (
+                mode.omega_rad_s / TAU,
+                mode.sigma_per_s,
+                None,
+                Measured::Episode,
+                [t[range.start], t[range.end - 1]],
+            ),
+            Rate::Kick(kick) => (
+                kick.freq_hz,
+                kick.sigma_per_s,
+                Some(kick.sigma_sd_per_s),
+                Measured::Kick(Source::Host),
+                kick.fit_s,
+            ),
         };
         // An onset before the stretch began would be extrapolated across
         // the cut: the first frame after it is all the data say.
@@ -472,13 +511,13 @@ impl<'a> Span<'a> {
             end_s: self.t_s[end],
             peak_s: t[top],
             freq_hz,
-            sigma_per_s: mode.sigma_per_s,
-            sigma_sd_per_s: None,
-            source: Measured::Episode,
+            sigma_per_s,
+            sigma_sd_per_s,
+            source,
             peak_amp_deg,
             speed_at_onset_mps: speed_around(&self.frames, onset_s, SPEED_HALF_WIDTH_S),
             stability,
-            fit_s: [t[range.start], t[range.end - 1]],
+            fit_s,
             censored: false,
             cut_at_start: None,
             cut_at_end: None,
@@ -488,6 +527,17 @@ impl<'a> Span<'a> {
             start,
             end: end_cut,
         })
+    }
+
+    /// The last of the host's kicks that rose from [`MATCH_S`] before
+    /// `onset_s` (where a stable episode was struck) to [`MATCH_S`] after
+    /// `swing_s` (its largest swing): the kick the episode is
+    /// (`super::kick_episodes::kick_of` pairs them the same way).
+    fn kick_struck(&self, onset_s: f64, swing_s: f64) -> Option<&'a Kick> {
+        let last = self.kicks.partition_point(|k| k.t_s <= swing_s + MATCH_S);
+        self.kicks[..last]
+            .last()
+            .filter(|k| k.t_s >= onset_s - MATCH_S)
     }
 
     /// Where the episodes either side of `region` end and start: the end

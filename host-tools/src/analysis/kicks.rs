@@ -174,6 +174,8 @@ pub struct KickSearch {
     steer_deg: Vec<f64>,
     speed_mps: Vec<f64>,
     kicks: Vec<Kick>,
+    /// Every kick rising before this is in `kicks`, s.
+    settled_s: f64,
     /// Most frames held at once.
     most_held: usize,
 }
@@ -204,6 +206,7 @@ impl KickSearch {
             steer_deg: Vec::new(),
             speed_mps: Vec::new(),
             kicks: Vec::new(),
+            settled_s: f64::NEG_INFINITY,
             most_held: 0,
         }
     }
@@ -217,6 +220,7 @@ impl KickSearch {
             if !follows(last, t_s, 1.0 / self.fs) {
                 self.search(None);
                 self.clear(self.t_s.len());
+                self.settled_s = t_s;
             }
         }
         self.t_s.push(t_s);
@@ -226,6 +230,7 @@ impl KickSearch {
         if self.t_s.len() >= self.piece {
             let shared = self.t_s.len() - self.overlap;
             self.search(Some(shared));
+            self.settled_s = self.t_s[shared];
             self.clear(shared);
         }
     }
@@ -235,6 +240,21 @@ impl KickSearch {
     #[must_use]
     pub fn most_held(&self) -> usize {
         self.most_held
+    }
+
+    /// The kicks found so far, in time order: every kick rising before
+    /// [`Self::settled_s`], none after it.
+    #[must_use]
+    pub fn found(&self) -> &[Kick] {
+        &self.kicks
+    }
+
+    /// Every kick rising before this time (s since boot) is
+    /// [`Self::found`]: those of the stretches before the last gap, and
+    /// those of the pieces searched.
+    #[must_use]
+    pub fn settled_s(&self) -> f64 {
+        self.settled_s
     }
 
     /// Every kick, in time order.

@@ -2,9 +2,18 @@
 //! and the data set) take from each: its summary, wobble episodes (a kick's
 //! with the kick's values, as `margin` has them), distance and top speed,
 //! found in one pass over the log in bounded memory.
+//!
+//! The kick search runs ahead of the episode search: a frame reaches the
+//! episodes only once every kick that could have struck an episode up to
+//! it is known, so that a stable episode that is a kick takes the kick's
+//! values instead of being fitted again (its own fits were most of the
+//! time a kick campaign's analysis took). The frames in between are held,
+//! at most one piece of the kick search ([`super::kicks::PIECE_FRAMES`]).
 
+use std::collections::VecDeque;
 use std::path::{Path, PathBuf};
 
+use super::campaign_kicks::MATCH_S;
 use super::filter::follows;
 use super::kick_episodes::give_kick_values;
 use super::kicks::KickSearch;
@@ -67,6 +76,11 @@ struct Analyser {
     /// The kicks, as `wobblog margin` finds them (`None` when the log's
     /// config gives no wheel: margin then takes no kick from the log).
     kicks: Option<KickSearch>,
+    /// How many of the kicks found the episode search has been given.
+    kicks_given: usize,
+    /// Frames (time, steering, speed) the kick search has seen and the
+    /// episode search not yet.
+    waiting: VecDeque<(f64, f64, f64)>,
     distance_m: f64,
     max_speed_mps: f64,
     /// Time and speed of the frame before.
@@ -82,7 +96,10 @@ impl Analyser {
             search: EpisodeSearch::new(fs_hz),
             kicks: wheel_circumference_m(config)
                 .ok()
+                .filter(|_| fs_hz.is_finite() && fs_hz > 0.0)
                 .map(|wheel_m| KickSearch::new(fs_hz, wheel_m)),
+            kicks_given: 0,
+            waiting: VecDeque::new(),
             distance_m: 0.0,
             max_speed_mps: 0.0,
             last: None,
@@ -95,16 +112,38 @@ impl Analyser {
         }
         self.last = Some((t_s, speed_mps));
         self.max_speed_mps = self.max_speed_mps.max(speed_mps);
-        self.search.push(t_s, steer_deg, speed_mps);
-        if let Some(kicks) = &mut self.kicks {
-            kicks.push(t_s, steer_deg, speed_mps);
+        let Some(kicks) = &mut self.kicks else {
+            self.search.push(t_s, steer_deg, speed_mps);
+            return;
+        };
+        kicks.push(t_s, steer_deg, speed_mps);
+        self.waiting.push_back((t_s, steer_deg, speed_mps));
+        // An episode measured when a frame arrives lies before it; the
+        // kick it is rose at most [`MATCH_S`] after its largest swing.
+        let settled_s = kicks.settled_s();
+        self.search.add_kicks(&kicks.found()[self.kicks_given..]);
+        self.kicks_given = kicks.found().len();
+        while let Some(&(t_s, steer_deg, speed_mps)) = self.waiting.front() {
+            if t_s + MATCH_S >= settled_s {
+                break;
+            }
+            self.search.push(t_s, steer_deg, speed_mps);
+            self.waiting.pop_front();
         }
     }
 
-    fn finish(self, path: &Path, summary: Summary) -> Ride {
+    fn finish(mut self, path: &Path, summary: Summary) -> Ride {
+        let kicks = self.kicks.map(|search| {
+            let kicks = search.finish();
+            self.search.add_kicks(&kicks[self.kicks_given..]);
+            for (t_s, steer_deg, speed_mps) in self.waiting.drain(..) {
+                self.search.push(t_s, steer_deg, speed_mps);
+            }
+            kicks
+        });
         let mut episodes = self.search.finish(&summary.losses);
-        if let Some(kicks) = self.kicks {
-            give_kick_values(&mut episodes, kicks.finish(), &summary.kick_records);
+        if let Some(kicks) = kicks {
+            give_kick_values(&mut episodes, kicks, &summary.kick_records);
         }
         Ride {
             path: path.to_path_buf(),

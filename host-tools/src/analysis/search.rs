@@ -15,6 +15,7 @@
 use super::censor::Edge;
 use super::episodes::{Found, Frames, Place, Span, MIN_SPAN_S};
 use super::filter::follows;
+use super::kicks::Kick;
 use super::Episode;
 use crate::losses::Losses;
 
@@ -33,6 +34,9 @@ pub struct EpisodeSearch {
     margin: usize,
     window: Window,
     found: Vec<Found>,
+    /// The host's kicks of the run, in time order: a stable episode that
+    /// is one of them takes its values instead of being fitted.
+    kicks: Vec<Kick>,
     /// Most frames the window has held.
     most_held: usize,
 }
@@ -87,8 +91,18 @@ impl EpisodeSearch {
             margin,
             window: Window::default(),
             found: Vec::new(),
+            kicks: Vec::new(),
             most_held: 0,
         }
+    }
+
+    /// Takes the next of the host's kicks of the run, in time order (as
+    /// [`super::kicks::KickSearch`] finds them): every kick that rose up to
+    /// [`super::campaign_kicks::MATCH_S`] after a frame must be given
+    /// before the frame is [`Self::push`]ed, for a stable episode that is
+    /// one of them to take its values instead of being fitted.
+    pub fn add_kicks(&mut self, kicks: &[Kick]) {
+        self.kicks.extend_from_slice(kicks);
     }
 
     /// Takes the next frame in file order: time, steering angle, speed.
@@ -157,7 +171,7 @@ impl EpisodeSearch {
             steer_deg: &w.steer_deg,
             speed_mps: &w.speed_mps,
         };
-        let span = Span::new(frames, self.fs_hz, place);
+        let span = Span::new(frames, self.fs_hz, place, &self.kicks);
         let len = w.len();
         // Regions that end before this are measured with all they need.
         let settled = if over { len } else { len - self.margin };
