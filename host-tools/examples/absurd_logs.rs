@@ -54,13 +54,14 @@ fn kicked(i: u64) -> f64 {
 
 /// Frames at 100 Hz from `t0_us`, steering `steer_deg(frame)`, until the
 /// file holds `len` bytes; `jump_us` is added at every new block; a card
-/// kick record after every `kick_every`-th frame if given.
+/// kick record after every `kick_every`-th frame if given (with the speed
+/// it gives, or none).
 fn log(
     t0_us: u64,
     jump_us: u64,
     len: usize,
     steer_deg: fn(u64) -> f64,
-    kick_every: Option<u64>,
+    kick_every: Option<(u64, Option<u16>)>,
 ) -> Vec<u8> {
     let mut enc = BlockEncoder::new();
     let mut file = Vec::with_capacity(len);
@@ -77,10 +78,10 @@ fn log(
             file.extend_from_slice(block);
             t_us += jump_us;
         }
-        if kick_every.is_some_and(|k| i % k == k - 1) {
+        if let Some((_, speed_mm_s)) = kick_every.filter(|&(k, _)| i % k == k - 1) {
             let kick = KickRingDown {
                 t_us,
-                speed_mm_s: Some(4000),
+                speed_mm_s,
                 freq_chz: 650,
                 sigma_milli_per_s: -800,
                 sigma_se_milli_per_s: 50,
@@ -171,7 +172,13 @@ fn main() -> std::io::Result<()> {
     write("kicked.wbl", &log(1_000_000, 0, LEN, kicked, None))?;
     write(
         "kick_records.wbl",
-        &log(1_000_000, 0, LEN, wobble, Some(20)),
+        &log(1_000_000, 0, LEN, wobble, Some((20, Some(4000)))),
+    )?;
+    // The same without a speed: margin takes each record's speed from the
+    // frames after it.
+    write(
+        "speedless_records.wbl",
+        &log(1_000_000, 0, LEN, wobble, Some((20, None))),
     )?;
     write("busy.wbl", &busy(LEN))
 }
