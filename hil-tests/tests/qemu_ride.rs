@@ -195,6 +195,21 @@ fn bundled_ride_logs_every_frame_fix_and_alert() {
     assert_eq!(fsck.code, 0, "{}", fsck.text);
     assert!(fsck.problems().is_empty(), "{}", fsck.text);
 
+    // The writer's card operations per iteration, counted by the core's
+    // counting device on the semihosted card: within the queue's sizing,
+    // and a flush with a block write happened.
+    let writer_ops = out.number("END", "writer_ops_max").expect("END line");
+    assert!(
+        (5..=u64::from(wobble_core::channels::WRITER_OPS_PER_ITERATION)).contains(&writer_ops),
+        "{:?}",
+        out.fields("END")
+    );
+    println!(
+        "FIGURES writer: at most {writer_ops} card operations in an iteration while logging, {} \
+         opening the card, longest iteration {} µs",
+        out.number("END", "writer_open_ops_max").unwrap_or(0),
+        out.number("END", "writer_busy_max_us").unwrap_or(0),
+    );
     let virtual_s = f64::from(FRAMES) / 100.0;
     println!(
         "FIGURES ride: virtual {virtual_s:.1} s in {:.2} s wall ({:.1}x), worst frame spacing error {worst_us} µs, \

@@ -174,7 +174,8 @@ async fn writer_task(card: SemihostingCard, config: &'static Config) {
     let st = logger.stats();
     report::line(format_args!(
         "END frames={} t_us={} max_late_us={} queue_high_water={} queue_frames_dropped={} \
-         queue_others_dropped={} card_frames_lost={} card_absent={} card_write_failed={} card_full={} files={} closed={}",
+         queue_others_dropped={} card_frames_lost={} card_absent={} card_write_failed={} card_full={} files={} closed={} \
+         writer_ops_max={} writer_open_ops_max={} writer_busy_max_us={}",
         FRAMES_SAMPLED.load(Ordering::Relaxed),
         Instant::now().as_micros(),
         MAX_LATE_US.load(Ordering::Relaxed),
@@ -187,6 +188,9 @@ async fn writer_task(card: SemihostingCard, config: &'static Config) {
         st.faults[usize::from(FAULT_CARD_FULL - 1)],
         st.files_opened,
         closed.is_ok(),
+        SHARED.writer().ops_max,
+        SHARED.writer().open_ops_max,
+        SHARED.writer().busy_max_us,
     ));
     semihosting::process::exit(0)
 }
