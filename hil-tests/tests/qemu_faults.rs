@@ -128,7 +128,10 @@ fn a_stall_as_long_as_the_worst_writer_iteration_loses_nothing() {
     assert!(log.dropouts.is_empty(), "{:?}", log.dropouts);
     assert_eq!(out.number("END", "queue_others_dropped"), Some(0));
     let high_water = out.number("END", "queue_high_water").expect("END line");
-    assert!(high_water >= u64::from(stall_ms) / 10, "high water {high_water}");
+    assert!(
+        high_water >= u64::from(stall_ms) / 10,
+        "high water {high_water}"
+    );
     assert!(high_water <= wobble_core::channels::QUEUE_LEN as u64);
     println!(
         "FIGURES worst-iteration stall: {stall_ms} ms in one card operation, queue high water \

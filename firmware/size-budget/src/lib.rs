@@ -154,7 +154,7 @@ mod tests {
             (PROGBITS, SHF_ALLOC | 0x1, 0x2000_0000, 16),   // .data
             (SHT_NOBITS, SHF_ALLOC | 0x1, 0x2000_0010, 4000), // .bss
             (SHT_NOBITS, SHF_ALLOC | 0x3, 0x1000_0000, 64), // .ccmram
-            (SHT_NOBITS, SHF_ALLOC | 0x1, 0x2000_0FB0, 8),   // .uninit
+            (SHT_NOBITS, SHF_ALLOC | 0x1, 0x2000_0FB0, 8),  // .uninit
             (PROGBITS, 0, 0, 9999),                         // .defmt, debug
         ]);
         assert_eq!(
