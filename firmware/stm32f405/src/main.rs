@@ -111,12 +111,13 @@ fn main() -> ! {
         // Nothing is written: no new log file per boot. The code repeats
         // until a power cycle (the watchdog is not started).
         defmt::error!(
-            "{} software resets in a row: not logging until power-off",
+            "{} panic, fault or watchdog resets in a row: not logging until power-off",
             streak
         );
         let mut led = Output::new(board.rider.alert_led.reborrow(), Level::Low, Speed::Low);
         loop {
-            startup::blink_code(&mut led, boot::FAULT_RESET_SOFTWARE);
+            // 5 after a panic or a fault, 3 after a hang.
+            startup::blink_code(&mut led, reset.fault_code());
         }
     }
     let button = marker_held(&mut board);
