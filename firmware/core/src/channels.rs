@@ -29,7 +29,7 @@
 //! blocks, a card past the specification) costs frames, counted and logged
 //! as a dropout.
 //!
-//! 576 records of 56 bytes (on the MCU) are 31.5 KiB: the board keeps the
+//! 576 records of 64 bytes (on the MCU) are 36 KiB: the board keeps the
 //! queue in the core-coupled RAM (CCM), which only the CPU reaches; nothing
 //! in a record is ever a DMA buffer (`firmware/docs/board.md`, memory plan).
 

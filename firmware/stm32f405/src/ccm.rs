@@ -1,6 +1,6 @@
 //! CPU-only state in the core-coupled RAM (CCM, 64 KiB at 0x1000_0000):
 //! the record queue between the sampler, the GPS task and the SD writer
-//! (`wobble_core::channels::RecordQueue`, 576 records, 31.5 KiB).
+//! (`wobble_core::channels::RecordQueue`, 576 records of 64 bytes, 36 KiB).
 //!
 //! CCM sits on the CPU's data bus alone: the DMA controllers cannot reach
 //! it, so no DMA buffer may ever live here (the SPI, ADC and USART rings
@@ -38,7 +38,7 @@ pub fn record_queue() -> Option<&'static RecordQueue> {
 
 /// Writes an empty queue into `slot`, in place: `RecordQueue::new` is a
 /// constant whose buffer is uninitialised, so the write stores the
-/// queue's few bookkeeping words, not 31.5 KiB through the stack (the
+/// queue's few bookkeeping words, not 36 KiB through the stack (the
 /// stack bound, `firmware/docs/board.md`, measures this frame).
 #[inline(never)]
 fn init(slot: &'static mut MaybeUninit<RecordQueue>) -> &'static RecordQueue {
