@@ -60,7 +60,10 @@ match the firmware's `set_priority` calls.
 The printed total is therefore a bound, not an estimate. `--check`
 fails (exit 1) when it exceeds the stack the image reserves: from the end
 of the statics (`_stack_end`) to the top of RAM (`_stack_start`), less the
-MPU guard at its bottom.
+MPU guard at its bottom; and when the memory plan does not hold: the
+statics in SRAM (`__sdata`, the start of RAM, to `_stack_end`) plus the
+bound at most SRAM_PLAN (120 KiB of the 128 KiB; CPU-only state goes to
+CCM, firmware/docs/board.md).
 """
 
 import argparse
@@ -105,6 +108,17 @@ PRIORITIES = {16 + 50: 5, 16 + 52: 6, 16 + 53: 7}  # TIM5, UART4, UART5
 FIXED_LEVELS = {2: -2, 3: -1}  # NMI, HardFault
 # The MPU guard at the stack's bottom (`startup::GUARD_BYTES`).
 GUARD_BYTES = 256
+# The memory plan: static SRAM plus the stack bound, at most (bytes).
+SRAM_PLAN = 120 * 1024
+
+
+def plan_failures(statics, bound, plan=SRAM_PLAN):
+    """The memory plan's verdict: [] when SRAM statics plus the stack bound
+    fit `plan`, else the failure to report."""
+    if statics + bound <= plan:
+        return []
+    return [f"static SRAM {statics} B + stack bound {bound} B = {statics + bound} B "
+            f"exceeds the memory plan's {plan} B (firmware/docs/board.md)"]
 
 
 class Image:
@@ -666,6 +680,15 @@ def main():
             failures.append(f"the bound {total} B exceeds the reserved stack {reserved} B")
     elif args.check:
         failures.append("no _stack_start/_stack_end symbols: cannot compare")
+    ram = image.symbols.get("__sdata")
+    if ram is not None and end is not None:
+        statics = end - ram
+        print(f"memory plan: static SRAM {statics} B + stack bound {total} B = "
+              f"{statics + total} B of {SRAM_PLAN} B")
+        if args.check:
+            failures += plan_failures(statics, total)
+    elif args.check:
+        failures.append("no __sdata/_stack_end symbols: cannot check the memory plan")
     for f in failures:
         print("FAIL:", f, file=sys.stderr)
     sys.exit(1 if failures else 0)

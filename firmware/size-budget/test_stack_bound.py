@@ -167,6 +167,14 @@ class Bound(unittest.TestCase):
         a.graph()
         self.assertEqual(a.dispatchers, {"_ZN16embassy_executor3raw8Executor4poll17h0E"})
 
+    def test_the_memory_plan_holds_statics_plus_the_bound(self):
+        self.assertEqual(sb.SRAM_PLAN, 120 * 1024)
+        self.assertEqual(sb.plan_failures(42_000, 60_000), [])
+        self.assertEqual(sb.plan_failures(60_000, 62_880), [])
+        [failure] = sb.plan_failures(60_000, 62_881)
+        self.assertIn("122881 B exceeds the memory plan's 122880 B", failure)
+        self.assertTrue(sb.plan_failures(1, 1, plan=1))
+
     def test_recursion_outside_fmt_fails(self):
         f = {"main": fn(0x08000100, 8, ("bl", "0x8000200 <loop>")),
              "loop": fn(0x08000200, 8, ("bl", "0x8000100 <main>"))}

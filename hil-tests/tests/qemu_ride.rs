@@ -195,6 +195,25 @@ fn bundled_ride_logs_every_frame_fix_and_alert() {
     assert_eq!(fsck.code, 0, "{}", fsck.text);
     assert!(fsck.problems().is_empty(), "{}", fsck.text);
 
+    // The writer's card operations per iteration, counted by the core's
+    // counting device on the semihosted card: within the queue's sizing,
+    // and a flush with a block write happened.
+    let writer_ops = out.number("WRITER", "ops_max").expect("WRITER line");
+    assert!(
+        (5..=u64::from(wobble_core::channels::WRITER_OPS_PER_ITERATION)).contains(&writer_ops),
+        "{:?}",
+        out.fields("WRITER")
+    );
+    // The card model's busy times and the semihosted transfers take
+    // virtual time: the worst iteration took some.
+    let busy_us = out.number("WRITER", "busy_max_us").expect("WRITER line");
+    assert!(busy_us > 0);
+    println!(
+        "FIGURES writer: at most {writer_ops} card operations in an iteration while logging, {} \
+         opening the card, longest iteration {} µs",
+        out.number("WRITER", "open_ops_max").unwrap_or(0),
+        busy_us,
+    );
     let virtual_s = f64::from(FRAMES) / 100.0;
     println!(
         "FIGURES ride: virtual {virtual_s:.1} s in {:.2} s wall ({:.1}x), worst frame spacing error {worst_us} µs, \

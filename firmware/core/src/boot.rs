@@ -179,26 +179,51 @@ pub const fn optcr_with_bor_level3(optcr: u32) -> u32 {
     optcr & !BOR_LEV_MASK & !OPTCR_CONTROL_MASK
 }
 
-/// Boots in a row that ended in a software reset (a panic or a fault)
-/// after which the logger stops opening a new log file per boot.
+/// Boots in a row that ended in a failure reset (a panic or a fault, or
+/// the watchdog: [`counts_towards_streak`]) after which the logger stops
+/// opening a new log file per boot.
 pub const PANIC_LOOP_BOOTS: u32 = 3;
 /// A boot that has run this long ends the streak, µs.
 pub const PANIC_STREAK_CLEAR_US: u64 = 60_000_000;
+/// The word the firmware's fault handler leaves in RAM that survives a
+/// reset (beside the streak) just before it resets the MCU: the next boot
+/// knows the software reset was its own, after a panic or a fault, and not
+/// a debug probe's (probe-rs resets through the same SYSRESETREQ).
+pub const FAULT_RESET_MARK: u32 = 0x4641_4C54;
 
-/// This boot's count of software resets in a row, from the count kept
-/// across the reset (`None` when the kept word is not valid: after a
-/// power-on RAM holds noise) and the reset cause.
+/// Whether a reset continues the streak of failed boots: a software reset
+/// the firmware's fault handler marked (`fault_marked`: a panic or a hard
+/// fault), and a watchdog reset (a hang; a hang at every boot would
+/// otherwise open a file per boot). A software reset without the mark (a
+/// debug probe flashing or resetting the board), a power-on, the reset pin
+/// and a brown-out are fresh starts.
 #[must_use]
-pub fn panic_streak(kept: Option<u32>, cause: ResetCause) -> u32 {
+pub const fn counts_towards_streak(cause: ResetCause, fault_marked: bool) -> bool {
     match cause {
-        ResetCause::Software => kept.unwrap_or(0).saturating_add(1),
-        _ => 0,
+        ResetCause::Software => fault_marked,
+        ResetCause::Watchdog | ResetCause::WindowWatchdog => true,
+        _ => false,
     }
 }
 
-/// Whether a boot with `streak` is in a panic loop: it writes nothing (a
-/// panic at every boot would otherwise leave a new, nearly empty log file
-/// per boot) and shows the software-reset code until a power cycle.
+/// This boot's count of failure resets in a row, from the count kept
+/// across the reset (`None` when the kept word is not valid: after a
+/// power-on RAM holds noise), the reset cause and whether the fault handler
+/// marked it ([`counts_towards_streak`]).
+#[must_use]
+pub const fn panic_streak(kept: Option<u32>, cause: ResetCause, fault_marked: bool) -> u32 {
+    if !counts_towards_streak(cause, fault_marked) {
+        return 0;
+    }
+    match kept {
+        Some(n) => n.saturating_add(1),
+        None => 1,
+    }
+}
+
+/// Whether a boot with `streak` is in a failure loop: it writes nothing (a
+/// panic or a hang at every boot would otherwise leave a new, nearly empty
+/// log file per boot) and shows the last reset's code until a power cycle.
 #[must_use]
 pub const fn in_panic_loop(streak: u32) -> bool {
     streak >= PANIC_LOOP_BOOTS
@@ -259,23 +284,67 @@ impl BorCheck {
 mod tests {
     use super::*;
 
-    #[test]
-    fn a_panic_at_every_boot_is_a_loop_after_three_and_anything_else_ends_it() {
+    /// The streak after each boot of `boots` (cause, marked by the fault
+    /// handler), starting from noise.
+    fn streaks(boots: &[(ResetCause, bool)]) -> Vec<u32> {
         let mut kept = None;
-        let mut loops = Vec::new();
-        for _ in 0..5 {
-            let n = panic_streak(kept, ResetCause::Software);
-            loops.push(in_panic_loop(n));
-            kept = Some(n);
-        }
+        boots
+            .iter()
+            .map(|&(cause, marked)| {
+                let n = panic_streak(kept, cause, marked);
+                kept = Some(n);
+                n
+            })
+            .collect()
+    }
+
+    #[test]
+    fn a_panic_at_every_boot_is_a_loop_after_three_and_a_fresh_start_ends_it() {
+        let panics = streaks(&[(ResetCause::Software, true); 5]);
+        assert_eq!(panics, [1, 2, 3, 4, 5]);
+        let loops: Vec<bool> = panics.iter().map(|&n| in_panic_loop(n)).collect();
         assert_eq!(loops, [false, false, true, true, true]);
-        // A power-on, the reset button, the watchdog: a fresh start.
-        for cause in [ResetCause::PowerOn, ResetCause::Pin, ResetCause::Watchdog] {
-            assert_eq!(panic_streak(Some(7), cause), 0);
+        // A power-on, the reset button, a brown-out: a fresh start.
+        for cause in [ResetCause::PowerOn, ResetCause::Pin, ResetCause::BrownOut] {
+            assert_eq!(panic_streak(Some(7), cause, false), 0);
+            // A mark is only ever believed on a software reset.
+            assert_eq!(panic_streak(Some(7), cause, true), 0);
         }
         // Noise after a power-on is never taken for a count.
-        assert_eq!(panic_streak(None, ResetCause::Software), 1);
-        assert_eq!(panic_streak(Some(u32::MAX), ResetCause::Software), u32::MAX);
+        assert_eq!(panic_streak(None, ResetCause::Software, true), 1);
+        assert_eq!(
+            panic_streak(Some(u32::MAX), ResetCause::Software, true),
+            u32::MAX
+        );
+    }
+
+    /// Flashing the board three times in a minute (probe-rs resets through
+    /// SYSRESETREQ, a software reset the fault handler did not mark) is no
+    /// panic loop, and it ends a streak of panics as a power-on does.
+    #[test]
+    fn probe_resets_are_fresh_starts_not_panics() {
+        let probe = (ResetCause::Software, false);
+        assert_eq!(streaks(&[probe, probe, probe, probe]), [0, 0, 0, 0]);
+        let panic = (ResetCause::Software, true);
+        assert_eq!(streaks(&[panic, panic, probe, panic]), [1, 2, 0, 1]);
+        assert!(!counts_towards_streak(ResetCause::Software, false));
+    }
+
+    /// A hang at every boot (the watchdog resets the MCU each time) is a
+    /// loop like a panic at every boot, and the two add up.
+    #[test]
+    fn watchdog_reset_loops_count_like_panics() {
+        let dog = (ResetCause::Watchdog, false);
+        let panic = (ResetCause::Software, true);
+        let n = streaks(&[dog, dog, dog]);
+        assert_eq!(n, [1, 2, 3]);
+        assert!(in_panic_loop(n[2]));
+        assert_eq!(streaks(&[panic, dog, panic]), [1, 2, 3]);
+        assert_eq!(panic_streak(Some(1), ResetCause::WindowWatchdog, false), 2);
+        assert_eq!(
+            streaks(&[dog, dog, (ResetCause::PowerOn, false), dog]),
+            [1, 2, 0, 1]
+        );
     }
 
     #[test]

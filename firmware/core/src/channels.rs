@@ -6,15 +6,32 @@
 //! | [`RecordQueue`] | sampler (high-priority executor), GPS task | writer (thread mode) |
 //! | [`SharedStatus`] | GPS task, writer | sampler (status bits, LED) |
 //!
-//! Queue sizing: at 100 frames/s plus a 20 Hz GPS (fix, and now and then a
-//! UTC pair, an alert or a fault) the producers make at most about
-//! [`MAX_RECORDS_PER_S`] = 125 records per second. The SD specification lets
-//! a card stall a write for up to 500 ms, but the writer's card operations
-//! are bounded at `drivers::sd_spi::CARD_OPERATION_BUDGET_US` = 1.5 s (a
-//! slow card's erase or file-system update), during which it drains
-//! nothing: 1.5 s × 125 /s = 188 records. [`QUEUE_LEN`] = 200 holds 1.6 s,
-//! so only an operation that the budget cuts off costs data, and that loss
-//! is counted and logged. 200 records of at most 56 bytes: 11 KiB of RAM.
+//! Queue sizing. The producers make at most [`MAX_RECORDS_PER_S`] = 125
+//! records a second: 100 frames, a 20 Hz GPS, and now and then a UTC pair,
+//! an alert, a kick, a marker or a fault. The writer drains the queue once
+//! per iteration (`app::writer`): a poll (a flush every 500 ms: the open
+//! block's snapshot, the directory entry, FSInfo) and one record's push
+//! (which writes a block when it closes one, and at a cluster boundary
+//! reads and writes both FATs). Counted with a counting device
+//! (`logger::ops`) over ten minutes of ride on FAT32 cards with 512-byte to
+//! 4 KiB clusters (`tests/writer_ops.rs`), one iteration while logging
+//! makes at most [`WRITER_OPS_PER_ITERATION`] = 14 card operations, and the
+//! slowest by the SD specification is [`WORST_ITERATION_OPS`]: 8 writes and
+//! 5 reads. The specification lets an SDHC/SDXC card stay busy
+//! [`CARD_WRITE_STALL_US`] = 500 ms on a write and [`CARD_READ_STALL_US`] =
+//! 100 ms on a read: 8 × 0.5 s + 5 × 0.1 s = 4.5 s
+//! ([`WORST_ITERATION_US`]), during which the writer drains nothing:
+//! 4.5 s × 125 /s = 563 records. [`QUEUE_LEN`] = 576 records hold
+//! [`QUEUE_HOLDS_US`] = 4.608 s: the worst iteration, at least
+//! [`MIN_QUEUE_US`] = 4 s, and more than one operation at the writer's
+//! 1.5 s budget (`drivers::sd_spi::CARD_OPERATION_BUDGET_US`). A longer
+//! stall (a fragmented card whose free-cluster search reads many FAT
+//! blocks, a card past the specification) costs frames, counted and logged
+//! as a dropout.
+//!
+//! 576 records of 64 bytes (on the MCU) are 36 KiB: the board keeps the
+//! queue in the core-coupled RAM (CCM), which only the CPU reaches; nothing
+//! in a record is ever a DMA buffer (`firmware/docs/board.md`, memory plan).
 
 use core::sync::atomic::{AtomicU32, Ordering};
 
@@ -23,13 +40,63 @@ use embassy_sync::channel::Channel;
 
 use crate::drivers::sd_spi::CARD_OPERATION_BUDGET_US;
 use crate::format::{Dropout, DropoutReason, Record};
+use crate::logger::CardOps;
 
 /// Most records the producers make per second (see the module docs).
 pub const MAX_RECORDS_PER_S: u64 = 125;
+/// Most card operations one writer iteration makes while a file is open
+/// (see the module docs).
+pub const WRITER_OPS_PER_ITERATION: u32 = 14;
+/// Longest the SD specification lets an SDHC/SDXC card stay busy on a
+/// write, µs (SDSC cards: 250 ms).
+pub const CARD_WRITE_STALL_US: u64 = 500_000;
+/// Longest the SD specification lets a card take to answer a read, µs.
+pub const CARD_READ_STALL_US: u64 = 100_000;
+/// The writer iteration that is slowest by the SD specification's limits
+/// (see the module docs).
+pub const WORST_ITERATION_OPS: CardOps = CardOps {
+    reads: 5,
+    writes: 8,
+    other: 0,
+};
+/// The longest writer iteration the queue must bridge, µs.
+pub const WORST_ITERATION_US: u64 = iteration_stall_us(WORST_ITERATION_OPS);
+/// The queue holds at least this long at the highest record rate, µs.
+pub const MIN_QUEUE_US: u64 = 4_000_000;
 /// Capacity of the sampler -> writer queue, in records (see the module docs).
-pub const QUEUE_LEN: usize = 200;
-// Holds the longest card operation at the highest record rate.
-const _: () = assert!(QUEUE_LEN as u64 * 1_000_000 >= MAX_RECORDS_PER_S * CARD_OPERATION_BUDGET_US);
+pub const QUEUE_LEN: usize = 576;
+/// How long [`QUEUE_LEN`] records last at [`MAX_RECORDS_PER_S`], µs.
+pub const QUEUE_HOLDS_US: u64 = queue_holds_us(QUEUE_LEN as u64, MAX_RECORDS_PER_S);
+// Holds the worst iteration, at least 4 s, and one operation at its budget.
+const _: () = assert!(QUEUE_HOLDS_US >= WORST_ITERATION_US);
+const _: () = assert!(QUEUE_HOLDS_US >= MIN_QUEUE_US);
+const _: () = assert!(QUEUE_HOLDS_US >= CARD_OPERATION_BUDGET_US);
+
+/// The longest the SD specification lets `ops` take, µs: each write at
+/// [`CARD_WRITE_STALL_US`], each read and other command at
+/// [`CARD_READ_STALL_US`].
+#[must_use]
+pub const fn iteration_stall_us(ops: CardOps) -> u64 {
+    ops.writes as u64 * CARD_WRITE_STALL_US
+        + (ops.reads as u64 + ops.other as u64) * CARD_READ_STALL_US
+}
+
+/// How long a queue of `records` lasts when `per_s` records come a second,
+/// µs (rounded down; `u64::MAX` when nothing comes).
+#[must_use]
+pub const fn queue_holds_us(records: u64, per_s: u64) -> u64 {
+    if per_s == 0 {
+        return u64::MAX;
+    }
+    records * 1_000_000 / per_s
+}
+
+/// Records a queue needs to bridge `stall_us` when `per_s` records come a
+/// second (rounded up).
+#[must_use]
+pub const fn records_for(stall_us: u64, per_s: u64) -> u64 {
+    (stall_us * per_s).div_ceil(1_000_000)
+}
 
 /// The bounded queue from the producers to the SD writer.
 ///
@@ -169,6 +236,26 @@ pub struct SharedStatus {
     card: AtomicU32,
     /// Whether the writer should close the log (0/1).
     stop: AtomicU32,
+    /// Most card operations of one writer iteration with a file open.
+    writer_ops_max: AtomicU32,
+    /// Most card operations of one writer iteration that opened a card.
+    writer_open_ops_max: AtomicU32,
+    /// Longest busy time of one writer iteration, µs.
+    writer_busy_max_us: AtomicU32,
+}
+
+/// The writer's worst iterations since boot ([`SharedStatus::writer`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct WriterFigures {
+    /// Most card operations of one iteration while logging (what the queue
+    /// is sized for: at most [`WRITER_OPS_PER_ITERATION`]).
+    pub ops_max: u32,
+    /// Most card operations of one iteration that opened a card (or tried
+    /// to): the boot's, and each retry's.
+    pub open_ops_max: u32,
+    /// Longest time one iteration kept the writer busy, µs.
+    pub busy_max_us: u32,
 }
 
 impl Default for SharedStatus {
@@ -185,6 +272,9 @@ impl SharedStatus {
             last_fix_ms: AtomicU32::new(0),
             card: AtomicU32::new(0),
             stop: AtomicU32::new(0),
+            writer_ops_max: AtomicU32::new(0),
+            writer_open_ops_max: AtomicU32::new(0),
+            writer_busy_max_us: AtomicU32::new(0),
         }
     }
 
@@ -228,6 +318,29 @@ impl SharedStatus {
     /// Whether a stop was requested.
     pub fn stop_requested(&self) -> bool {
         self.stop.load(Ordering::Acquire) != 0
+    }
+
+    /// The writer finished an iteration of `ops` card operations that kept
+    /// it busy `busy_us`; `logging`: a file was open when it began (else it
+    /// opened a card, or tried to).
+    pub fn note_writer_iteration(&self, logging: bool, ops: u32, busy_us: u64) {
+        let max = if logging {
+            &self.writer_ops_max
+        } else {
+            &self.writer_open_ops_max
+        };
+        max.fetch_max(ops, Ordering::Relaxed);
+        let busy = u32::try_from(busy_us).unwrap_or(u32::MAX);
+        self.writer_busy_max_us.fetch_max(busy, Ordering::Relaxed);
+    }
+
+    /// The writer's worst iterations since boot.
+    pub fn writer(&self) -> WriterFigures {
+        WriterFigures {
+            ops_max: self.writer_ops_max.load(Ordering::Relaxed),
+            open_ops_max: self.writer_open_ops_max.load(Ordering::Relaxed),
+            busy_max_us: self.writer_busy_max_us.load(Ordering::Relaxed),
+        }
     }
 }
 
@@ -360,15 +473,12 @@ mod tests {
         }
     }
 
-    /// The longest card operation the writer's budget allows, at the
-    /// highest record rate (100 frames and 25 other records a second):
-    /// nothing is dropped.
-    #[test]
-    fn a_card_operation_at_its_budget_loses_no_record() {
-        let q = RecordQueue::new();
+    /// Pushes `seconds_us` of the highest record rate (100 frames and 25
+    /// other records a second) into `q` without draining it; returns how
+    /// many records were pushed.
+    fn fill_at_highest_rate(q: &RecordQueue, stall_us: u64) -> u64 {
         let mut pushed = 0u64;
-        let ticks = CARD_OPERATION_BUDGET_US / 10_000;
-        for k in 0..ticks {
+        for k in 0..stall_us / 10_000 {
             q.push(frame(k * 10_000));
             pushed += 1;
             if k % 4 == 0 {
@@ -379,9 +489,74 @@ mod tests {
                 pushed += 1;
             }
         }
-        assert!(pushed >= MAX_RECORDS_PER_S * CARD_OPERATION_BUDGET_US / 1_000_000);
+        pushed
+    }
+
+    /// The worst writer iteration (every operation at the SD
+    /// specification's longest busy time, at least 4 s) at the highest
+    /// record rate: nothing is dropped. Half a second more is: the queue is
+    /// what bounds it.
+    #[test]
+    fn the_worst_writer_iteration_loses_no_record() {
+        let stall = WORST_ITERATION_US.max(MIN_QUEUE_US);
+        let q = RecordQueue::new();
+        let pushed = fill_at_highest_rate(&q, stall);
+        assert!(pushed >= MAX_RECORDS_PER_S * stall / 1_000_000);
         assert_eq!(q.len() as u64, pushed);
         assert_eq!((q.frames_dropped_pending(), q.others_dropped()), (0, 0));
+        assert_eq!(q.high_water() as u64, pushed);
+
+        let q = RecordQueue::new();
+        fill_at_highest_rate(&q, stall + 500_000);
+        assert_eq!(q.len(), QUEUE_LEN);
+        assert!(q.frames_dropped_pending() > 0);
+    }
+
+    /// The sizing arithmetic of the module docs.
+    #[test]
+    fn queue_sizing_arithmetic() {
+        // 576 records at 125 a second: 4.608 s.
+        assert_eq!(QUEUE_HOLDS_US, 4_608_000);
+        // 8 writes at 0.5 s and 5 reads at 0.1 s.
+        assert_eq!(WORST_ITERATION_US, 4_500_000);
+        assert_eq!(records_for(WORST_ITERATION_US, MAX_RECORDS_PER_S), 563);
+        let one_each = CardOps {
+            reads: 1,
+            writes: 1,
+            other: 1,
+        };
+        assert_eq!(iteration_stall_us(one_each), 700_000);
+        assert_eq!(iteration_stall_us(CardOps::default()), 0);
+        assert_eq!(queue_holds_us(200, 125), 1_600_000);
+        assert_eq!(queue_holds_us(1, 0), u64::MAX);
+        // 4 s at 125 records a second: 500 records; 1 µs more: 501.
+        assert_eq!(records_for(4_000_000, 125), 500);
+        assert_eq!(records_for(4_000_001, 125), 501);
+        assert_eq!(records_for(0, 125), 0);
+        assert!(records_for(WORST_ITERATION_US, MAX_RECORDS_PER_S) <= QUEUE_LEN as u64);
+        assert!(records_for(MIN_QUEUE_US, MAX_RECORDS_PER_S) <= QUEUE_LEN as u64);
+    }
+
+    /// The writer's figures keep the worst of each kind of iteration.
+    #[test]
+    fn writer_figures_keep_the_worst_iteration_of_each_kind() {
+        let s = SharedStatus::new();
+        assert_eq!(s.writer(), WriterFigures::default());
+        s.note_writer_iteration(false, 40, 700_000);
+        s.note_writer_iteration(true, 3, 1_000);
+        s.note_writer_iteration(true, 7, 20_000);
+        s.note_writer_iteration(true, 2, 500);
+        s.note_writer_iteration(false, 12, 100);
+        assert_eq!(
+            s.writer(),
+            WriterFigures {
+                ops_max: 7,
+                open_ops_max: 40,
+                busy_max_us: 700_000
+            }
+        );
+        s.note_writer_iteration(true, 1, u64::MAX);
+        assert_eq!(s.writer().busy_max_us, u32::MAX);
     }
 
     /// The writer stops once `is_empty` says everything queued is on its

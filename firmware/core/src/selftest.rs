@@ -352,6 +352,98 @@ pub fn write_report(m: &Measurements, out: &mut impl Write) -> fmt::Result {
     Ok(())
 }
 
+/// The record queue's line of the report, written after the checks of
+/// [`CHECKS`] (`queue PASS capacity=576 holds_ms=4608 high_water=3 ...`):
+/// the queue this boot and what the card measured means for it. A check of
+/// its own, apart from [`Measurements`], so that reports and readers of the
+/// ten checks before it stay as they are; a failure shows as LED code
+/// [`QUEUE_LED_CODE`] ([`overall_code`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct QueueCheck {
+    /// The queue's capacity, records.
+    pub capacity: u32,
+    /// Its high-water mark this boot, records.
+    pub high_water: u32,
+    /// The card's slowest block write during the speed test (one
+    /// embedded-sdmmc write call, FAT updates included), µs; `None`
+    /// without a working card.
+    pub slowest_write_us: Option<u32>,
+}
+
+/// LED code of a failed queue check: after the ten of [`CHECKS`].
+pub const QUEUE_LED_CODE: u8 = CHECKS.len() as u8 + 1;
+
+impl QueueCheck {
+    /// The longest writer iteration this card would take, µs: every one of
+    /// the iteration's most operations
+    /// ([`crate::channels::WRITER_OPS_PER_ITERATION`]) as slow as its
+    /// slowest write (an over-estimate: reads are faster).
+    #[must_use]
+    pub fn predicted_iteration_us(&self) -> Option<u64> {
+        self.slowest_write_us
+            .map(|us| u64::from(us) * u64::from(crate::channels::WRITER_OPS_PER_ITERATION))
+    }
+
+    /// The queue's fill after that iteration at the highest record rate.
+    #[must_use]
+    pub fn predicted_high_water(&self) -> Option<u64> {
+        self.predicted_iteration_us()
+            .map(|us| crate::channels::records_for(us, crate::channels::MAX_RECORDS_PER_S))
+    }
+
+    /// Pass when this card's predicted worst iteration fits the queue.
+    #[must_use]
+    pub fn verdict(&self) -> Verdict {
+        match self.predicted_high_water() {
+            Some(records) if records <= u64::from(self.capacity) => Verdict::Pass,
+            _ => Verdict::Fail,
+        }
+    }
+
+    /// Writes the report line (with its newline).
+    ///
+    /// # Errors
+    /// `out`'s error (a full buffer).
+    pub fn write_line(&self, out: &mut impl Write) -> fmt::Result {
+        let verdict = match self.verdict() {
+            Verdict::Pass => "PASS",
+            Verdict::Fail => "FAIL",
+        };
+        let holds_ms = crate::channels::queue_holds_us(
+            u64::from(self.capacity),
+            crate::channels::MAX_RECORDS_PER_S,
+        ) / 1000;
+        write!(
+            out,
+            "queue {verdict} capacity={} holds_ms={holds_ms} high_water={}",
+            self.capacity, self.high_water
+        )?;
+        match (
+            self.slowest_write_us,
+            self.predicted_iteration_us(),
+            self.predicted_high_water(),
+        ) {
+            (Some(write_us), Some(iteration_us), Some(records)) => writeln!(
+                out,
+                " slowest_write_us={write_us} worst_iteration_ms={} predicted_high_water={records}",
+                iteration_us / 1000
+            ),
+            _ => writeln!(out, " card not measured"),
+        }
+    }
+}
+
+/// The LED code of the whole self-test: the first failing check of
+/// [`CHECKS`] ([`failure_code`]), else [`QUEUE_LED_CODE`] if the queue's
+/// check failed, else 0.
+#[must_use]
+pub fn overall_code(m: &Measurements, queue: &QueueCheck) -> u8 {
+    match failure_code(m) {
+        0 if queue.verdict() == Verdict::Fail => QUEUE_LED_CODE,
+        code => code,
+    }
+}
+
 /// One line of a report read back.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct ReportLine<'a> {
@@ -520,6 +612,66 @@ mod tests {
             }
         }
         p
+    }
+
+    /// The queue's line: a card whose slowest write, at every operation of
+    /// the writer's worst iteration, still fits the queue passes; one that
+    /// does not, or no card, fails with code 11 after every other check.
+    #[test]
+    fn the_queue_line_judges_the_card_against_the_queue() {
+        let fast = QueueCheck {
+            capacity: 576,
+            high_water: 3,
+            slowest_write_us: Some(40_000),
+        };
+        // 14 operations at 40 ms: 560 ms, 70 records at 125 a second.
+        assert_eq!(fast.predicted_iteration_us(), Some(560_000));
+        assert_eq!(fast.predicted_high_water(), Some(70));
+        assert_eq!(fast.verdict(), Verdict::Pass);
+        let mut line = String::new();
+        fast.write_line(&mut line).unwrap();
+        assert_eq!(
+            line,
+            "queue PASS capacity=576 holds_ms=4608 high_water=3 slowest_write_us=40000 \
+             worst_iteration_ms=560 predicted_high_water=70\n"
+        );
+        // 330 ms per write: 4.62 s, 578 records: over.
+        let slow = QueueCheck {
+            slowest_write_us: Some(330_000),
+            ..fast
+        };
+        assert_eq!(slow.predicted_high_water(), Some(578));
+        assert_eq!(slow.verdict(), Verdict::Fail);
+        // 329 ms: 4.606 s, 576 records: just fits.
+        let edge = QueueCheck {
+            slowest_write_us: Some(329_000),
+            ..fast
+        };
+        assert_eq!(edge.verdict(), Verdict::Pass);
+        let none = QueueCheck {
+            slowest_write_us: None,
+            ..fast
+        };
+        assert_eq!(none.verdict(), Verdict::Fail);
+        let mut line = String::new();
+        none.write_line(&mut line).unwrap();
+        assert_eq!(
+            line,
+            "queue FAIL capacity=576 holds_ms=4608 high_water=3 card not measured\n"
+        );
+        // The report with the queue's line reads back, eleven checks.
+        let mut text = report_of(&good());
+        slow.write_line(&mut text).unwrap();
+        let mut names = Vec::new();
+        read_report(&text, &mut |l| names.push((l.check, l.verdict))).unwrap();
+        assert_eq!(names.len(), 11);
+        assert_eq!(names[10], ("queue", Verdict::Fail));
+        // LED codes: the other checks first, then the queue's.
+        assert_eq!(overall_code(&good(), &fast), 0);
+        assert_eq!(overall_code(&good(), &slow), 11);
+        let mut bad = good();
+        bad.wheel_edges = 0;
+        assert_eq!(overall_code(&bad, &slow), 3);
     }
 
     #[test]

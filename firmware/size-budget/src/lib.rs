@@ -3,8 +3,16 @@
 //!
 //! - **flash** = every allocated section with contents (`.vector_table`,
 //!   `.text`, `.rodata`, and `.data`, whose initial values live in flash);
-//! - **static RAM** = every allocated section placed in RAM (`.data`,
-//!   `.bss`, `.uninit`). The stack is what is left of RAM above that.
+//! - **static RAM** = every allocated section placed in SRAM (`.data`,
+//!   `.bss`, `.uninit`). The stack is what is left of SRAM above that;
+//! - **CCM** = every allocated section placed in the core-coupled RAM
+//!   (`.ccmram`: CPU-only state, never a DMA buffer).
+//!
+//! The memory plan (`firmware/docs/board.md`): flash at most
+//! [`FLASH_BUDGET`], the active slot of a two-image layout for field
+//! updates; CCM at most its 64 KiB. Static SRAM plus the worst-case stack
+//! bound at most 120 KiB is checked where the bound is computed
+//! (`stack_bound.py --check`).
 //!
 //! Sections that are not loaded (`.defmt` strings, debug information) do
 //! not count. Only 32-bit little-endian ELF files are read (the ARM
@@ -13,14 +21,18 @@
 
 use std::fmt;
 
-/// STM32F405 SRAM (SRAM1 + SRAM2) and CCM ranges: `[start, end)`.
-pub const RAM_RANGES: [(u32, u32); 2] = [(0x2000_0000, 0x2002_0000), (0x1000_0000, 0x1001_0000)];
+/// STM32F405 SRAM (SRAM1 + SRAM2): `[start, end)`.
+pub const SRAM_RANGE: (u32, u32) = (0x2000_0000, 0x2002_0000);
+/// STM32F405 core-coupled RAM: `[start, end)`.
+pub const CCM_RANGE: (u32, u32) = (0x1000_0000, 0x1001_0000);
 
-/// The firmware's budget, bytes: 192 KiB of flash (of the chip's 1 MiB;
-/// the margin goes to correctness: fault handling, self-test, bring-up).
-pub const FLASH_BUDGET: u64 = 192 * 1024;
-/// The firmware's budget, bytes: 64 KiB of static RAM.
-pub const RAM_BUDGET: u64 = 64 * 1024;
+/// Flash, bytes: 384 KiB, the active slot of the flash layout for field
+/// updates (sectors 5-7 of the STM32F405's 16, 16, 16, 16, 64 and 7 × 128
+/// KiB; a second image needs sectors 8-11, one 128 KiB sector more than the
+/// slot, to swap into; the bootloader and its state take sectors 0-3).
+pub const FLASH_BUDGET: u64 = 384 * 1024;
+/// CCM, bytes: all of it (64 KiB).
+pub const CCM_BUDGET: u64 = (CCM_RANGE.1 - CCM_RANGE.0) as u64;
 
 const SHF_ALLOC: u32 = 0x2;
 const SHT_NOBITS: u32 = 8;
@@ -31,8 +43,10 @@ const SECTION_HEADER_LEN: usize = 40;
 pub struct Footprint {
     /// Bytes programmed into flash.
     pub flash: u64,
-    /// Bytes of RAM reserved before the stack.
+    /// Bytes of SRAM reserved before the stack.
     pub ram: u64,
+    /// Bytes of CCM reserved.
+    pub ccm: u64,
 }
 
 /// Why a file could not be measured.
@@ -99,11 +113,10 @@ pub fn measure(elf: &[u8]) -> Result<Footprint, ElfError> {
         if kind != SHT_NOBITS {
             footprint.flash += size;
         }
-        if RAM_RANGES
-            .iter()
-            .any(|&(start, end)| (start..end).contains(&addr))
-        {
+        if (SRAM_RANGE.0..SRAM_RANGE.1).contains(&addr) {
             footprint.ram += size;
+        } else if (CCM_RANGE.0..CCM_RANGE.1).contains(&addr) {
+            footprint.ccm += size;
         }
     }
     Ok(footprint)
@@ -140,16 +153,41 @@ mod tests {
             (PROGBITS, SHF_ALLOC, 0x0800_1000, 200),        // .rodata
             (PROGBITS, SHF_ALLOC | 0x1, 0x2000_0000, 16),   // .data
             (SHT_NOBITS, SHF_ALLOC | 0x1, 0x2000_0010, 4000), // .bss
-            (SHT_NOBITS, SHF_ALLOC | 0x1, 0x1000_0000, 64), // CCM
+            (SHT_NOBITS, SHF_ALLOC | 0x3, 0x1000_0000, 64), // .ccmram
+            (SHT_NOBITS, SHF_ALLOC | 0x1, 0x2000_0FB0, 8),  // .uninit
             (PROGBITS, 0, 0, 9999),                         // .defmt, debug
         ]);
         assert_eq!(
             measure(&image),
             Ok(Footprint {
                 flash: 1216,
-                ram: 4080
+                ram: 4024,
+                ccm: 64
             })
         );
+    }
+
+    /// Only addresses inside each range count for it: SRAM ends at
+    /// 0x2002_0000 and CCM at 0x1001_0000 (QEMU's larger SRAM or the
+    /// backup SRAM are neither).
+    #[test]
+    fn each_memory_counts_only_its_own_range() {
+        let image = elf(&[
+            (SHT_NOBITS, SHF_ALLOC | 0x1, 0x2001_FFFC, 4),
+            (SHT_NOBITS, SHF_ALLOC | 0x1, 0x2002_0000, 100),
+            (SHT_NOBITS, SHF_ALLOC | 0x1, 0x1000_FFF0, 16),
+            (SHT_NOBITS, SHF_ALLOC | 0x1, 0x1001_0000, 200),
+            (SHT_NOBITS, SHF_ALLOC | 0x1, 0x0FFF_FFF0, 300),
+        ]);
+        assert_eq!(
+            measure(&image),
+            Ok(Footprint {
+                flash: 0,
+                ram: 4,
+                ccm: 16
+            })
+        );
+        assert_eq!(CCM_BUDGET, 64 * 1024);
     }
 
     #[test]

@@ -12,7 +12,7 @@ use static_cell::StaticCell;
 use wobble_core::app::sampler::{self, Sampler, SamplerPorts};
 use wobble_core::config::{self, Config, Loaded, KEY_COUNT, MAX_TEXT_LEN};
 use wobble_core::frame_assembly::FrameConfig;
-use wobble_core::logger::{FixedTime, HeaderSpec, Volumes};
+use wobble_core::logger::{self, FixedTime, HeaderSpec};
 use wobble_core::steering::Steering;
 use wobble_core::wheel::WheelSpeed;
 
@@ -58,7 +58,7 @@ pub fn card_and_config(pins: pins::CardPins) -> (SdCard, Loaded) {
         adapters::card::spi_config(wobble_core::drivers::sdcard::IDENTIFICATION_CLOCK_HZ),
     );
     let cs = Output::new(pins.cs, Level::High, Speed::VeryHigh);
-    let volumes = Volumes::new_with_limits(adapters::card::card(bus, cs), FixedTime::EPOCH, 0);
+    let volumes = logger::volumes(adapters::card::card(bus, cs), FixedTime::EPOCH);
     let mut file = [0u8; CONFIG_FILE_BYTES];
     let (loaded, source) = config::load(&volumes, &mut file);
     defmt::info!("config: {}, {} faults", source, loaded.faults.first().len());
@@ -66,7 +66,7 @@ pub fn card_and_config(pins: pins::CardPins) -> (SdCard, Loaded) {
         defmt::warn!("CONFIG.TXT line {}: fault {}", fault.line, fault.code);
     }
     let (card, _) = volumes.free();
-    (card, loaded)
+    (card.into_inner(), loaded)
 }
 
 /// The header of every log file: identity and the configuration in force.

@@ -8,6 +8,7 @@
 
 pub mod adapters;
 pub mod assembly;
+pub mod ccm;
 pub mod clocks;
 pub mod pins;
 pub mod selftest;

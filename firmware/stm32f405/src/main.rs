@@ -14,7 +14,7 @@
 use wobble_stm32f405::assembly::{
     card_and_config, header, marker_held, sampler_parts, Ports, FIRMWARE,
 };
-use wobble_stm32f405::{adapters, clocks, startup, watchdog};
+use wobble_stm32f405::{adapters, ccm, clocks, startup, watchdog};
 
 use cortex_m_rt::entry;
 use embassy_executor::{Executor, InterruptExecutor};
@@ -38,8 +38,6 @@ use wobble_stm32f405::adapters::card::SdCard;
 use wobble_stm32f405::adapters::gps::GpsAdapter;
 use wobble_stm32f405::pins::Board;
 
-/// Records from the sampler and the GPS task to the SD writer.
-static QUEUE: RecordQueue = RecordQueue::new();
 /// Fix age and card state, shared by the tasks.
 static SHARED: SharedStatus = SharedStatus::new();
 
@@ -62,6 +60,8 @@ unsafe fn UART5() {
 #[entry]
 fn main() -> ! {
     startup::guard_stack();
+    // Records from the sampler and the GPS task to the SD writer, in CCM.
+    let queue = defmt::unwrap!(ccm::record_queue());
     // RTT needs no clock: this line appears even if the clocks never come up.
     defmt::info!("{} starting", FIRMWARE);
     let reset = startup::take_reset_cause();
@@ -92,7 +92,7 @@ fn main() -> ! {
         bor,
     ];
     for code in boot_faults.into_iter().flatten() {
-        QUEUE.push(Record::Fault(boot::system_fault(code, 0)));
+        queue.push(Record::Fault(boot::system_fault(code, 0)));
     }
     let debugger = cortex_m::peripheral::DCB::is_debugger_attached();
     if reset.blink_at_boot(debugger) || !crystal {
@@ -111,12 +111,13 @@ fn main() -> ! {
         // Nothing is written: no new log file per boot. The code repeats
         // until a power cycle (the watchdog is not started).
         defmt::error!(
-            "{} software resets in a row: not logging until power-off",
+            "{} panic, fault or watchdog resets in a row: not logging until power-off",
             streak
         );
         let mut led = Output::new(board.rider.alert_led.reborrow(), Level::Low, Speed::Low);
         loop {
-            startup::blink_code(&mut led, boot::FAULT_RESET_SOFTWARE);
+            // 5 after a panic or a fault, 3 after a hang.
+            startup::blink_code(&mut led, reset.fault_code());
         }
     }
     let button = marker_held(&mut board);
@@ -144,12 +145,12 @@ fn main() -> ! {
             reset,
         };
         EXECUTOR_THREAD.init(Executor::new()).run(move |thread| {
-            thread.spawn(defmt::unwrap!(selftest_task(parts)));
+            thread.spawn(defmt::unwrap!(selftest_task(parts, queue)));
         })
     }
     let t_us = Instant::now().as_micros();
     for fault in loaded.faults.records(t_us) {
-        QUEUE.push(Record::Fault(fault));
+        queue.push(Record::Fault(fault));
     }
     let logger = CardLogger::new(
         card,
@@ -164,26 +165,26 @@ fn main() -> ! {
 
     interrupt::UART4.set_priority(Priority::P6);
     let high = EXECUTOR_HIGH.start(interrupt::UART4);
-    high.spawn(defmt::unwrap!(sampler_task(sampler, ports)));
+    high.spawn(defmt::unwrap!(sampler_task(sampler, ports, queue)));
 
     interrupt::UART5.set_priority(Priority::P7);
     let medium = EXECUTOR_MEDIUM.start(interrupt::UART5);
-    medium.spawn(defmt::unwrap!(gps_task(gps_port)));
+    medium.spawn(defmt::unwrap!(gps_task(gps_port, queue)));
 
     let watchdog = board.watchdog;
     EXECUTOR_THREAD.init(Executor::new()).run(move |thread| {
-        thread.spawn(defmt::unwrap!(writer_task(logger)));
-        thread.spawn(defmt::unwrap!(watchdog_task(watchdog)));
+        thread.spawn(defmt::unwrap!(writer_task(logger, queue)));
+        thread.spawn(defmt::unwrap!(watchdog_task(watchdog, queue)));
     })
 }
 
 #[embassy_executor::task]
-async fn sampler_task(mut sampler: Sampler, mut ports: Ports) {
+async fn sampler_task(mut sampler: Sampler, mut ports: Ports, queue: &'static RecordQueue) {
     ports.imu.start().await;
     sampler::run(
         &mut sampler,
         &mut ports,
-        &QUEUE,
+        queue,
         &SHARED,
         u32::MAX,
         &mut |t_us, event| {
@@ -194,26 +195,29 @@ async fn sampler_task(mut sampler: Sampler, mut ports: Ports) {
 }
 
 #[embassy_executor::task]
-async fn gps_task(mut port: GpsAdapter) {
-    gps::run_link(&mut port, &QUEUE, &SHARED, &mut |step| {
+async fn gps_task(mut port: GpsAdapter, queue: &'static RecordQueue) {
+    gps::run_link(&mut port, queue, &SHARED, &mut |step| {
         defmt::info!("GPS set-up: {}", step);
     })
     .await;
 }
 
 #[embassy_executor::task]
-async fn selftest_task(parts: wobble_stm32f405::selftest::Parts) {
-    wobble_stm32f405::selftest::run(parts).await
+async fn selftest_task(parts: wobble_stm32f405::selftest::Parts, queue: &'static RecordQueue) {
+    wobble_stm32f405::selftest::run(parts, queue).await
 }
 
 #[embassy_executor::task]
-async fn writer_task(mut logger: CardLogger<'static, SdCard, FixedTime>) {
-    if let Err(e) = writer::run(&mut logger, &QUEUE, &SHARED).await {
+async fn writer_task(
+    mut logger: CardLogger<'static, SdCard, FixedTime>,
+    queue: &'static RecordQueue,
+) {
+    if let Err(e) = writer::run(&mut logger, queue, &SHARED).await {
         defmt::error!("log not closed cleanly: {}", e);
     }
 }
 
 #[embassy_executor::task]
-async fn watchdog_task(iwdg: Peri<'static, IWDG>) {
-    watchdog::feed(iwdg).await
+async fn watchdog_task(iwdg: Peri<'static, IWDG>, queue: &'static RecordQueue) {
+    watchdog::feed(iwdg, queue, &SHARED).await
 }

@@ -8,7 +8,7 @@
 //! green LED on and one long beep; a failure, the red LED and the buzzer
 //! repeat the failing check's number (1 IMU, 2 steering, 3 wheel, 4 GPS,
 //! 5 card, 6 clock, 7 reset, 8 brown-out level, 9 stack, 10 IMU data-ready
-//! line) until power-off.
+//! line, 11 record queue: the card too slow for it) until power-off.
 //! The brown-out level is programmed here when it is below 2.7 V (never at
 //! boot): the check fails until a power cycle and a second self-test show
 //! the stored level.
@@ -20,11 +20,12 @@ use embedded_sdmmc::{Mode, VolumeIdx};
 use wobble_core::app::gps_setup;
 use wobble_core::app::ports::{DataReadyPort, ImuPort, SteeringPort, WheelPort};
 use wobble_core::boot::ResetCause;
+use wobble_core::channels::{RecordQueue, QUEUE_LEN};
 use wobble_core::detector::math::sqrtf;
-use wobble_core::logger::{FixedTime, Volumes};
+use wobble_core::logger::{self, FixedTime, Volumes};
 use wobble_core::selftest::{
-    failure_code, fat_free_mib, write_report, Measurements, PulseTrain, DATA_READY_WINDOW_US,
-    TEST_WINDOW_US,
+    fat_free_mib, overall_code, write_report, Measurements, PulseTrain, QueueCheck,
+    DATA_READY_WINDOW_US, TEST_WINDOW_US,
 };
 
 use crate::adapters::card::SdCard;
@@ -125,9 +126,10 @@ async fn sensors(
     led.set_low();
 }
 
-/// Write and read speed, KiB/s, through a scratch file that is deleted
-/// afterwards (logs are never touched).
-fn card_speed(volumes: &Volumes<SdCard, FixedTime>) -> Option<(u32, u32)> {
+/// Write and read speed, KiB/s, and the slowest single block write, µs,
+/// through a scratch file that is deleted afterwards (logs are never
+/// touched).
+fn card_speed(volumes: &Volumes<SdCard, FixedTime>) -> Option<(u32, u32, u32)> {
     let volume = volumes.open_volume(VolumeIdx(0)).ok()?;
     let root = volume.open_root_dir().ok()?;
     let block = [0x5Au8; 512];
@@ -136,12 +138,15 @@ fn card_speed(volumes: &Volumes<SdCard, FixedTime>) -> Option<(u32, u32)> {
         (u64::from(SPEED_BLOCKS) * 512 * 1_000_000 / 1024 / us) as u32
     };
     let start = Instant::now();
+    let mut slowest_us = 0u64;
     {
         let file = root
             .open_file_in_dir(SCRATCH, Mode::ReadWriteCreateOrTruncate)
             .ok()?;
         for _ in 0..SPEED_BLOCKS {
+            let write_start = Instant::now();
             file.write(&block).ok()?;
+            slowest_us = slowest_us.max(Instant::now().duration_since(write_start).as_micros());
         }
         file.close().ok()?;
     }
@@ -159,7 +164,7 @@ fn card_speed(volumes: &Volumes<SdCard, FixedTime>) -> Option<(u32, u32)> {
     }
     let read = kib_s(start);
     root.delete_entry_in_dir(SCRATCH).ok()?;
-    Some((write, read))
+    Some((write, read, u32::try_from(slowest_us).unwrap_or(u32::MAX)))
 }
 
 fn write_report_file(volumes: &Volumes<SdCard, FixedTime>, text: &str) -> bool {
@@ -188,8 +193,10 @@ async fn show(led: &mut Output<'static>, buzzer: &mut Output<'static>, code: u8)
     Timer::after_secs(2).await;
 }
 
-/// Runs the self-test, then shows its result until power-off.
-pub async fn run(p: Parts) -> ! {
+/// Runs the self-test, then shows its result until power-off. `queue` is
+/// the ride's record queue (in CCM), whose capacity and high-water mark
+/// this boot the report's `queue` line gives.
+pub async fn run(p: Parts, queue: &'static RecordQueue) -> ! {
     let Parts {
         mut imu,
         mut steering,
@@ -223,7 +230,7 @@ pub async fn run(p: Parts) -> ! {
     // here, at the bench, and verified by the next self-test.
     m.bor = Some(crate::startup::program_bor_level3());
     m.stack_bytes = Some(crate::startup::stack_use());
-    let volumes = Volumes::new_with_limits(card, FixedTime::EPOCH, 0);
+    let volumes = logger::volumes(card, FixedTime::EPOCH);
     m.card_free_mib = volumes.device(|card| fat_free_mib(card)).unwrap_or(0);
     // The volume, opened and dropped (closed) at once: what the logger's
     // `open_fault` calls an unusable card.
@@ -231,16 +238,22 @@ pub async fn run(p: Parts) -> ! {
         volumes.open_volume(VolumeIdx(0)),
         Err(embedded_sdmmc::Error::FormatError(_))
     );
-    m.card_kib_s = card_speed(&volumes);
-    let mut text = heapless::String::<640>::new();
-    if write_report(&m, &mut text).is_err() {
+    let speed = card_speed(&volumes);
+    m.card_kib_s = speed.map(|(w, r, _)| (w, r));
+    let queue = QueueCheck {
+        capacity: QUEUE_LEN as u32,
+        high_water: queue.high_water(),
+        slowest_write_us: speed.map(|(_, _, slowest)| slowest),
+    };
+    let mut text = heapless::String::<768>::new();
+    if write_report(&m, &mut text).is_err() || queue.write_line(&mut text).is_err() {
         defmt::warn!("self-test report cut short");
     }
     defmt::info!("{=str}", text.as_str());
     if !write_report_file(&volumes, &text) {
         defmt::error!("{} not written", REPORT);
     }
-    let code = failure_code(&m);
+    let code = overall_code(&m, &queue);
     if code == 0 {
         status_led.set_high();
         buzzer.set_high();

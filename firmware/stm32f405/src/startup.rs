@@ -13,7 +13,8 @@ use embassy_stm32::pac::{self, FLASH, RCC};
 use embassy_time::{block_for, Duration};
 
 use wobble_core::boot::{
-    optcr_with_bor_level3, panic_streak, BorCheck, BorLevel, ResetCause, FLASH_SR_ERRORS,
+    optcr_with_bor_level3, panic_streak, BorCheck, BorLevel, ResetCause, FAULT_RESET_MARK,
+    FLASH_SR_ERRORS,
 };
 
 use crate::clocks::HSE_STARTUP_TIMEOUT_MS;
@@ -221,32 +222,50 @@ unsafe fn DefaultHandler(irqn: i16) {
     defmt::error!("unexpected interrupt {}: masked", irqn);
 }
 
-/// The software-reset streak kept across resets: a magic word and the
-/// count, in `.uninit` (not zeroed at reset; noise after a power-on, which
-/// the magic word tells apart).
+/// The failure-reset streak kept across resets: a magic word, the count
+/// and the fault handler's mark ([`FAULT_RESET_MARK`]), in `.uninit` (not
+/// zeroed at reset; noise after a power-on, which the magic word tells
+/// apart).
 #[link_section = ".uninit.PANIC_STREAK"]
-static mut PANIC_STREAK: MaybeUninit<[u32; 2]> = MaybeUninit::uninit();
+static mut PANIC_STREAK: MaybeUninit<[u32; 3]> = MaybeUninit::uninit();
 const STREAK_MAGIC: u32 = 0x5742_4C21;
 
 fn keep_streak(n: u32) {
-    // SAFETY: written only in thread mode (boot, then the watchdog task),
-    // never borrowed.
-    unsafe { addr_of_mut!(PANIC_STREAK).write_volatile(MaybeUninit::new([STREAK_MAGIC, n])) }
+    // SAFETY: written only in thread mode (boot, then the watchdog task)
+    // and by the hard fault handler on its way to a reset, never borrowed.
+    unsafe { addr_of_mut!(PANIC_STREAK).write_volatile(MaybeUninit::new([STREAK_MAGIC, n, 0])) }
 }
 
-/// This boot's software-reset streak (`wobble_core::boot::panic_streak`),
-/// kept for the next boot.
+/// This boot's failure-reset streak (`wobble_core::boot::panic_streak`:
+/// panics, faults and watchdog resets in a row; a debug probe's reset is a
+/// fresh start), kept for the next boot with the fault mark cleared.
 pub fn take_panic_streak(cause: ResetCause) -> u32 {
-    // SAFETY: as in `keep_streak`; any bit pattern is a valid `[u32; 2]`.
-    let [magic, count] = unsafe { addr_of_mut!(PANIC_STREAK).read_volatile().assume_init() };
-    let n = panic_streak((magic == STREAK_MAGIC).then_some(count), cause);
+    // SAFETY: as in `keep_streak`; any bit pattern is a valid `[u32; 3]`.
+    let [magic, count, mark] = unsafe { addr_of_mut!(PANIC_STREAK).read_volatile().assume_init() };
+    let valid = magic == STREAK_MAGIC;
+    let n = panic_streak(
+        valid.then_some(count),
+        cause,
+        valid && mark == FAULT_RESET_MARK,
+    );
     keep_streak(n);
     n
 }
 
-/// The logger ran long enough: the next panic starts a new streak.
+/// The logger ran long enough: the next failure starts a new streak.
 pub fn clear_panic_streak() {
     keep_streak(0);
+}
+
+/// Marks the coming software reset as the firmware's own, after a panic
+/// or a fault (`boot::counts_towards_streak`); the count is left as it is.
+fn mark_fault_reset() {
+    // SAFETY: the hard fault handler runs with every other handler and
+    // thread mode preempted and resets right after; a single word write.
+    unsafe {
+        let words = addr_of_mut!(PANIC_STREAK).cast::<u32>();
+        words.add(2).write_volatile(FAULT_RESET_MARK);
+    }
 }
 
 /// Turns on the clock security system once the clocks run from the
@@ -270,10 +289,12 @@ unsafe fn NonMaskableInt() {
 }
 
 /// A panic (after panic-probe has printed it over defmt) or a fault ends
-/// here: reset, so the logger comes back and the next log records a
-/// software reset. With a probe attached, probe-rs halts on the fault
-/// before this runs and shows the backtrace.
+/// here: the reset is marked as a failure for the next boot's streak (a
+/// debug probe's reset is not), then the MCU resets, so the logger comes
+/// back and the next log records a software reset. With a probe attached,
+/// probe-rs halts on the fault before this runs and shows the backtrace.
 #[exception]
 unsafe fn HardFault(_frame: &ExceptionFrame) -> ! {
+    mark_fault_reset();
     cortex_m::peripheral::SCB::sys_reset()
 }

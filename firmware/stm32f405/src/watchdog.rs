@@ -19,6 +19,7 @@ use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
 use embassy_sync::blocking_mutex::Mutex;
 use embassy_time::{Instant, Timer};
 use wobble_core::boot::PANIC_STREAK_CLEAR_US;
+use wobble_core::channels::{RecordQueue, SharedStatus, QUEUE_LEN};
 use wobble_core::watchdog::{Liveness, Verdict, TIMEOUT_REQUEST_US};
 
 /// How often the task behind the writer asks.
@@ -87,8 +88,13 @@ pub fn freeze_when_halted() {
     pac::DBGMCU.apb1fzr().modify(|w| w.set_iwdg(true));
 }
 
-/// Starts the watchdog and asks for feeds behind the writer.
-pub async fn feed(iwdg: Peri<'static, IWDG>) -> ! {
+/// Starts the watchdog and asks for feeds behind the writer; once a minute
+/// logs the stack's, the record queue's and the writer's worst figures.
+pub async fn feed(
+    iwdg: Peri<'static, IWDG>,
+    queue: &'static RecordQueue,
+    shared: &'static SharedStatus,
+) -> ! {
     freeze_when_halted();
     let mut dog = IndependentWatchdog::new(iwdg, TIMEOUT_REQUEST_US as u32);
     dog.unleash();
@@ -104,10 +110,24 @@ pub async fn feed(iwdg: Peri<'static, IWDG>) -> ! {
     loop {
         prove_alive();
         // The stack's high-water mark in the log once a minute (a scan of
-        // the painted stack, well under a millisecond).
+        // the painted stack, well under a millisecond), with the queue's
+        // and the writer's worst iterations (`app::writer`).
         if asks.is_multiple_of(STACK_REPORT_ASKS) {
             let (used, size) = crate::startup::stack_use();
             defmt::info!("stack: {} of {} bytes used at most", used, size);
+            let writer = shared.writer();
+            defmt::info!(
+                "queue: high water {} of {} records, {} frames dropped and not yet in a \
+                 dropout record, {} other records dropped; writer: at most {} card operations in an iteration while logging ({} opening \
+                 a card), longest iteration {} us",
+                queue.high_water(),
+                QUEUE_LEN,
+                queue.frames_dropped_pending(),
+                queue.others_dropped(),
+                writer.ops_max,
+                writer.open_ops_max,
+                writer.busy_max_us
+            );
         }
         asks = asks.wrapping_add(1);
         if u64::from(asks) * ASK_MS * 1000 == PANIC_STREAK_CLEAR_US {

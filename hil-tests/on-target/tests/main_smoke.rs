@@ -31,9 +31,7 @@ mod tests {
     use wobble_core::app::{gps, writer};
     use wobble_core::channels::{RecordQueue, SharedStatus};
     use wobble_core::format::{Decoder, Event, Record, BLOCK_LEN};
-    use wobble_core::logger::{
-        CardLogger, FixedTime, HeaderSpec, LoggerConfig, LoggerState, Volumes,
-    };
+    use wobble_core::logger::{self, CardLogger, FixedTime, HeaderSpec, LoggerConfig, LoggerState};
     use wobble_stm32f405::adapters;
     use wobble_stm32f405::adapters::gps::GpsAdapter;
     use wobble_stm32f405::assembly::{card_and_config, header, sampler_parts, Ports};
@@ -41,7 +39,6 @@ mod tests {
     /// 5 s of frames at 100 Hz.
     const FRAMES: u32 = 500;
 
-    static QUEUE: RecordQueue = RecordQueue::new();
     static SHARED: SharedStatus = SharedStatus::new();
     static EXECUTOR_HIGH: InterruptExecutor = InterruptExecutor::new();
     static EXECUTOR_MEDIUM: InterruptExecutor = InterruptExecutor::new();
@@ -60,12 +57,12 @@ mod tests {
 
     /// The sampler for `FRAMES` frames, then the end of the ride.
     #[embassy_executor::task]
-    async fn sampler_task(mut sampler: Sampler, mut ports: Ports) {
+    async fn sampler_task(mut sampler: Sampler, mut ports: Ports, queue: &'static RecordQueue) {
         ports.imu.start().await;
         sampler::run(
             &mut sampler,
             &mut ports,
-            &QUEUE,
+            queue,
             &SHARED,
             FRAMES,
             &mut |_, _| {},
@@ -75,8 +72,8 @@ mod tests {
     }
 
     #[embassy_executor::task]
-    async fn gps_task(mut port: GpsAdapter) {
-        gps::run_link(&mut port, &QUEUE, &SHARED, &mut |_| {}).await;
+    async fn gps_task(mut port: GpsAdapter, queue: &'static RecordQueue) {
+        gps::run_link(&mut port, queue, &SHARED, &mut |_| {}).await;
     }
 
     /// What the log holds, as the decoder reads it.
@@ -141,10 +138,18 @@ mod tests {
     #[timeout(60)]
     async fn the_assembled_logger_writes_a_log_that_closes_and_decodes() {
         let (board, _) = wobble_on_target::board();
+        // The queue as main has it: in CCM (0x1000_0000-0x1000_FFFF).
+        let queue = defmt::unwrap!(wobble_stm32f405::ccm::record_queue());
+        let at = core::ptr::from_ref(queue) as usize;
+        defmt::assert!(
+            (0x1000_0000..0x1001_0000).contains(&at),
+            "queue at {=usize:x}",
+            at
+        );
         let (card, loaded) = card_and_config(board.card);
         let config = loaded.config;
         for fault in loaded.faults.records(Instant::now().as_micros()) {
-            QUEUE.push(Record::Fault(fault));
+            queue.push(Record::Fault(fault));
         }
         let spec = header(&config);
         let mut logger = CardLogger::new(card, FixedTime::EPOCH, spec, LoggerConfig::DEFAULT);
@@ -158,20 +163,30 @@ mod tests {
 
         interrupt::UART4.set_priority(Priority::P6);
         let high = EXECUTOR_HIGH.start(interrupt::UART4);
-        high.spawn(defmt::unwrap!(sampler_task(sampler, ports)));
+        high.spawn(defmt::unwrap!(sampler_task(sampler, ports, queue)));
         interrupt::UART5.set_priority(Priority::P7);
         let medium = EXECUTOR_MEDIUM.start(interrupt::UART5);
-        medium.spawn(defmt::unwrap!(gps_task(GpsAdapter::new(board.gps))));
+        medium.spawn(defmt::unwrap!(gps_task(GpsAdapter::new(board.gps), queue)));
 
         // Returns once the sampler has asked it to stop and the log is closed.
-        defmt::unwrap!(writer::run(&mut logger, &QUEUE, &SHARED).await);
+        defmt::unwrap!(writer::run(&mut logger, queue, &SHARED).await);
         let stats = logger.stats();
         defmt::info!("run {}: {}", run, stats);
         defmt::assert_eq!(stats.files_opened, 1);
         defmt::assert_eq!(stats.frames_lost, 0);
         defmt::assert_eq!(stats.frames_on_card, FRAMES);
+        // The writer counted its card operations: a real card's worst
+        // iteration within the queue's sizing.
+        let figures = SHARED.writer();
+        defmt::info!(
+            "writer: {}, queue high water {}",
+            figures,
+            queue.high_water()
+        );
+        defmt::assert!(figures.ops_max >= 1);
+        defmt::assert!(figures.ops_max <= wobble_core::channels::WRITER_OPS_PER_ITERATION);
 
-        let volumes = Volumes::new_with_limits(logger.into_device(), FixedTime::EPOCH, 0);
+        let volumes = logger::volumes(logger.into_device(), FixedTime::EPOCH);
         let volume = defmt::unwrap!(volumes.open_volume(VolumeIdx(0)).ok());
         let root = defmt::unwrap!(volume.open_root_dir().ok());
         let mut name: heapless::String<12> = heapless::String::new();

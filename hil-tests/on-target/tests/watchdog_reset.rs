@@ -14,6 +14,7 @@ mod tests {
     use embassy_stm32::pac;
     use embassy_time::{Duration, Instant, Timer};
     use wobble_core::boot::ResetCause;
+    use wobble_core::channels::SharedStatus;
     use wobble_core::watchdog::TIMEOUT_REQUEST_US;
     use wobble_stm32f405::{startup, watchdog};
 
@@ -42,6 +43,9 @@ mod tests {
     #[test]
     async fn a_fed_watchdog_lets_the_chip_run_past_its_timeout() {
         let (board, _) = wobble_on_target::board();
+        // The feeder logs the queue's figures with the stack's once a minute.
+        static SHARED: SharedStatus = SharedStatus::new();
+        let queue = defmt::unwrap!(wobble_stm32f405::ccm::record_queue());
         let run_for = Duration::from_micros(3 * TIMEOUT_REQUEST_US);
         let start = Instant::now();
         let heartbeats = async {
@@ -52,7 +56,7 @@ mod tests {
             }
         };
         // A reset here fails the test: probe-rs loses the running test.
-        match select(watchdog::feed(board.watchdog), heartbeats).await {
+        match select(watchdog::feed(board.watchdog, queue, &SHARED), heartbeats).await {
             Either::First(never) => match never {},
             Either::Second(()) => {}
         }

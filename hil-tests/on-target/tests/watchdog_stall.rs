@@ -86,6 +86,7 @@ fn after_the_reset() {
 mod tests {
     use embassy_futures::select::{select, Either};
     use embassy_time::{Duration, Instant, Timer};
+    use wobble_core::channels::SharedStatus;
     use wobble_core::watchdog::TIMEOUT_REQUEST_US;
     use wobble_stm32f405::watchdog;
 
@@ -105,6 +106,9 @@ mod tests {
     #[timeout(40)]
     async fn a_stalled_task_makes_the_watchdog_reset_the_chip() {
         let (board, _) = wobble_on_target::board();
+        // The feeder logs the queue's figures with the stack's once a minute.
+        static SHARED: SharedStatus = SharedStatus::new();
+        let queue = defmt::unwrap!(wobble_stm32f405::ccm::record_queue());
         // SAFETY: clearing the reset vector catch only changes what a
         // debugger does at the next reset (module docs).
         unsafe {
@@ -138,7 +142,7 @@ mod tests {
                 Timer::after_millis(10).await;
             }
         };
-        match select(watchdog::feed(board.watchdog), heartbeats).await {
+        match select(watchdog::feed(board.watchdog, queue, &SHARED), heartbeats).await {
             Either::First(never) => match never {},
             Either::Second(()) => {}
         }

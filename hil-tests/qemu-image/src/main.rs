@@ -188,6 +188,12 @@ async fn writer_task(card: SemihostingCard, config: &'static Config) {
         st.files_opened,
         closed.is_ok(),
     ));
+    // A line of its own: the END line is near the report's 256 characters.
+    let w = SHARED.writer();
+    report::line(format_args!(
+        "WRITER ops_max={} open_ops_max={} busy_max_us={}",
+        w.ops_max, w.open_ops_max, w.busy_max_us
+    ));
     semihosting::process::exit(0)
 }
 

@@ -1,13 +1,20 @@
 //! The SD writer task: drains the record queue into the card logger, in
 //! thread mode, where embedded-sdmmc's blocking writes may take as long as
 //! the card likes while the sampler preempts it.
+//!
+//! One iteration is a [`CardLogger::poll`] (a flush when one is due, an
+//! attempt to open a card without one) and the push of one record (which
+//! writes a block when it closes one). The card operations of each
+//! iteration and its busy time are counted ([`SharedStatus::writer`]): the
+//! queue is sized for the worst iteration (`channels`), and the figures
+//! show how close a card came to it.
 
 use embassy_futures::select::{select, Either};
 use embassy_time::{Instant, Timer};
 use embedded_sdmmc::{BlockDevice, TimeSource};
 
 use crate::channels::{RecordQueue, SharedStatus};
-use crate::logger::{CardLogger, CloseError};
+use crate::logger::{CardLogger, CloseError, LoggerState};
 
 /// Longest wait for a record before the logger is polled anyway (flushes
 /// and card retries happen even if the producers go quiet).
@@ -25,14 +32,24 @@ pub async fn run<D: BlockDevice, T: TimeSource>(
     shared: &SharedStatus,
 ) -> Result<(), CloseError> {
     loop {
+        let logging = matches!(logger.state(), LoggerState::Logging { .. });
+        let ops_before = logger.card_ops();
         // Polled before the first record too: the card is opened at boot,
         // while the queue holds what the sampler makes meanwhile.
-        logger.poll(Instant::now().as_micros());
+        let start = Instant::now().as_micros();
+        logger.poll(start);
+        let mut busy_us = Instant::now().as_micros().saturating_sub(start);
         shared.set_card(logger.state().into());
         let next = select(queue.pop(), Timer::after_millis(IDLE_POLL_MS)).await;
         if let Either::First(rec) = next {
-            logger.push(&rec, Instant::now().as_micros());
+            let start = Instant::now().as_micros();
+            logger.push(&rec, start);
+            busy_us += Instant::now().as_micros().saturating_sub(start);
         }
+        let ops = logger.card_ops().since(ops_before).total();
+        // An iteration that opened the card (or tried to) is not one of
+        // the ride's: it is counted apart (`SharedStatus::writer`).
+        shared.note_writer_iteration(logging, ops, busy_us);
         if shared.stop_requested() && queue.is_empty() {
             return logger.close(Instant::now().as_micros());
         }

@@ -30,6 +30,7 @@
 
 #[cfg(feature = "mock")]
 pub mod mock;
+pub mod ops;
 
 use core::ops::ControlFlow;
 
@@ -38,6 +39,7 @@ use embedded_sdmmc::{
     TimeSource, VolumeIdx, VolumeManager,
 };
 
+pub use self::ops::{CardOps, CountingDevice};
 use crate::format::header::header_records;
 use crate::format::{
     Block, BlockEncoder, Dropout, DropoutReason, Fault, FaultSource, LogInfo, Record, BLOCK_LEN,
@@ -188,10 +190,16 @@ pub enum CloseError {
 }
 
 /// The card's file system with room for one volume, directory and file
-/// open at a time: all the logger needs. The board reads `CONFIG.TXT` and
-/// runs the self-test through the same type, so the firmware holds one
-/// copy of embedded-sdmmc's code, not one per set of limits.
-pub type Volumes<D, T> = VolumeManager<D, T, 1, 1, 1>;
+/// open at a time: all the logger needs, over a device that counts its
+/// operations ([`ops`]). The board reads `CONFIG.TXT` and runs the
+/// self-test through the same type, so the firmware holds one copy of
+/// embedded-sdmmc's code, not one per set of limits or device.
+pub type Volumes<D, T> = VolumeManager<CountingDevice<D>, T, 1, 1, 1>;
+
+/// The file system over `device`, its operations counted from zero.
+pub fn volumes<D: BlockDevice, T: TimeSource>(device: D, time: T) -> Volumes<D, T> {
+    VolumeManager::new_with_limits(CountingDevice::new(device), time, 0)
+}
 
 /// The logger (see the module docs).
 pub struct CardLogger<'a, D: BlockDevice, T: TimeSource> {
@@ -244,7 +252,7 @@ impl<'a, D: BlockDevice, T: TimeSource> CardLogger<'a, D, T> {
     /// A logger that will open the card at the first [`Self::poll`].
     pub fn new(device: D, time: T, header: HeaderSpec<'a>, config: LoggerConfig) -> Self {
         Self {
-            fs: Volumes::new_with_limits(device, time, 0),
+            fs: volumes(device, time),
             header,
             config,
             encoder: BlockEncoder::new(),
@@ -278,13 +286,20 @@ impl<'a, D: BlockDevice, T: TimeSource> CardLogger<'a, D, T> {
 
     /// Runs `f` on the block device (the tests' fault injection uses this).
     pub fn with_device<R>(&self, f: impl FnOnce(&mut D) -> R) -> R {
-        self.fs.device(f)
+        self.fs.device(|d| f(d.inner_mut()))
     }
 
     /// The block device back, for a new file system on the same card once
     /// the log is closed (the on-target smoke test reads its log this way).
     pub fn into_device(self) -> D {
-        self.fs.free().0
+        self.fs.free().0.into_inner()
+    }
+
+    /// Card operations since boot (every read, write and size query,
+    /// whether it succeeded or not): the writer counts them per iteration
+    /// (`app::writer`).
+    pub fn card_ops(&self) -> CardOps {
+        self.fs.device(|d| d.ops())
     }
 
     /// Logs one record at local time `now_us`. Without a card, frames are
@@ -555,7 +570,7 @@ impl<'a, D: BlockDevice, T: TimeSource> CardLogger<'a, D, T> {
 
 /// Writes one whole block at its offset in the file.
 fn write_block<D: BlockDevice, T: TimeSource>(
-    fs: &VolumeManager<D, T, 1, 1, 1>,
+    fs: &Volumes<D, T>,
     file: RawFile,
     seq: u32,
     block: &Block,
@@ -570,7 +585,7 @@ fn write_block<D: BlockDevice, T: TimeSource>(
 /// The run number after the highest `RUNnnnnn.WBL` in `dir` (1 on an empty
 /// card).
 fn next_run<D: BlockDevice, T: TimeSource>(
-    fs: &VolumeManager<D, T, 1, 1, 1>,
+    fs: &Volumes<D, T>,
     dir: RawDirectory,
 ) -> Result<u32, FsError<D::Error>> {
     let mut highest = 0;

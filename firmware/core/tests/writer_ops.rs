@@ -1,0 +1,208 @@
+//! The writer's card operations per iteration (`app::writer`), counted by
+//! the logger's counting device (`logger::ops`) on FAT32 cards: the queue
+//! is sized for the worst iteration (`channels::WRITER_OPS_PER_ITERATION`),
+//! so no iteration of a long ride may make more, whatever the cluster size.
+
+use core::future::Future;
+use core::pin::pin;
+use core::task::{Context, Poll, Waker};
+
+use embassy_time::{Duration, MockDriver};
+use wobble_core::app::writer;
+use wobble_core::channels::{
+    iteration_stall_us, RecordQueue, SharedStatus, WORST_ITERATION_OPS, WORST_ITERATION_US,
+    WRITER_OPS_PER_ITERATION,
+};
+use wobble_core::format::{Frame, FrameStatus, GpsFix, Record};
+use wobble_core::logger::mock::MockCard;
+use wobble_core::logger::{CardLogger, CardOps, FixedTime, HeaderSpec, LoggerConfig, LoggerState};
+
+const CARD_BYTES: u64 = 40 << 20;
+const FRAME_PERIOD_US: u64 = 10_000;
+const CONFIG: [&str; 1] = ["sample_rate_hz=100"];
+
+fn header() -> HeaderSpec<'static> {
+    HeaderSpec {
+        firmware: "test",
+        device_id: [7; 12],
+        sample_rate_hz: 100,
+        config: &CONFIG,
+    }
+}
+
+/// A card image: an MBR with one FAT32 partition at block 1, formatted
+/// with `cluster` bytes per cluster.
+fn fat32_image(cluster: u32) -> Vec<u8> {
+    let mut image = vec![0u8; CARD_BYTES as usize];
+    let blocks = (CARD_BYTES / 512 - 1) as u32;
+    let opts = fatfs::FormatVolumeOptions::new()
+        .fat_type(fatfs::FatType::Fat32)
+        .bytes_per_cluster(cluster);
+    fatfs::format_volume(std::io::Cursor::new(&mut image[512..]), opts).expect("format");
+    let entry = &mut image[446..462];
+    entry[4] = 0x0C;
+    entry[8..12].copy_from_slice(&1u32.to_le_bytes());
+    entry[12..16].copy_from_slice(&blocks.to_le_bytes());
+    image[510] = 0x55;
+    image[511] = 0xAA;
+    image
+}
+
+fn frame(i: u64) -> Record<'static> {
+    Record::Frame(Frame {
+        t_us: i * FRAME_PERIOD_US,
+        accel: [i as i16, (i % 1000) as i16 - 500, 2048],
+        gyro: [(i % 97) as i16, 2, 3],
+        steer_cdeg: (i % 300) as i16,
+        wheel_count: i as u16,
+        wheel_edge_age_us: 100,
+        speed_mm_s: 4000,
+        status: FrameStatus(0),
+    })
+}
+
+fn fix(i: u64) -> Record<'static> {
+    Record::Gps(GpsFix {
+        t_us: i * FRAME_PERIOD_US,
+        lat_e7: Some(520_000_000 + i as i32),
+        lon_e7: Some(43_000_000 - i as i32),
+        ..GpsFix::default()
+    })
+}
+
+/// The records of `frames` frames at 100 Hz with a 20 Hz GPS: what the
+/// writer drains.
+fn ride(frames: u64) -> impl Iterator<Item = (u64, Record<'static>)> {
+    (0..frames).flat_map(|i| {
+        let t = i * FRAME_PERIOD_US;
+        let gps = (i % 5 == 0).then(|| (t, fix(i)));
+        core::iter::once((t, frame(i))).chain(gps)
+    })
+}
+
+/// Card operations of each writer iteration (a poll, then one record's
+/// push, as `writer::run` does) while a file is open.
+fn iterations(cluster: u32, frames: u64) -> Vec<CardOps> {
+    let mut log = CardLogger::new(
+        MockCard::new(fat32_image(cluster)),
+        FixedTime::EPOCH,
+        header(),
+        LoggerConfig::DEFAULT,
+    );
+    let mut out = Vec::new();
+    for (t, rec) in ride(frames) {
+        let logging = matches!(log.state(), LoggerState::Logging { .. });
+        let before = log.card_ops();
+        log.poll(t);
+        log.push(&rec, t);
+        if logging {
+            out.push(log.card_ops().since(before));
+        }
+    }
+    assert_eq!(log.state(), LoggerState::Logging { run: 1 });
+    assert_eq!(log.stats().frames_lost, 0);
+    out
+}
+
+/// FAT32 cards with clusters of one block (a FAT update at every block
+/// written) to 4 KiB: no iteration makes more operations, or takes longer
+/// by the SD specification's limits, than the queue is sized for, and the
+/// worst iterations are exactly that (the sizing is not loose either).
+/// Larger clusters need a card image too large for a test (65 525
+/// clusters at least); they allocate less often and cost less.
+#[test]
+fn no_writer_iteration_exceeds_the_queue_sizing() {
+    let (mut most_ops, mut slowest) = (0, CardOps::default());
+    for cluster in [512, 1024, 4096] {
+        // Ten minutes of ride: thousands of blocks, 1200 flushes.
+        let its = iterations(cluster, 60_000);
+        let worst = its.iter().map(|o| o.total()).max().unwrap_or(0);
+        let slow = its
+            .iter()
+            .copied()
+            .max_by_key(|&o| iteration_stall_us(o))
+            .unwrap_or_default();
+        let busy = its.iter().filter(|o| o.total() > 0).count();
+        println!(
+            "cluster {cluster} B: {} iterations, {busy} with card operations, at most {worst} \
+             operations in one; slowest by the specification {slow:?}: {} ms",
+            its.len(),
+            iteration_stall_us(slow) / 1000
+        );
+        assert!(
+            worst <= WRITER_OPS_PER_ITERATION,
+            "cluster {cluster}: an iteration made {worst} card operations"
+        );
+        assert!(
+            iteration_stall_us(slow) <= WORST_ITERATION_US,
+            "cluster {cluster}: {slow:?}"
+        );
+        // Most iterations only encode: a block closes every dozen records.
+        assert!(busy * 4 < its.len());
+        most_ops = most_ops.max(worst);
+        if iteration_stall_us(slow) > iteration_stall_us(slowest) {
+            slowest = slow;
+        }
+    }
+    assert_eq!(most_ops, WRITER_OPS_PER_ITERATION);
+    assert_eq!(slowest, WORST_ITERATION_OPS);
+}
+
+/// Polls `future` to its end, advancing the mock clock by 1 ms whenever it
+/// waits (the writer's idle timer).
+fn drive<F: Future>(future: F) -> F::Output {
+    let mut future = pin!(future);
+    let mut cx = Context::from_waker(Waker::noop());
+    loop {
+        if let Poll::Ready(out) = future.as_mut().poll(&mut cx) {
+            return out;
+        }
+        MockDriver::get().advance(Duration::from_millis(1));
+    }
+}
+
+/// The real writer loop counts its iterations' operations into the shared
+/// status: the boot's opening of the card apart from the ride's iterations,
+/// which stay within the sizing.
+#[test]
+fn the_writer_task_reports_its_worst_iterations() {
+    let queue = RecordQueue::new();
+    let shared = SharedStatus::new();
+    let mut log = CardLogger::new(
+        MockCard::new(fat32_image(512)),
+        FixedTime::EPOCH,
+        header(),
+        LoggerConfig::DEFAULT,
+    );
+    let mut records = ride(3_000).map(|(_, r)| r).peekable();
+    let producer = async {
+        // 300 records at a time, the mock clock moving 10 ms per frame.
+        while records.peek().is_some() {
+            for rec in records.by_ref().take(300) {
+                if matches!(rec, Record::Frame(_)) {
+                    MockDriver::get().advance(Duration::from_micros(FRAME_PERIOD_US));
+                }
+                assert!(queue.push(rec));
+            }
+            while !queue.is_empty() {
+                embassy_futures::yield_now().await;
+            }
+        }
+        shared.request_stop();
+    };
+    let (closed, ()) = drive(embassy_futures::join::join(
+        writer::run(&mut log, &queue, &shared),
+        producer,
+    ));
+    closed.expect("closed");
+    let figures = shared.writer();
+    println!("{figures:?}");
+    // Opening: the MBR, boot sector, FSInfo, the root directory's search
+    // for the next run number, the file's creation, the header and a flush.
+    assert!(figures.open_ops_max > figures.ops_max);
+    // At least one flush with a block to write, and never past the sizing.
+    assert!(figures.ops_max >= 5);
+    assert!(figures.ops_max <= WRITER_OPS_PER_ITERATION);
+    assert_eq!(log.stats().frames_lost, 0);
+    assert_eq!(log.stats().frames_on_card, 3_000);
+}
