@@ -1,13 +1,14 @@
 //! A log's frames as a [`Table`]: the rows `wobblog decode` writes, in its
 //! columns and time window, decoded without the GIL.
 
+use std::ops::ControlFlow;
 use std::path::Path;
 
 use pyo3::prelude::*;
-use wobble_core::format::{Event, Record};
+use wobble_core::format::{DecodeStats, Event, Record};
 use wobblog::export::columns::Column;
 use wobblog::losses::Losses;
-use wobblog::reader::read_log_try;
+use wobblog::reader::read_log_until;
 use wobblog::rows::{Row, RowAssembler};
 use wobblog::time::TimeWindow;
 use wobblog::CliError;
@@ -16,16 +17,34 @@ use crate::stream::Table;
 use crate::table::TableBuilder;
 
 /// Decoder events between two looks for a pending `KeyboardInterrupt`.
-const EVENTS_PER_SIGNAL_CHECK: u32 = 1 << 16;
+const EVENTS_PER_SIGNAL_CHECK: u32 = 1 << 14;
 
-/// The rows of the log at `path` inside `window`, in `columns`, and what
-/// the log lost. Called without the GIL; it is taken briefly now and then
-/// to see whether Ctrl-C was pressed, which ends the decoding with
+/// What one pass over a log gave.
+pub struct Decoded {
+    /// The rows inside the window.
+    pub table: Table,
+    /// The decoder's totals.
+    pub stats: DecodeStats,
+    /// First and last boot time of every row (inside the window or not), s.
+    pub span_s: Option<(f64, f64)>,
+    /// The log has a UTC sync pair.
+    pub has_utc: bool,
+}
+
+/// Decodes the log at `path` once: its rows inside `window`, in `columns`,
+/// and every decoder event passed to `observe` as well (a summary, the
+/// losses). Called without the GIL; it is taken briefly now and then to see
+/// whether Ctrl-C was pressed, which ends the decoding with
 /// `KeyboardInterrupt`.
-pub fn decode(path: &Path, columns: Vec<Column>, window: TimeWindow) -> PyResult<(Table, Losses)> {
+pub fn walk(
+    path: &Path,
+    columns: &[Column],
+    window: TimeWindow,
+    mut observe: impl FnMut(&Event<'_>),
+) -> PyResult<Decoded> {
     let fail = |e: CliError| crate::errors::to_py(e);
     window.check_order(path).map_err(fail)?;
-    let mut table = TableBuilder::new(columns);
+    let mut table = TableBuilder::frames(columns);
     let mut kept = 0u64;
     let mut span_s: Option<(f64, f64)> = None;
     let mut has_utc = false;
@@ -43,22 +62,28 @@ pub fn decode(path: &Path, columns: Vec<Column>, window: TimeWindow) -> PyResult
         }
     };
     let mut rows = RowAssembler::new();
-    let mut losses = Losses::default();
     let mut events = 0u32;
-    let walked = read_log_try(path, |event| {
-        losses.observe(&event);
+    let mut interrupted = None;
+    // The reader's usual chunks from the start (the first is clamped to them).
+    let stats = read_log_until(path, usize::MAX, |event| {
+        observe(&event);
         if let Event::Record(record) = event {
             has_utc |= matches!(record, Record::UtcSync(_));
             rows.push(&record, &mut keep);
         }
         events = events.wrapping_add(1);
         if events.is_multiple_of(EVENTS_PER_SIGNAL_CHECK) {
-            Python::attach(|py| py.check_signals())?;
+            if let Err(e) = Python::attach(|py| py.check_signals()) {
+                interrupted = Some(e);
+                return ControlFlow::Break(());
+            }
         }
-        Ok::<(), PyErr>(())
+        ControlFlow::Continue(())
     })
     .map_err(fail)?;
-    walked?;
+    if let Some(e) = interrupted {
+        return Err(e);
+    }
     rows.finish(&mut keep);
     if let Some(e) = failure {
         return Err(arrow_error(path, &e));
@@ -69,10 +94,23 @@ pub fn decode(path: &Path, columns: Vec<Column>, window: TimeWindow) -> PyResult
         ));
     }
     let (schema, batches) = table.finish().map_err(|e| arrow_error(path, &e))?;
-    Ok((Table::new(schema, batches), losses))
+    Ok(Decoded {
+        table: Table::new(schema, batches),
+        stats,
+        span_s,
+        has_utc,
+    })
 }
 
-fn arrow_error(path: &Path, e: &arrow_schema::ArrowError) -> PyErr {
+/// The rows of the log at `path` inside `window`, in `columns`, and what
+/// the log lost (see [`walk`]).
+pub fn decode(path: &Path, columns: &[Column], window: TimeWindow) -> PyResult<(Table, Losses)> {
+    let mut losses = Losses::default();
+    let decoded = walk(path, columns, window, |event| losses.observe(event))?;
+    Ok((decoded.table, losses))
+}
+
+pub fn arrow_error(path: &Path, e: &arrow_schema::ArrowError) -> PyErr {
     crate::errors::to_py(CliError::file(
         path,
         format!("cannot build the Arrow table: {e}"),
