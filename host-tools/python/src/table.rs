@@ -10,7 +10,7 @@ use arrow_array::{
     ArrayRef, BooleanArray, Float64Array, Int64Array, RecordBatch, StringArray,
     TimestampMicrosecondArray,
 };
-use arrow_buffer::NullBuffer;
+use arrow_buffer::{NullBuffer, OffsetBuffer};
 use arrow_schema::{ArrowError, DataType, Field, Schema, SchemaRef, TimeUnit};
 use wobblog::export::columnar::{buffers, row_buffers, ColumnBuffers, Values};
 use wobblog::export::columns::{Column, Kind};
@@ -52,7 +52,7 @@ fn array(values: Values) -> ArrayRef {
     match values {
         Values::Number(v) => Arc::new(Float64Array::new(v.into(), None)),
         Values::OptNumber(v, present) => Arc::new(Float64Array::new(v.into(), nulls(present))),
-        Values::Label(v) => Arc::new(StringArray::from(v)),
+        Values::Label(v) => Arc::new(labels(&v)),
         Values::Text(v) => Arc::new(StringArray::from(v)),
         Values::Utc(v, present) => {
             Arc::new(TimestampMicrosecondArray::new(v.into(), nulls(present)).with_timezone("UTC"))
@@ -60,6 +60,20 @@ fn array(values: Values) -> ArrayRef {
         Values::Integer(v, present) => Arc::new(Int64Array::new(v.into(), nulls(present))),
         Values::Bool(v, present) => Arc::new(BooleanArray::new(v.into(), nulls(present))),
     }
+}
+
+/// Names from a small set (a few bytes each) as a string array, laid out
+/// in one pass.
+fn labels(values: &[Option<&str>]) -> StringArray {
+    let mut bytes = Vec::with_capacity(4 * values.len());
+    let offsets = OffsetBuffer::from_lengths(values.iter().map(|v| {
+        let s = v.unwrap_or_default();
+        bytes.extend_from_slice(s.as_bytes());
+        s.len()
+    }));
+    let nulls = NullBuffer::from_iter(values.iter().map(Option::is_some));
+    let nulls = (nulls.null_count() > 0).then_some(nulls);
+    StringArray::new(offsets, bytes.into(), nulls)
 }
 
 /// Rows of `R` turned into record batches of [`BATCH_ROWS`] rows.
