@@ -126,8 +126,9 @@ pub trait ColumnBuffers<R>: Send {
     fn take(&mut self) -> Vec<Values>;
 }
 
-/// The buffers for a table of `columns`: [`RowColumns`] for decoded frames
-/// (see [`row_buffers`]), else [`ValueColumns`].
+/// The buffers for a table of `columns` of any row type, with room for
+/// `rows` rows per batch: [`ValueColumns`] (decoded frames have
+/// [`row_buffers`]).
 #[must_use]
 pub fn buffers<R: 'static>(columns: &[Column<R>], rows: usize) -> Box<dyn ColumnBuffers<R>> {
     Box::new(ValueColumns::new(columns, rows))
@@ -454,10 +455,9 @@ mod tests {
             kind: Kind::Utc,
             value: |r| Value::Number(*r),
         }];
-        assert!(buffers_of(&wrong).push(&Some(1.0)).is_err());
-    }
-
-    fn buffers_of(columns: &[Column<Option<f64>>]) -> ValueColumns<Option<f64>> {
-        ValueColumns::new(columns, 1)
+        assert_eq!(
+            ValueColumns::new(&wrong, 1).push(&Some(1.0)).unwrap_err(),
+            "y: value of the wrong type"
+        );
     }
 }
