@@ -325,7 +325,7 @@ fn episodes_columns() -> Vec<Column<EpisodesRow>> {
 }
 
 /// Writes `rows` as the one file of the table folder `dir`.
-fn write_table<R>(dir: &Path, columns: &[Column<R>], rows: &[R]) -> Result<(), CliError> {
+fn write_table<R: 'static>(dir: &Path, columns: &[Column<R>], rows: &[R]) -> Result<(), CliError> {
     std::fs::create_dir_all(dir).map_err(|e| CliError::file(dir, e))?;
     let path = dir.join("part-0.parquet");
     let mut out = Output::create(&path, &[])?;

@@ -1,13 +1,14 @@
 //! A log's frames as a [`Table`]: the rows `wobblog decode` writes, in its
 //! columns and time window, decoded without the GIL.
 
+use std::ops::ControlFlow;
 use std::path::Path;
 
 use pyo3::prelude::*;
-use wobble_core::format::{Event, Record};
+use wobble_core::format::{DecodeStats, Event, Record};
 use wobblog::export::columns::Column;
 use wobblog::losses::Losses;
-use wobblog::reader::read_log_try;
+use wobblog::reader::read_log_until;
 use wobblog::rows::{Row, RowAssembler};
 use wobblog::time::TimeWindow;
 use wobblog::CliError;
@@ -15,51 +16,157 @@ use wobblog::CliError;
 use crate::stream::Table;
 use crate::table::TableBuilder;
 
-/// Decoder events between two looks for a pending `KeyboardInterrupt`.
-const EVENTS_PER_SIGNAL_CHECK: u32 = 1 << 16;
+/// Records between two looks for a pending `KeyboardInterrupt`.
+const RECORDS_PER_SIGNAL_CHECK: usize = 1 << 14;
 
-/// The rows of the log at `path` inside `window`, in `columns`, and what
-/// the log lost. Called without the GIL; it is taken briefly now and then
-/// to see whether Ctrl-C was pressed, which ends the decoding with
-/// `KeyboardInterrupt`.
-pub fn decode(path: &Path, columns: Vec<Column>, window: TimeWindow) -> PyResult<(Table, Losses)> {
-    let fail = |e: CliError| crate::errors::to_py(e);
-    window.check_order(path).map_err(fail)?;
-    let mut table = TableBuilder::new(columns);
-    let mut kept = 0u64;
-    let mut span_s: Option<(f64, f64)> = None;
-    let mut has_utc = false;
-    let mut failure: Option<arrow_schema::ArrowError> = None;
+/// What one pass over a log gave.
+pub struct Decoded {
+    /// The rows inside the window.
+    pub table: Table,
+    /// The decoder's totals.
+    pub stats: DecodeStats,
+    /// First and last boot time of every row (inside the window or not), s.
+    pub span_s: Option<(f64, f64)>,
+    /// The log has a UTC sync pair.
+    pub has_utc: bool,
+}
+
+/// Records handed from the decoding thread to the one building the
+/// columns at a time.
+const RECORDS_PER_HANDOVER: usize = 1024;
+
+/// What the thread building the columns gives back.
+struct Built {
+    table: TableBuilder<Row>,
+    kept: u64,
+    span_s: Option<(f64, f64)>,
+    failure: Option<arrow_schema::ArrowError>,
+    /// Ctrl-C, which stopped the building (and so the decoding).
+    interrupted: Option<PyErr>,
+}
+
+/// The records the rows are made of (frames, fixes, sync pairs; see
+/// [`RowAssembler::push`]), owned, so they can go to another thread.
+fn row_record(record: &Record<'_>) -> Option<Record<'static>> {
+    match *record {
+        Record::Frame(f) => Some(Record::Frame(f)),
+        Record::Gps(g) => Some(Record::Gps(g)),
+        Record::UtcSync(s) => Some(Record::UtcSync(s)),
+        _ => None,
+    }
+}
+
+/// Turns records into rows, and the rows inside `window` into columns.
+fn build(
+    records: std::sync::mpsc::Receiver<Vec<Record<'static>>>,
+    columns: &[Column],
+    window: TimeWindow,
+) -> Built {
+    let mut built = Built {
+        table: TableBuilder::frames(columns),
+        kept: 0,
+        span_s: None,
+        failure: None,
+        interrupted: None,
+    };
     let mut keep = |row: &Row| {
-        span_s = Some(span_s.map_or((row.t_s, row.t_s), |(a, b)| {
+        built.span_s = Some(built.span_s.map_or((row.t_s, row.t_s), |(a, b)| {
             (a.min(row.t_s), b.max(row.t_s))
         }));
         // As `wobblog decode`: a row is in when its boot time or UTC (ms) is.
         if window.is_all() || window.contains(row.t_s, row.utc_us.map(|u| u / 1000)) {
-            kept += 1;
-            if failure.is_none() {
-                failure = table.push(row).err();
+            built.kept += 1;
+            if built.failure.is_none() {
+                built.failure = built.table.push(row).err();
             }
         }
     };
     let mut rows = RowAssembler::new();
-    let mut losses = Losses::default();
-    let mut events = 0u32;
-    let walked = read_log_try(path, |event| {
-        losses.observe(&event);
-        if let Event::Record(record) = event {
-            has_utc |= matches!(record, Record::UtcSync(_));
-            rows.push(&record, &mut keep);
+    let mut since_check = 0;
+    for batch in &records {
+        for record in &batch {
+            rows.push(record, &mut keep);
         }
-        events = events.wrapping_add(1);
-        if events.is_multiple_of(EVENTS_PER_SIGNAL_CHECK) {
-            Python::attach(|py| py.check_signals())?;
+        // Python runs signal handlers on its main thread only: the one that
+        // called, this one.
+        since_check += batch.len();
+        if since_check >= RECORDS_PER_SIGNAL_CHECK {
+            since_check = 0;
+            if let Err(e) = Python::attach(|py| py.check_signals()) {
+                // Dropping the receiver stops the decoding.
+                built.interrupted = Some(e);
+                return built;
+            }
         }
-        Ok::<(), PyErr>(())
-    })
-    .map_err(fail)?;
-    walked?;
+    }
     rows.finish(&mut keep);
+    built
+}
+
+/// Decodes the log at `path` once: its rows inside `window`, in `columns`,
+/// and every decoder event passed to `observe` as well (a summary, the
+/// losses). The log is decoded on a second thread while this one builds
+/// the rows and their columns. Called without the GIL; it is taken briefly now and
+/// then to see whether Ctrl-C was pressed, which ends the decoding with
+/// `KeyboardInterrupt`.
+pub fn walk(
+    path: &Path,
+    columns: &[Column],
+    window: TimeWindow,
+    mut observe: impl FnMut(&Event<'_>) + Send,
+) -> PyResult<Decoded> {
+    let fail = |e: CliError| crate::errors::to_py(e);
+    window.check_order(path).map_err(fail)?;
+    let (walked, has_utc, built) = std::thread::scope(|scope| {
+        let (send, records) = std::sync::mpsc::sync_channel(8);
+        let decoder = scope.spawn(move || {
+            let mut has_utc = false;
+            let mut batch = Vec::with_capacity(RECORDS_PER_HANDOVER);
+            // The reader's usual chunks from the start (the first is clamped
+            // to them).
+            let walked = read_log_until(path, usize::MAX, |event| {
+                observe(&event);
+                if let Event::Record(record) = &event {
+                    has_utc |= matches!(record, Record::UtcSync(_));
+                    if let Some(owned) = row_record(record) {
+                        batch.push(owned);
+                        if batch.len() == RECORDS_PER_HANDOVER {
+                            let full = std::mem::replace(
+                                &mut batch,
+                                Vec::with_capacity(RECORDS_PER_HANDOVER),
+                            );
+                            if send.send(full).is_err() {
+                                // The builder stopped (Ctrl-C).
+                                return ControlFlow::Break(());
+                            }
+                        }
+                    }
+                }
+                ControlFlow::Continue(())
+            });
+            let _ = send.send(batch);
+            (walked, has_utc)
+        });
+        // The rows are built on this thread, the caller's, where Python
+        // looks for Ctrl-C.
+        let built = build(records, columns, window);
+        let (walked, has_utc) = match decoder.join() {
+            Ok(done) => done,
+            Err(panic) => std::panic::resume_unwind(panic),
+        };
+        (walked, has_utc, built)
+    });
+    let Built {
+        table,
+        kept,
+        span_s,
+        failure,
+        interrupted,
+    } = built;
+    if let Some(e) = interrupted {
+        return Err(e);
+    }
+    let stats = walked.map_err(fail)?;
     if let Some(e) = failure {
         return Err(arrow_error(path, &e));
     }
@@ -69,10 +176,23 @@ pub fn decode(path: &Path, columns: Vec<Column>, window: TimeWindow) -> PyResult
         ));
     }
     let (schema, batches) = table.finish().map_err(|e| arrow_error(path, &e))?;
-    Ok((Table::new(schema, batches), losses))
+    Ok(Decoded {
+        table: Table::new(schema, batches),
+        stats,
+        span_s,
+        has_utc,
+    })
 }
 
-fn arrow_error(path: &Path, e: &arrow_schema::ArrowError) -> PyErr {
+/// The rows of the log at `path` inside `window`, in `columns`, and what
+/// the log lost (see [`walk`]).
+pub fn decode(path: &Path, columns: &[Column], window: TimeWindow) -> PyResult<(Table, Losses)> {
+    let mut losses = Losses::default();
+    let decoded = walk(path, columns, window, |event| losses.observe(event))?;
+    Ok((decoded.table, losses))
+}
+
+pub fn arrow_error(path: &Path, e: &arrow_schema::ArrowError) -> PyErr {
     crate::errors::to_py(CliError::file(
         path,
         format!("cannot build the Arrow table: {e}"),

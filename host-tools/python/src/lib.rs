@@ -18,8 +18,9 @@ use std::path::PathBuf;
 
 use pyo3::prelude::*;
 
-/// Opens the card log at `path` (`RUNnnnnn.WBL`): reads it once for its
-/// summary and warns (`wobblog.DamageWarning`) of what it lost.
+/// Opens the card log at `path` (`RUNnnnnn.WBL`): decodes it once, for its
+/// summary and its frames (kept for `frames()`), and warns
+/// (`wobblog.DamageWarning`) of what it lost.
 #[pyfunction]
 fn open(py: Python<'_>, path: PathBuf) -> PyResult<log::Log> {
     log::Log::open(py, path)

@@ -4,13 +4,18 @@
 use std::convert::Infallible;
 use std::path::PathBuf;
 
+use arrow_array::cast::AsArray;
+use arrow_array::types::{Float64Type, TimestampMicrosecondType};
+use arrow_array::{Array, RecordBatch};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use wobblog::analysis::campaign_kicks::load_campaign_kicks;
 use wobblog::analysis::{estimate_roll_deg, Ride, Run};
 use wobblog::cmd::events::{walk, JsonEvent};
 use wobblog::export::columns::{self, Column, Kind, Value};
-use wobblog::summary::Summary;
+use wobblog::summary::{Summary, SummaryBuilder};
+use wobblog::time::TimeWindow;
+use wobblog::CliError;
 
 use crate::errors::{detached, warn_damage, WobblogError};
 use crate::stream::Table;
@@ -32,7 +37,9 @@ const DAMAGE_KEYS: [&str; 11] = [
     "losses",
 ];
 
-/// A card log (`RUNnnnnn.WBL`), read once on opening for its summary.
+/// A card log (`RUNnnnnn.WBL`), decoded once on opening: its summary and
+/// its frames come from that one pass, and the frames are kept for
+/// [`Log::frames`], which hands out (slices of) them without a copy.
 ///
 /// Damage (lost blocks, damaged bytes, dropouts) is reported on opening as
 /// a `wobblog.DamageWarning` per loss; what survived is still read.
@@ -40,6 +47,12 @@ const DAMAGE_KEYS: [&str; 11] = [
 pub struct Log {
     path: PathBuf,
     summary: Summary,
+    /// Every frame in every column of [`columns::COLUMNS`].
+    frames: Table,
+    /// First and last boot time of the frames, s.
+    span_s: Option<(f64, f64)>,
+    /// The log has a UTC sync pair.
+    has_utc: bool,
 }
 
 /// A `t_s`, `roll_deg` pair of the roll table.
@@ -61,8 +74,14 @@ const ROLL_COLUMNS: [Column<RollRow>; 2] = [
 impl Log {
     /// Opens the log at `path`, warning of its losses.
     pub fn open(py: Python<'_>, path: PathBuf) -> PyResult<Self> {
-        let summary = detached(py, &path.display().to_string(), || {
-            wobblog::cmd::info::summarise(&path)
+        // One pass: what `wobblog info` summarises and every frame.
+        let (summary, decoded) = py.detach(|| {
+            let mut builder = SummaryBuilder::new();
+            let decoded =
+                crate::frames::walk(&path, &columns::COLUMNS, TimeWindow::default(), |event| {
+                    builder.observe(event)
+                })?;
+            PyResult::Ok((builder.finish(&decoded.stats), decoded))
         })?;
         // The logger's own dropouts too: frames missing from the data
         // whatever their cause (`wobblog info` counts them with the losses).
@@ -82,7 +101,79 @@ impl Log {
         for line in dropped.iter().chain(&losses) {
             warn_damage(py, &format!("{}: {line}", path.display()))?;
         }
-        Ok(Self { path, summary })
+        Ok(Self {
+            path,
+            summary,
+            frames: decoded.table,
+            span_s: decoded.span_s,
+            has_utc: decoded.has_utc,
+        })
+    }
+
+    /// The frames in `chosen` inside `window`, from those decoded on
+    /// opening: the columns picked and the rows sliced, nothing copied.
+    fn frames_in(&self, chosen: &[Column], window: &TimeWindow) -> Result<Table, CliError> {
+        window.check_order(&self.path)?;
+        let (schema, batches) = self.frames.parts();
+        let index = |name: &str| {
+            schema
+                .index_of(name)
+                .map_err(|e| CliError::file(&self.path, e))
+        };
+        let picked = chosen
+            .iter()
+            .map(|c| index(c.name))
+            .collect::<Result<Vec<usize>, _>>()?;
+        let t = index("t_s")?;
+        let utc = index("utc")?;
+        let mut kept = Vec::new();
+        for batch in batches {
+            if window.is_all() {
+                kept.push(batch.clone());
+                continue;
+            }
+            let t_s = batch.column(t).as_primitive::<Float64Type>();
+            let utc_us = batch.column(utc).as_primitive::<TimestampMicrosecondType>();
+            // As `wobblog decode`: a row is in when its boot time or UTC (ms) is.
+            let inside = |i: usize| {
+                let utc_ms = utc_us.is_valid(i).then(|| utc_us.value(i) / 1000);
+                window.contains(t_s.value(i), utc_ms)
+            };
+            // Runs of rows inside, each a slice of the batch.
+            let mut i = 0;
+            while i < batch.num_rows() {
+                if !inside(i) {
+                    i += 1;
+                    continue;
+                }
+                let start = i;
+                while i < batch.num_rows() && inside(i) {
+                    i += 1;
+                }
+                kept.push(batch.slice(start, i - start));
+            }
+        }
+        if kept.iter().all(|b| b.num_rows() == 0) && !window.is_all() {
+            return Err(window.selects_nothing(&self.path, "frames", self.span_s, self.has_utc));
+        }
+        let projected = kept
+            .iter()
+            .map(|b| b.project(&picked))
+            .collect::<Result<Vec<_>, _>>()
+            .map_err(|e| CliError::file(&self.path, e))?;
+        let schema = std::sync::Arc::new(
+            schema
+                .project(&picked)
+                .map_err(|e| CliError::file(&self.path, e))?,
+        );
+        // At least one batch, empty for no rows, so every consumer sees the
+        // columns.
+        let projected = if projected.is_empty() {
+            vec![RecordBatch::new_empty(schema.clone())]
+        } else {
+            projected
+        };
+        Ok(Table::new(schema, projected))
     }
 
     fn shown(&self) -> String {
@@ -143,10 +234,8 @@ impl Log {
         let chosen = columns::select(columns.map(|c| c.join(",")).as_deref())
             .map_err(|e| WobblogError::new_err(format!("{}: {e}", self.shown())))?;
         let window = window(start.as_ref(), end.as_ref())?;
-        let path = self.path.clone();
-        // Its losses were reported on opening.
-        py.detach(|| crate::frames::decode(&path, chosen, window))
-            .map(|(table, _)| table)
+        // Decoded on opening, where its losses were reported.
+        detached(py, &self.shown(), || self.frames_in(&chosen, &window))
     }
 
     /// Alerts, markers, faults, dropouts and damage in time order: one dict
@@ -213,7 +302,7 @@ impl Log {
         detached(py, &self.shown(), || {
             let run = Run::load(&path)?;
             let roll = estimate_roll_deg(&run);
-            let mut table = TableBuilder::new(ROLL_COLUMNS.to_vec());
+            let mut table = TableBuilder::new(&ROLL_COLUMNS);
             for row in run.t_s.iter().copied().zip(roll) {
                 table
                     .push(&row)

@@ -210,7 +210,7 @@ impl Model {
         };
         detached(py, &self.shown(), || {
             let survey = survey(&self.model, &speeds, &self.path)?;
-            let mut table = TableBuilder::new(EIG_COLUMNS.to_vec());
+            let mut table = TableBuilder::new(&EIG_COLUMNS);
             let visited = visit_rows(&self.model, &survey, &speeds, |row| table.push(row));
             match visited {
                 Ok(()) => {}

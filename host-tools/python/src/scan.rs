@@ -104,15 +104,12 @@ impl Scan {
 
     /// The frames as a `polars.DataFrame` (needs polars).
     fn to_polars<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyAny>> {
-        slf.py()
-            .import("polars")?
-            .getattr("DataFrame")?
-            .call1((slf,))
+        crate::stream::to_polars(slf.as_any())
     }
 
     /// The frames as a `pyarrow.Table` (needs pyarrow).
     fn to_arrow<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyAny>> {
-        slf.py().import("pyarrow")?.getattr("table")?.call1((slf,))
+        crate::stream::to_arrow(slf.as_any())
     }
 
     fn __repr__(&self) -> String {
@@ -134,7 +131,7 @@ impl LogByLog {
     /// that cannot be read, or has no frame in the window, gives none and a
     /// warning, as `wobblog export` goes on past it.
     fn batches_of(&self, entry: &LogEntry) -> Result<Vec<RecordBatch>, ArrowError> {
-        let decoded = crate::frames::decode(&entry.path, self.columns.clone(), self.window);
+        let decoded = crate::frames::decode(&entry.path, &self.columns, self.window);
         let (table, losses) = match decoded {
             Ok(decoded) => decoded,
             Err(e) => {

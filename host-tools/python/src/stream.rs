@@ -27,11 +27,35 @@ impl Table {
         Self { schema, batches }
     }
 
+    /// Its schema and batches, borrowed.
+    #[must_use]
+    pub fn parts(&self) -> (&SchemaRef, &[RecordBatch]) {
+        (&self.schema, &self.batches)
+    }
+
     /// Its schema and batches.
     #[must_use]
     pub fn into_parts(self) -> (SchemaRef, Vec<RecordBatch>) {
         (self.schema, self.batches)
     }
+}
+
+/// An Arrow stream (`__arrow_c_stream__`) as a `polars.DataFrame`.
+pub fn to_polars<'py>(stream: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
+    stream
+        .py()
+        .import("polars")?
+        .getattr("DataFrame")?
+        .call1((stream,))
+}
+
+/// An Arrow stream (`__arrow_c_stream__`) as a `pyarrow.Table`.
+pub fn to_arrow<'py>(stream: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
+    stream
+        .py()
+        .import("pyarrow")?
+        .getattr("table")?
+        .call1((stream,))
 }
 
 #[pymethods]
@@ -84,15 +108,12 @@ impl Table {
 
     /// The table as a `polars.DataFrame` (needs polars).
     fn to_polars<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyAny>> {
-        slf.py()
-            .import("polars")?
-            .getattr("DataFrame")?
-            .call1((slf,))
+        to_polars(slf.as_any())
     }
 
     /// The table as a `pyarrow.Table` (needs pyarrow).
     fn to_arrow<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyAny>> {
-        slf.py().import("pyarrow")?.getattr("table")?.call1((slf,))
+        to_arrow(slf.as_any())
     }
 
     /// The table as a `pandas.DataFrame` (needs pandas and pyarrow).

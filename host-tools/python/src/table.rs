@@ -1,15 +1,20 @@
 //! Decoded frames as Arrow record batches, one array per column of the
 //! CLI's column table (`wobblog::export::columns`), so names, order, units
-//! and types are those of `wobblog decode`'s Parquet.
+//! and types are those of `wobblog decode`'s Parquet. The columns are
+//! built by the library (`wobblog::export::columnar`), as for that Parquet,
+//! and their vectors become the arrays' buffers.
 
 use std::sync::Arc;
 
-use arrow_array::builder::{
-    BooleanBuilder, Float64Builder, Int64Builder, StringBuilder, TimestampMicrosecondBuilder,
+use arrow_array::{
+    ArrayRef, BooleanArray, Float64Array, Int64Array, RecordBatch, StringArray,
+    TimestampMicrosecondArray,
 };
-use arrow_array::{ArrayRef, RecordBatch};
+use arrow_buffer::{NullBuffer, OffsetBuffer};
 use arrow_schema::{ArrowError, DataType, Field, Schema, SchemaRef, TimeUnit};
-use wobblog::export::columns::{Column, Kind, Value};
+use wobblog::export::columnar::{buffers, row_buffers, ColumnBuffers, Values};
+use wobblog::export::columns::{Column, Kind};
+use wobblog::rows::Row;
 
 /// Rows per record batch: large enough that per-batch costs vanish, small
 /// enough that a consumer can start before a long log is converted.
@@ -36,72 +41,68 @@ pub fn schema<R>(columns: &[Column<R>]) -> SchemaRef {
     Arc::new(Schema::new(fields))
 }
 
-/// One column being filled.
-enum Builder {
-    Number(Float64Builder),
-    Text(StringBuilder),
-    Utc(TimestampMicrosecondBuilder),
-    Integer(Int64Builder),
-    Bool(BooleanBuilder),
+/// One batch of a column as an Arrow array, its buffers moved, not copied
+/// (text is laid out anew).
+fn array(values: Values) -> ArrayRef {
+    // A validity bitmap only where a row lacks its value.
+    let nulls = |present: Vec<bool>| {
+        let nulls = NullBuffer::from(present);
+        (nulls.null_count() > 0).then_some(nulls)
+    };
+    match values {
+        Values::Number(v) => Arc::new(Float64Array::new(v.into(), None)),
+        Values::OptNumber(v, present) => Arc::new(Float64Array::new(v.into(), nulls(present))),
+        Values::Label(v) => Arc::new(labels(&v)),
+        Values::Text(v) => Arc::new(StringArray::from(v)),
+        Values::Utc(v, present) => {
+            Arc::new(TimestampMicrosecondArray::new(v.into(), nulls(present)).with_timezone("UTC"))
+        }
+        Values::Integer(v, present) => Arc::new(Int64Array::new(v.into(), nulls(present))),
+        Values::Bool(v, present) => Arc::new(BooleanArray::new(v.into(), nulls(present))),
+    }
 }
 
-impl Builder {
-    fn new(kind: Kind) -> Self {
-        match kind {
-            Kind::Number | Kind::OptNumber => {
-                Self::Number(Float64Builder::with_capacity(BATCH_ROWS))
-            }
-            Kind::Label | Kind::Text => Self::Text(StringBuilder::new()),
-            Kind::Utc => Self::Utc(
-                TimestampMicrosecondBuilder::with_capacity(BATCH_ROWS).with_timezone("UTC"),
-            ),
-            Kind::Integer => Self::Integer(Int64Builder::with_capacity(BATCH_ROWS)),
-            Kind::Bool => Self::Bool(BooleanBuilder::with_capacity(BATCH_ROWS)),
-        }
-    }
-
-    fn push(&mut self, value: Value) {
-        match (self, value) {
-            (Self::Number(b), Value::Number(v)) => b.append_option(v),
-            (Self::Text(b), Value::Label(v)) => b.append_option(v),
-            (Self::Text(b), Value::Text(v)) => b.append_option(v),
-            (Self::Utc(b), Value::Utc(v)) => b.append_option(v),
-            (Self::Integer(b), Value::Integer(v)) => b.append_option(v),
-            (Self::Bool(b), Value::Bool(v)) => b.append_option(v),
-            // A column's kind fixes its values' variant (columns.rs).
-            (_, value) => unreachable!("a column value of another kind: {value:?}"),
-        }
-    }
-
-    fn finish(&mut self) -> ArrayRef {
-        match self {
-            Self::Number(b) => Arc::new(b.finish()),
-            Self::Text(b) => Arc::new(b.finish()),
-            Self::Utc(b) => Arc::new(b.finish()),
-            Self::Integer(b) => Arc::new(b.finish()),
-            Self::Bool(b) => Arc::new(b.finish()),
-        }
-    }
+/// Names from a small set (a few bytes each) as a string array, laid out
+/// in one pass.
+fn labels(values: &[Option<&str>]) -> StringArray {
+    let mut bytes = Vec::with_capacity(4 * values.len());
+    let offsets = OffsetBuffer::from_lengths(values.iter().map(|v| {
+        let s = v.unwrap_or_default();
+        bytes.extend_from_slice(s.as_bytes());
+        s.len()
+    }));
+    let nulls = NullBuffer::from_iter(values.iter().map(Option::is_some));
+    let nulls = (nulls.null_count() > 0).then_some(nulls);
+    StringArray::new(offsets, bytes.into(), nulls)
 }
 
 /// Rows of `R` turned into record batches of [`BATCH_ROWS`] rows.
 pub struct TableBuilder<R: 'static> {
-    columns: Vec<Column<R>>,
     schema: SchemaRef,
-    builders: Vec<Builder>,
-    rows: usize,
+    buffers: Box<dyn ColumnBuffers<R>>,
     batches: Vec<RecordBatch>,
 }
 
-impl<R> TableBuilder<R> {
+impl TableBuilder<Row> {
+    /// A table of decoded frames in `columns`, each field stored straight
+    /// into its column.
+    #[must_use]
+    pub fn frames(columns: &[Column<Row>]) -> Self {
+        Self::with_buffers(schema(columns), row_buffers(columns, BATCH_ROWS))
+    }
+}
+
+impl<R: 'static> TableBuilder<R> {
     /// A table of `columns`.
     #[must_use]
-    pub fn new(columns: Vec<Column<R>>) -> Self {
+    pub fn new(columns: &[Column<R>]) -> Self {
+        Self::with_buffers(schema(columns), buffers(columns, BATCH_ROWS))
+    }
+
+    fn with_buffers(schema: SchemaRef, buffers: Box<dyn ColumnBuffers<R>>) -> Self {
         Self {
-            schema: schema(&columns),
-            builders: columns.iter().map(|c| Builder::new(c.kind)).collect(),
-            columns,
-            rows: 0,
+            schema,
+            buffers,
             batches: Vec::new(),
         }
     }
@@ -109,23 +110,22 @@ impl<R> TableBuilder<R> {
     /// Appends one row.
     ///
     /// # Errors
-    /// Arrow refuses the batch (cannot happen for builders of the schema's types).
+    /// A value that does not fit its column, or Arrow refuses the batch
+    /// (cannot happen for the columns' own types).
     pub fn push(&mut self, row: &R) -> Result<(), ArrowError> {
-        for (builder, column) in self.builders.iter_mut().zip(&self.columns) {
-            builder.push((column.value)(row));
-        }
-        self.rows += 1;
-        if self.rows == BATCH_ROWS {
+        self.buffers
+            .push(row)
+            .map_err(ArrowError::InvalidArgumentError)?;
+        if self.buffers.len() == BATCH_ROWS {
             self.flush()?;
         }
         Ok(())
     }
 
     fn flush(&mut self) -> Result<(), ArrowError> {
-        let arrays = self.builders.iter_mut().map(Builder::finish).collect();
+        let arrays = self.buffers.take().into_iter().map(array).collect();
         self.batches
             .push(RecordBatch::try_new(self.schema.clone(), arrays)?);
-        self.rows = 0;
         Ok(())
     }
 
@@ -135,7 +135,7 @@ impl<R> TableBuilder<R> {
     /// # Errors
     /// As [`Self::push`].
     pub fn finish(mut self) -> Result<(SchemaRef, Vec<RecordBatch>), ArrowError> {
-        if self.rows > 0 || self.batches.is_empty() {
+        if !self.buffers.is_empty() || self.batches.is_empty() {
             self.flush()?;
         }
         Ok((self.schema, self.batches))

@@ -11,7 +11,7 @@ import pyarrow.parquet as pq
 import pytest
 
 import wobblog
-from conftest import cli
+from conftest import cli, encode
 
 
 def decoded_parquet(log, tmp_path, *args):
@@ -137,3 +137,26 @@ def test_frames_of_a_damaged_log_warn_and_keep_the_rest(damaged_copy, wobble_log
     whole = wobblog.open(wobble_log).frames().num_rows
     assert 0 < frames.num_rows < whole
     assert_same_table(frames, decoded_parquet(damaged_copy, tmp_path))
+
+
+def test_a_window_across_time_jumps_equals_the_cli(golden, tmp_path):
+    # Boot time jumps forward to 5.2 s and back to 1.0 s: the window keeps
+    # rows of the first and the last segment, not of the middle one.
+    log = open_quietly(golden["timejump"])
+    ours = pa.table(log.frames(start=0.1, end=1.02))
+    theirs = decoded_parquet(golden["timejump"], tmp_path, "--from", "0.1", "--to", "1.02")
+    assert_same_table(ours, theirs)
+    times = ours.column("t_s").to_pylist()
+    assert min(times) < 0.5 and max(times) >= 1.0 and not any(t > 5 for t in times)
+
+
+def test_a_window_across_batches_equals_the_cli(tmp_path):
+    # 70 000 frames: more than one record batch (65 536 rows each).
+    lines = ["t_s,steer_deg,speed_mps"]
+    lines.extend(f"{i / 100:.2f},{(i % 300) / 100:.2f},4.5" for i in range(70_000))
+    log = encode("\n".join(lines) + "\n", tmp_path, "RUN00001")
+    frames = wobblog.open(log).frames(columns=["t_s", "steer_deg"], start=600.0, end=700.0)
+    theirs = decoded_parquet(log, tmp_path, "--columns", "t_s,steer_deg",
+                             "--from", "600", "--to", "700")
+    assert_same_table(pa.table(frames), theirs)
+    assert pl.DataFrame(frames).equals(pl.from_arrow(theirs))

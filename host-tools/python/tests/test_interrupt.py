@@ -1,5 +1,6 @@
-"""Ctrl-C stops a long decoding: `frames()` looks for a pending
-KeyboardInterrupt while it works without the GIL, instead of finishing first."""
+"""Ctrl-C stops a long decoding: `open()`, which decodes the log's summary and
+frames in one pass, looks for a pending KeyboardInterrupt while it works
+without the GIL, instead of finishing first."""
 
 import _thread
 import threading
@@ -19,10 +20,9 @@ def long_log(tmp_path_factory):
     return encode("\n".join(lines) + "\n", tmp_path_factory.mktemp("long"), "RUN00001")
 
 
-def test_ctrl_c_stops_frames_before_it_ends(long_log):
-    log = wobblog.open(long_log)
+def test_ctrl_c_stops_open_before_it_ends(long_log):
     start = time.perf_counter()
-    whole = log.frames()
+    whole = wobblog.open(long_log).frames()
     uninterrupted = time.perf_counter() - start
     assert whole.num_rows == 240_000
     # Ctrl-C a tenth of the way in, from another thread (the GIL is free).
@@ -30,7 +30,7 @@ def test_ctrl_c_stops_frames_before_it_ends(long_log):
     start = time.perf_counter()
     timer.start()
     with pytest.raises(KeyboardInterrupt):
-        log.frames()
+        wobblog.open(long_log)
         # Not reached when the decoding stopped; Python would raise the
         # interrupt here otherwise, after the whole decoding.
         time.sleep(1.0)

@@ -1,6 +1,7 @@
 //! Writing rows as CSV, JSON lines or Parquet, with the columns of
 //! [`columns::COLUMNS`] (or a selection of them).
 
+pub mod columnar;
 pub mod columns;
 mod lines;
 pub mod mcap;
@@ -236,7 +237,7 @@ impl<W: Write + Send> RowWriter<W> {
                 Sink::Lines(LineWriter::new(out, &columns, line), Some(header))
             }
             Format::Jsonl => Sink::Lines(LineWriter::new(out, &columns, LineFormat::Json), None),
-            Format::Parquet => Sink::Parquet(parquet::ParquetWriter::new(out, &columns)),
+            Format::Parquet => Sink::Parquet(parquet::ParquetWriter::frames(out, &columns)),
             Format::Mcap => Sink::Mcap(None, Some(out)),
         };
         Self { columns, sink }

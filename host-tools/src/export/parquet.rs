@@ -17,7 +17,8 @@ use parquet::file::writer::{
 use parquet::schema::parser::parse_message_type;
 use parquet::schema::types::ColumnPath;
 
-use super::columns::{Column, Kind, Value};
+use super::columnar::{buffers, present_only, row_buffers, ColumnBuffers, Values};
+use super::columns::{Column, Kind};
 use super::LogMetadata;
 use crate::rows::Row;
 
@@ -30,19 +31,8 @@ const ROW_GROUP_ROWS: usize = 65_536;
 pub struct ParquetWriter<W: Write + Send, R = Row> {
     state: State<W>,
     columns: Vec<Column<R>>,
-    buffers: Vec<Buffer>,
-    rows: usize,
-}
-
-/// One column's values of the row group being built, with the definition
-/// levels of a nullable column (1 present, 0 absent).
-enum Buffer {
-    Number(Vec<f64>, Option<Vec<i16>>),
-    Label(Vec<ByteArray>, Vec<i16>),
-    Utc(Vec<i64>, Vec<i16>),
-    Integer(Vec<i64>, Vec<i16>),
-    Text(Vec<ByteArray>, Vec<i16>),
-    Bool(Vec<bool>, Vec<i16>),
+    /// The row group being built ([`super::columnar`]).
+    buffers: Box<dyn ColumnBuffers<R>>,
 }
 
 enum State<W: Write + Send> {
@@ -52,26 +42,25 @@ enum State<W: Write + Send> {
     Closed,
 }
 
-impl<W: Write + Send, R> ParquetWriter<W, R> {
+impl<W: Write + Send> ParquetWriter<W, Row> {
+    /// A writer of decoded frames in `columns` on `out`, each field stored
+    /// straight into its column ([`super::columnar::RowColumns`]).
+    pub fn frames(out: W, columns: &[Column<Row>]) -> Self {
+        Self::with_buffers(out, columns, row_buffers(columns, ROW_GROUP_ROWS))
+    }
+}
+
+impl<W: Write + Send, R: 'static> ParquetWriter<W, R> {
     /// A writer of `columns` on `out`.
     pub fn new(out: W, columns: &[Column<R>]) -> Self {
-        let buffers = columns
-            .iter()
-            .map(|c| match c.kind {
-                Kind::Number => Buffer::Number(Vec::new(), None),
-                Kind::OptNumber => Buffer::Number(Vec::new(), Some(Vec::new())),
-                Kind::Label => Buffer::Label(Vec::new(), Vec::new()),
-                Kind::Utc => Buffer::Utc(Vec::new(), Vec::new()),
-                Kind::Integer => Buffer::Integer(Vec::new(), Vec::new()),
-                Kind::Text => Buffer::Text(Vec::new(), Vec::new()),
-                Kind::Bool => Buffer::Bool(Vec::new(), Vec::new()),
-            })
-            .collect();
+        Self::with_buffers(out, columns, buffers(columns, ROW_GROUP_ROWS))
+    }
+
+    fn with_buffers(out: W, columns: &[Column<R>], buffers: Box<dyn ColumnBuffers<R>>) -> Self {
         Self {
             state: State::Idle(out),
             columns: columns.to_vec(),
             buffers,
-            rows: 0,
         }
     }
 
@@ -132,96 +121,79 @@ impl<W: Write + Send, R> ParquetWriter<W, R> {
 
     /// Adds one row.
     pub fn write(&mut self, row: &R) -> Result<(), ParquetError> {
-        for (column, buffer) in self.columns.iter().zip(&mut self.buffers) {
-            match (buffer, (column.value)(row)) {
-                (Buffer::Number(values, levels), Value::Number(v)) => {
-                    match levels {
-                        Some(levels) => levels.push(i16::from(v.is_some())),
-                        None if v.is_none() => {
-                            return Err(ParquetError::General(format!(
-                                "{} has no value in a row",
-                                column.name
-                            )))
-                        }
-                        None => {}
-                    }
-                    values.extend(v);
-                }
-                (Buffer::Label(values, levels), Value::Label(v)) => {
-                    levels.push(i16::from(v.is_some()));
-                    values.extend(v.map(|s| ByteArray::from(s.as_bytes().to_vec())));
-                }
-                (Buffer::Utc(values, levels), Value::Utc(v))
-                | (Buffer::Integer(values, levels), Value::Integer(v)) => {
-                    levels.push(i16::from(v.is_some()));
-                    values.extend(v);
-                }
-                (Buffer::Text(values, levels), Value::Text(v)) => {
-                    levels.push(i16::from(v.is_some()));
-                    values.extend(v.map(|s| ByteArray::from(s.into_bytes())));
-                }
-                (Buffer::Bool(values, levels), Value::Bool(v)) => {
-                    levels.push(i16::from(v.is_some()));
-                    values.extend(v);
-                }
-                _ => {
-                    return Err(ParquetError::General(format!(
-                        "{}: value of the wrong type",
-                        column.name
-                    )))
-                }
-            }
-        }
-        self.rows += 1;
-        if self.rows >= ROW_GROUP_ROWS {
+        self.buffers.push(row).map_err(ParquetError::General)?;
+        if self.buffers.len() >= ROW_GROUP_ROWS {
             self.write_group()?;
         }
         Ok(())
     }
 
     fn write_group(&mut self) -> Result<(), ParquetError> {
-        let rows = std::mem::take(&mut self.rows);
-        let buffers: Vec<Buffer> = self
-            .buffers
-            .iter_mut()
-            .map(|b| match b {
-                Buffer::Number(v, l) => {
-                    Buffer::Number(std::mem::take(v), l.as_mut().map(std::mem::take))
-                }
-                Buffer::Label(v, l) => Buffer::Label(std::mem::take(v), std::mem::take(l)),
-                Buffer::Utc(v, l) => Buffer::Utc(std::mem::take(v), std::mem::take(l)),
-                Buffer::Integer(v, l) => Buffer::Integer(std::mem::take(v), std::mem::take(l)),
-                Buffer::Text(v, l) => Buffer::Text(std::mem::take(v), std::mem::take(l)),
-                Buffer::Bool(v, l) => Buffer::Bool(std::mem::take(v), std::mem::take(l)),
-            })
-            .collect();
+        let rows = self.buffers.len();
+        let columns = self.buffers.take();
         let file = self.file()?;
         if rows == 0 {
             return Ok(());
         }
+        let levels =
+            |present: &[bool]| -> Vec<i16> { present.iter().map(|&p| i16::from(p)).collect() };
+        let bytes = |labels: &[Option<&str>]| -> Vec<ByteArray> {
+            labels
+                .iter()
+                .flatten()
+                .map(|s| ByteArray::from(s.as_bytes().to_vec()))
+                .collect()
+        };
         let mut group = file.next_row_group()?;
-        for buffer in &buffers {
+        for values in columns {
             let mut column = next_column(&mut group)?;
-            match buffer {
-                Buffer::Number(values, levels) => {
+            match values {
+                Values::Number(values) => {
                     column
                         .typed::<DoubleType>()
-                        .write_batch(values, levels.as_deref(), None)?;
+                        .write_batch(&values, None, None)?;
                 }
-                Buffer::Label(values, levels) | Buffer::Text(values, levels) => {
-                    column
-                        .typed::<ByteArrayType>()
-                        .write_batch(values, Some(levels), None)?;
+                Values::OptNumber(values, present) => {
+                    column.typed::<DoubleType>().write_batch(
+                        &present_only(&values, &present),
+                        Some(&levels(&present)),
+                        None,
+                    )?;
                 }
-                Buffer::Utc(values, levels) | Buffer::Integer(values, levels) => {
-                    column
-                        .typed::<Int64Type>()
-                        .write_batch(values, Some(levels), None)?;
+                Values::Label(labels) => {
+                    let present: Vec<bool> = labels.iter().map(Option::is_some).collect();
+                    column.typed::<ByteArrayType>().write_batch(
+                        &bytes(&labels),
+                        Some(&levels(&present)),
+                        None,
+                    )?;
                 }
-                Buffer::Bool(values, levels) => {
-                    column
-                        .typed::<BoolType>()
-                        .write_batch(values, Some(levels), None)?;
+                Values::Text(texts) => {
+                    let present: Vec<bool> = texts.iter().map(Option::is_some).collect();
+                    let values: Vec<ByteArray> = texts
+                        .into_iter()
+                        .flatten()
+                        .map(|s| ByteArray::from(s.into_bytes()))
+                        .collect();
+                    column.typed::<ByteArrayType>().write_batch(
+                        &values,
+                        Some(&levels(&present)),
+                        None,
+                    )?;
+                }
+                Values::Utc(values, present) | Values::Integer(values, present) => {
+                    column.typed::<Int64Type>().write_batch(
+                        &present_only(&values, &present),
+                        Some(&levels(&present)),
+                        None,
+                    )?;
+                }
+                Values::Bool(values, present) => {
+                    column.typed::<BoolType>().write_batch(
+                        &present_only(&values, &present),
+                        Some(&levels(&present)),
+                        None,
+                    )?;
                 }
             }
             column.close()?;

@@ -62,7 +62,8 @@ class Log:
         """The decoded 100 Hz frames in ``wobblog decode``'s columns (units in the
         names: ``t_s`` s since boot, ``steer_deg`` deg, ``speed_mps`` m/s, ``utc`` a
         UTC timestamp), from ``start`` to ``end`` inclusive: seconds since boot, or
-        timezone-aware datetimes (UTC)."""
+        timezone-aware datetimes (UTC). Taken from the frames decoded on opening,
+        without a copy."""
     def events(self) -> list[dict[str, Any]]:
         """Alerts, markers, faults, dropouts and damage in time order, as
         ``wobblog events --json`` (``t_s`` s since boot)."""
@@ -106,7 +107,9 @@ def summary(dir: _Path) -> list[dict[str, Any]]:
     ``distance_m`` m, ``max_speed_mps`` and ``wobble_speed_mps`` m/s, ...)."""
 
 def open(path: _Path) -> Log:
-    """Opens a card log (``RUNnnnnn.WBL``), warning (``DamageWarning``) of what it lost."""
+    """Opens a card log (``RUNnnnnn.WBL``), warning (``DamageWarning``) of what it lost.
+    The log is decoded once, here: its summary and its frames, which the ``Log``
+    keeps for ``frames()``."""
 
 def margin(
     inputs: Sequence[_Path],

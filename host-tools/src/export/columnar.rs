@@ -1,0 +1,463 @@
+//! Rows turned into typed columns: one vector of values per column (and
+//! which rows have one), filled a row at a time and taken a batch at a time.
+//! The Parquet writer writes them as column chunks and the Python package
+//! hands them to Arrow, so both build their columns here, with the names,
+//! order and types of the column table ([`super::columns`]).
+//!
+//! Decoded frames ([`Row`]) have columns of their own, [`RowColumns`], that
+//! store each field straight into its vector; any other table is filled
+//! through its columns' value functions ([`ValueColumns`]).
+
+use super::columns::{Column, Kind, Value, COLUMNS};
+use crate::rows::Row;
+
+/// One column's values for a batch of rows: a slot per row (absent values
+/// hold a default, `0.0` or `0`, so numbers are laid out as Arrow lays them
+/// out), with which rows have a value where the column can lack one.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Values {
+    /// [`Kind::Number`]: a number in every row.
+    Number(Vec<f64>),
+    /// [`Kind::OptNumber`]: numbers, and which rows have one.
+    OptNumber(Vec<f64>, Vec<bool>),
+    /// [`Kind::Label`]: names.
+    Label(Vec<Option<&'static str>>),
+    /// [`Kind::Utc`]: µs since 1970, and which rows have a time.
+    Utc(Vec<i64>, Vec<bool>),
+    /// [`Kind::Integer`]: whole numbers, and which rows have one.
+    Integer(Vec<i64>, Vec<bool>),
+    /// [`Kind::Text`]: text.
+    Text(Vec<Option<String>>),
+    /// [`Kind::Bool`]: truth values, and which rows have one.
+    Bool(Vec<bool>, Vec<bool>),
+}
+
+impl Values {
+    /// Empty values of `kind`, with room for `rows` rows.
+    #[must_use]
+    pub fn with_capacity(kind: Kind, rows: usize) -> Self {
+        let present = || Vec::with_capacity(rows);
+        match kind {
+            Kind::Number => Self::Number(Vec::with_capacity(rows)),
+            Kind::OptNumber => Self::OptNumber(Vec::with_capacity(rows), present()),
+            Kind::Label => Self::Label(Vec::with_capacity(rows)),
+            Kind::Utc => Self::Utc(Vec::with_capacity(rows), present()),
+            Kind::Integer => Self::Integer(Vec::with_capacity(rows), present()),
+            Kind::Text => Self::Text(Vec::with_capacity(rows)),
+            Kind::Bool => Self::Bool(Vec::with_capacity(rows), present()),
+        }
+    }
+
+    /// Number of rows.
+    #[must_use]
+    pub fn len(&self) -> usize {
+        match self {
+            Self::Number(v) | Self::OptNumber(v, _) => v.len(),
+            Self::Label(v) => v.len(),
+            Self::Utc(v, _) | Self::Integer(v, _) => v.len(),
+            Self::Text(v) => v.len(),
+            Self::Bool(v, _) => v.len(),
+        }
+    }
+
+    /// No rows.
+    #[must_use]
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Appends one cell of a column named `name`.
+    ///
+    /// # Errors
+    /// A value of another kind than the column's, or none in a column of
+    /// [`Kind::Number`].
+    fn push(&mut self, name: &str, value: Value) -> Result<(), String> {
+        fn slot<T: Default>(values: &mut Vec<T>, present: &mut Vec<bool>, v: Option<T>) {
+            present.push(v.is_some());
+            values.push(v.unwrap_or_default());
+        }
+        match (self, value) {
+            (Self::Number(values), Value::Number(Some(v))) => values.push(v),
+            (Self::Number(_), Value::Number(None)) => {
+                return Err(format!("{name} has no value in a row"))
+            }
+            (Self::OptNumber(values, present), Value::Number(v)) => slot(values, present, v),
+            (Self::Label(values), Value::Label(v)) => values.push(v),
+            (Self::Utc(values, present), Value::Utc(v))
+            | (Self::Integer(values, present), Value::Integer(v)) => slot(values, present, v),
+            (Self::Text(values), Value::Text(v)) => values.push(v),
+            (Self::Bool(values, present), Value::Bool(v)) => slot(values, present, v),
+            _ => return Err(format!("{name}: value of the wrong type")),
+        }
+        Ok(())
+    }
+}
+
+/// The values of the rows that have one (`present`), for writers that
+/// store only those (Parquet).
+#[must_use]
+pub fn present_only<T: Clone>(values: &[T], present: &[bool]) -> Vec<T> {
+    values
+        .iter()
+        .zip(present)
+        .filter(|(_, &p)| p)
+        .map(|(v, _)| v.clone())
+        .collect()
+}
+
+/// Typed columns being filled from rows of `R`.
+pub trait ColumnBuffers<R>: Send {
+    /// Appends one row.
+    ///
+    /// # Errors
+    /// A value that does not fit its column (see [`Values`]).
+    fn push(&mut self, row: &R) -> Result<(), String>;
+
+    /// Rows appended since the last [`Self::take`].
+    fn len(&self) -> usize;
+
+    /// No rows since the last [`Self::take`].
+    fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// The values of the rows appended since the last call, one entry per
+    /// column in the columns' order; the buffers start empty again.
+    fn take(&mut self) -> Vec<Values>;
+}
+
+/// The buffers for a table of `columns` of any row type, with room for
+/// `rows` rows per batch: [`ValueColumns`] (decoded frames have
+/// [`row_buffers`]).
+#[must_use]
+pub fn buffers<R: 'static>(columns: &[Column<R>], rows: usize) -> Box<dyn ColumnBuffers<R>> {
+    Box::new(ValueColumns::new(columns, rows))
+}
+
+/// Any table, filled through its columns' value functions.
+pub struct ValueColumns<R> {
+    columns: Vec<Column<R>>,
+    values: Vec<Values>,
+    rows: usize,
+    capacity: usize,
+}
+
+impl<R> ValueColumns<R> {
+    /// Buffers for `columns`, with room for `rows` rows per batch.
+    #[must_use]
+    pub fn new(columns: &[Column<R>], rows: usize) -> Self {
+        Self {
+            values: columns
+                .iter()
+                .map(|c| Values::with_capacity(c.kind, rows))
+                .collect(),
+            columns: columns.to_vec(),
+            rows: 0,
+            capacity: rows,
+        }
+    }
+}
+
+impl<R> ColumnBuffers<R> for ValueColumns<R> {
+    fn push(&mut self, row: &R) -> Result<(), String> {
+        for (column, values) in self.columns.iter().zip(&mut self.values) {
+            values.push(column.name, (column.value)(row))?;
+        }
+        self.rows += 1;
+        Ok(())
+    }
+
+    fn len(&self) -> usize {
+        self.rows
+    }
+
+    fn take(&mut self) -> Vec<Values> {
+        self.rows = 0;
+        self.columns
+            .iter()
+            .zip(&mut self.values)
+            .map(|(c, v)| std::mem::replace(v, Values::with_capacity(c.kind, self.capacity)))
+            .collect()
+    }
+}
+
+/// The buffers for decoded frames in `columns`: each field stored straight
+/// into its vector ([`RowColumns`]) when every column is one of
+/// [`COLUMNS`], else through the value functions.
+#[must_use]
+pub fn row_buffers(columns: &[Column<Row>], rows: usize) -> Box<dyn ColumnBuffers<Row>> {
+    match RowColumns::new(columns, rows) {
+        Some(fast) => Box::new(fast),
+        None => Box::new(ValueColumns::new(columns, rows)),
+    }
+}
+
+/// A field of [`Row`] that is a column of [`COLUMNS`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Field {
+    T,
+    Accel(usize),
+    Gyro(usize),
+    Steer,
+    Speed,
+    GpsLat,
+    GpsLon,
+    GpsSpeed,
+    GpsFix,
+    Utc,
+}
+
+impl Field {
+    /// The field of the column `name` of [`COLUMNS`] (a test holds the two
+    /// together).
+    fn of(name: &str) -> Option<Self> {
+        Some(match name {
+            "t_s" => Self::T,
+            "ax_g" => Self::Accel(0),
+            "ay_g" => Self::Accel(1),
+            "az_g" => Self::Accel(2),
+            "gx_dps" => Self::Gyro(0),
+            "gy_dps" => Self::Gyro(1),
+            "gz_dps" => Self::Gyro(2),
+            "steer_deg" => Self::Steer,
+            "speed_mps" => Self::Speed,
+            "gps_lat_deg" => Self::GpsLat,
+            "gps_lon_deg" => Self::GpsLon,
+            "gps_speed_mps" => Self::GpsSpeed,
+            "gps_fix" => Self::GpsFix,
+            "utc" => Self::Utc,
+            _ => return None,
+        })
+    }
+}
+
+/// Decoded frames as columns: every field of a row is stored into its own
+/// vector as the row comes (no per-cell dispatch), and the chosen columns
+/// are taken by name.
+pub struct RowColumns {
+    fields: Vec<Field>,
+    capacity: usize,
+    t_s: Vec<f64>,
+    accel_g: [Vec<f64>; 3],
+    gyro_dps: [Vec<f64>; 3],
+    steer_deg: Vec<f64>,
+    speed_mps: Vec<f64>,
+    /// Latitude, longitude, speed; 0.0 where the row has none.
+    gps: [Vec<f64>; 3],
+    has_gps: Vec<bool>,
+    has_gps_speed: Vec<bool>,
+    gps_fix: Vec<Option<&'static str>>,
+    utc_us: Vec<i64>,
+    has_utc: Vec<bool>,
+}
+
+impl RowColumns {
+    /// Columns for `columns` (with room for `rows` rows per batch), `None`
+    /// if one of them is not one of [`COLUMNS`].
+    #[must_use]
+    pub fn new(columns: &[Column<Row>], rows: usize) -> Option<Self> {
+        let fields = columns
+            .iter()
+            .map(|c| {
+                let known = COLUMNS.iter().any(|k| k.name == c.name && k.kind == c.kind);
+                Field::of(c.name).filter(|_| known)
+            })
+            .collect::<Option<Vec<Field>>>()?;
+        let mut new = Self {
+            fields,
+            capacity: rows,
+            t_s: Vec::new(),
+            accel_g: Default::default(),
+            gyro_dps: Default::default(),
+            steer_deg: Vec::new(),
+            speed_mps: Vec::new(),
+            gps: Default::default(),
+            has_gps: Vec::new(),
+            has_gps_speed: Vec::new(),
+            gps_fix: Vec::new(),
+            utc_us: Vec::new(),
+            has_utc: Vec::new(),
+        };
+        new.reserve();
+        Some(new)
+    }
+
+    fn reserve(&mut self) {
+        let n = self.capacity;
+        let numbers = [&mut self.t_s, &mut self.steer_deg, &mut self.speed_mps]
+            .into_iter()
+            .chain(&mut self.accel_g)
+            .chain(&mut self.gyro_dps)
+            .chain(&mut self.gps);
+        for v in numbers {
+            v.reserve(n);
+        }
+        self.has_gps.reserve(n);
+        self.has_gps_speed.reserve(n);
+        self.gps_fix.reserve(n);
+        self.utc_us.reserve(n);
+        self.has_utc.reserve(n);
+    }
+}
+
+impl ColumnBuffers<Row> for RowColumns {
+    fn push(&mut self, row: &Row) -> Result<(), String> {
+        self.t_s.push(row.t_s);
+        for (v, x) in self.accel_g.iter_mut().zip(row.accel_g) {
+            v.push(x);
+        }
+        for (v, x) in self.gyro_dps.iter_mut().zip(row.gyro_dps) {
+            v.push(x);
+        }
+        self.steer_deg.push(row.steer_deg);
+        self.speed_mps.push(row.speed_mps);
+        let [lat, lon, speed] = &mut self.gps;
+        lat.push(row.gps.map_or(0.0, |g| g.lat_deg));
+        lon.push(row.gps.map_or(0.0, |g| g.lon_deg));
+        let gps_speed = row.gps.and_then(|g| g.speed_mps);
+        speed.push(gps_speed.unwrap_or_default());
+        self.has_gps.push(row.gps.is_some());
+        self.has_gps_speed.push(gps_speed.is_some());
+        self.gps_fix.push(row.gps.map(|g| g.fix.as_str()));
+        self.utc_us.push(row.utc_us.unwrap_or_default());
+        self.has_utc.push(row.utc_us.is_some());
+        Ok(())
+    }
+
+    fn len(&self) -> usize {
+        self.t_s.len()
+    }
+
+    fn take(&mut self) -> Vec<Values> {
+        use std::mem::take;
+        let [lat, lon, speed] = &mut self.gps;
+        let chosen = self
+            .fields
+            .iter()
+            .map(|field| match *field {
+                Field::T => Values::Number(take(&mut self.t_s)),
+                Field::Accel(i) => Values::Number(take(&mut self.accel_g[i])),
+                Field::Gyro(i) => Values::Number(take(&mut self.gyro_dps[i])),
+                Field::Steer => Values::Number(take(&mut self.steer_deg)),
+                Field::Speed => Values::Number(take(&mut self.speed_mps)),
+                Field::GpsLat => Values::OptNumber(take(lat), self.has_gps.clone()),
+                Field::GpsLon => Values::OptNumber(take(lon), self.has_gps.clone()),
+                Field::GpsSpeed => Values::OptNumber(take(speed), take(&mut self.has_gps_speed)),
+                Field::GpsFix => Values::Label(take(&mut self.gps_fix)),
+                Field::Utc => Values::Utc(take(&mut self.utc_us), take(&mut self.has_utc)),
+            })
+            .collect();
+        // What no column took starts the next batch empty too.
+        let numbers = [&mut self.t_s, &mut self.steer_deg, &mut self.speed_mps]
+            .into_iter()
+            .chain(&mut self.accel_g)
+            .chain(&mut self.gyro_dps)
+            .chain(&mut self.gps);
+        for v in numbers {
+            v.clear();
+        }
+        self.has_gps.clear();
+        self.has_gps_speed.clear();
+        self.gps_fix.clear();
+        self.utc_us.clear();
+        self.has_utc.clear();
+        self.reserve();
+        chosen
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::rows::GpsColumns;
+    use wobble_core::format::{FixMode, FrameStatus};
+
+    fn rows() -> Vec<Row> {
+        let base = Row {
+            t_s: 1.25,
+            accel_g: [0.01, -0.5, 1.0],
+            gyro_dps: [3.5, -2.25, 0.125],
+            steer_deg: -1.5,
+            speed_mps: 4.2,
+            wheel_count: 7,
+            status: FrameStatus::default(),
+            gps: None,
+            utc_us: None,
+        };
+        let fix = GpsColumns {
+            lat_deg: 52.0,
+            lon_deg: 4.375,
+            speed_mps: Some(4.0),
+            fix: FixMode::Fix3d,
+        };
+        vec![
+            base,
+            Row {
+                t_s: 1.26,
+                gps: Some(fix),
+                utc_us: Some(1_584_538_100_000_000),
+                ..base
+            },
+            Row {
+                t_s: 1.27,
+                gps: Some(GpsColumns {
+                    speed_mps: None,
+                    fix: FixMode::Fix2d,
+                    ..fix
+                }),
+                ..base
+            },
+        ]
+    }
+
+    #[test]
+    fn every_frame_column_is_a_field_stored_as_its_value_function_gives_it() {
+        let mut fast = RowColumns::new(&COLUMNS, 4).expect("every column has a field");
+        let mut slow = ValueColumns::new(&COLUMNS, 4);
+        for row in rows() {
+            fast.push(&row).unwrap();
+            slow.push(&row).unwrap();
+        }
+        assert_eq!(fast.len(), 3);
+        assert_eq!(fast.take(), slow.take());
+        assert!(fast.is_empty() && slow.is_empty());
+    }
+
+    #[test]
+    fn chosen_columns_come_in_their_order_batch_after_batch() {
+        let chosen = super::super::columns::select(Some("utc,steer_deg,gps_fix")).unwrap();
+        let mut fast = row_buffers(&chosen, 2);
+        let mut slow = ValueColumns::new(&chosen, 2);
+        for _ in 0..2 {
+            for row in rows() {
+                fast.push(&row).unwrap();
+                slow.push(&row).unwrap();
+            }
+            let taken = fast.take();
+            assert_eq!(taken.len(), 3);
+            assert!(matches!(taken[0], Values::Utc(..)));
+            assert_eq!(taken, slow.take());
+        }
+    }
+
+    #[test]
+    fn a_missing_number_or_a_value_of_another_kind_is_refused() {
+        let columns: [Column<Option<f64>>; 1] = [Column {
+            name: "x",
+            kind: Kind::Number,
+            value: |r| Value::Number(*r),
+        }];
+        let mut buffers = buffers(&columns, 1);
+        assert!(buffers.push(&Some(1.0)).is_ok());
+        assert_eq!(buffers.push(&None).unwrap_err(), "x has no value in a row");
+        let wrong: [Column<Option<f64>>; 1] = [Column {
+            name: "y",
+            kind: Kind::Utc,
+            value: |r| Value::Number(*r),
+        }];
+        assert_eq!(
+            ValueColumns::new(&wrong, 1).push(&Some(1.0)).unwrap_err(),
+            "y: value of the wrong type"
+        );
+    }
+}
