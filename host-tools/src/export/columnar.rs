@@ -282,14 +282,18 @@ impl RowColumns {
         Some(new)
     }
 
-    fn reserve(&mut self) {
-        let n = self.capacity;
-        let numbers = [&mut self.t_s, &mut self.steer_deg, &mut self.speed_mps]
+    /// Every column of numbers.
+    fn numbers(&mut self) -> impl Iterator<Item = &mut Vec<f64>> {
+        [&mut self.t_s, &mut self.steer_deg, &mut self.speed_mps]
             .into_iter()
             .chain(&mut self.accel_g)
             .chain(&mut self.gyro_dps)
-            .chain(&mut self.gps);
-        for v in numbers {
+            .chain(&mut self.gps)
+    }
+
+    fn reserve(&mut self) {
+        let n = self.capacity;
+        for v in self.numbers() {
             v.reserve(n);
         }
         self.has_gps.reserve(n);
@@ -348,12 +352,7 @@ impl ColumnBuffers<Row> for RowColumns {
             })
             .collect();
         // What no column took starts the next batch empty too.
-        let numbers = [&mut self.t_s, &mut self.steer_deg, &mut self.speed_mps]
-            .into_iter()
-            .chain(&mut self.accel_g)
-            .chain(&mut self.gyro_dps)
-            .chain(&mut self.gps);
-        for v in numbers {
+        for v in self.numbers() {
             v.clear();
         }
         self.has_gps.clear();
