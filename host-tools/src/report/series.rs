@@ -63,7 +63,10 @@ pub struct SeriesBuilder {
     period_s: f64,
     origin_s: f64,
     bucket_s: f64,
+    /// The close-look stretches, in time order, apart.
     detail_s: Vec<(f64, f64)>,
+    /// The first of `detail_s` not over before the last frame taken.
+    detail_at: usize,
     bucket: Option<Bucket>,
     last_s: Option<f64>,
     frame: usize,
@@ -97,6 +100,7 @@ impl SeriesBuilder {
             origin_s: span_s.0,
             bucket_s,
             detail_s: if all { Vec::new() } else { budgeted(detail_s) },
+            detail_at: 0,
             bucket: None,
             last_s: None,
             frame: 0,
@@ -118,7 +122,7 @@ impl SeriesBuilder {
             }
         }
         self.last_s = Some(t_s);
-        let detail = self.detail_s.iter().any(|&(a, b)| (a..=b).contains(&t_s));
+        let detail = self.in_detail(t_s);
         if self.bucket_s <= 0.0 || detail {
             self.flush();
             self.row(t_s, &values.map(Some));
@@ -148,6 +152,21 @@ impl SeriesBuilder {
                 bucket.high[c] = (v, frame);
             }
         }
+    }
+
+    /// Whether `t_s` is in a close-look stretch; the times asked about
+    /// only increase.
+    fn in_detail(&mut self, t_s: f64) -> bool {
+        while self
+            .detail_s
+            .get(self.detail_at)
+            .is_some_and(|&(_, b)| b < t_s)
+        {
+            self.detail_at += 1;
+        }
+        self.detail_s
+            .get(self.detail_at)
+            .is_some_and(|&(a, _)| a <= t_s)
     }
 
     /// The display columns.
