@@ -142,7 +142,11 @@ fn the_drawing_of_a_run_holds_no_more_for_a_longer_run() {
     assert!(long_peak < 16_000_000, "{long_peak} B");
     // The drawings are sized by the display, not by the run.
     for d in [&short, &long] {
-        assert!(d.series.t.len() <= OVERVIEW_ROWS + 1_600, "{}", d.series.t.len());
+        assert!(
+            d.series.t.len() <= OVERVIEW_ROWS + 1_600,
+            "{}",
+            d.series.t.len()
+        );
         assert!(d.series.t.len() > OVERVIEW_ROWS / 2, "{}", d.series.t.len());
     }
     let (s, l) = (
@@ -153,5 +157,9 @@ fn the_drawing_of_a_run_holds_no_more_for_a_longer_run() {
     let (s_track, l_track) = (short.track_svg.unwrap(), long.track_svg.unwrap());
     let points = |svg: &str| svg.matches(',').count();
     assert!(points(&l_track) <= 4_100 && points(&s_track) <= 4_100);
-    assert!((long.min_speed_mps - 3.0).abs() < 1e-3, "{}", long.min_speed_mps);
+    assert!(
+        (long.min_speed_mps - 3.0).abs() < 1e-3,
+        "{}",
+        long.min_speed_mps
+    );
 }

@@ -35,9 +35,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
     let campaign = Campaign::load(&logs, args.model.as_deref())?;
     // Written as it is made; only a whole page is committed.
     page::write(&campaign, &mut out).map_err(|e| match e {
-        PageError::Data(e) => {
-            CliError::file(&args.output, format!("cannot write the report: {e}"))
-        }
+        PageError::Data(e) => CliError::file(&args.output, format!("cannot write the report: {e}")),
         PageError::Write(e) => out.error(e),
     })?;
     out.commit()

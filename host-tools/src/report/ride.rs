@@ -15,12 +15,12 @@ use super::track::TrackBuilder;
 use crate::analysis::roll::RollStream;
 use crate::analysis::run::read_rows;
 use crate::analysis::{Episode, Ride, Run, Stability};
-use crate::events::{EventConverter, EventKind, LogEvent, TimeOrder};
-use crate::time::SyncPair;
 use crate::cmd::detect::log_config;
 use crate::cmd::summary::RunRow;
+use crate::events::{EventConverter, EventKind, LogEvent, TimeOrder};
 use crate::rows::Row;
 use crate::summary::Summary;
+use crate::time::SyncPair;
 use crate::CliError;
 
 /// Events listed per run, at most: a log damaged all through has
@@ -209,8 +209,7 @@ impl Drawing {
     #[must_use]
     pub fn finish(mut self) -> Drawn {
         let series = &mut self.series;
-        self.roll
-            .finish(&mut |f, j, roll| draw(series, f, j, roll));
+        self.roll.finish(&mut |f, j, roll| draw(series, f, j, roll));
         Drawn {
             series: self.series.finish(),
             spectrogram: self.spectrogram.and_then(SpectrogramBuilder::finish),

@@ -334,7 +334,11 @@ mod tests {
         }
         let s = b.finish();
         let breaks = s.columns[0].iter().filter(|v| v.is_none()).count();
-        assert!(s.t.len() <= 3 * OVERVIEW_ROWS / 2 + 10, "{} rows", s.t.len());
+        assert!(
+            s.t.len() <= 3 * OVERVIEW_ROWS / 2 + 10,
+            "{} rows",
+            s.t.len()
+        );
         assert!(breaks > OVERVIEW_ROWS / 4, "{breaks} breaks");
         assert!(s.t.windows(2).all(|w| w[0] < w[1]));
         // Every bucket still has its extremes.

@@ -135,8 +135,8 @@ impl SpectrogramBuilder {
         let n = self.n;
         let grid = self.grid.get_or_insert_with(|| {
             let (first, last) = (t_s + 0.5 * WINDOW_S, self.latest_s - 0.5 * WINDOW_S);
-            let columns =
-                (((last - first) * self.fs_hz / (n as f64 / 4.0)) as usize + 1).clamp(1, MAX_COLUMNS);
+            let columns = (((last - first) * self.fs_hz / (n as f64 / 4.0)) as usize + 1)
+                .clamp(1, MAX_COLUMNS);
             let step_s = if columns > 1 {
                 (last - first) / (columns - 1) as f64
             } else {

@@ -86,9 +86,9 @@ impl TrackBuilder {
 
     /// Takes the next fix, in time order.
     pub fn push(&mut self, (t, lat, lon): Fix) {
-        let (lat0, lon0, coslat) = *self.origin.get_or_insert_with(|| {
-            (lat, lon, lat.to_radians().cos().max(1e-6))
-        });
+        let (lat0, lon0, coslat) = *self
+            .origin
+            .get_or_insert_with(|| (lat, lon, lat.to_radians().cos().max(1e-6)));
         let p = (
             t,
             (lon - lon0) * M_PER_DEG * coslat,
