@@ -459,7 +459,10 @@ mod tests {
                 r += v * angle(k * i).cos();
                 m -= v * angle(k * i).sin();
             }
-            assert!((re[k] - r).abs() < 1e-9 && (im[k] - m).abs() < 1e-9, "bin {k}");
+            assert!(
+                (re[k] - r).abs() < 1e-9 && (im[k] - m).abs() < 1e-9,
+                "bin {k}"
+            );
         }
     }
 
