@@ -1,11 +1,11 @@
 //! `wobblog report`: one self-contained HTML page for a card or a set of
 //! logs (the campaign view and one ride view per run).
 
-use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use crate::output::Output;
-use crate::report::{page, Campaign};
+use crate::report::page::{self, PageError};
+use crate::report::Campaign;
 use crate::CliError;
 
 /// Arguments of `wobblog report`.
@@ -33,8 +33,10 @@ pub fn run(args: &Args) -> Result<(), CliError> {
     }
     let mut out = Output::create(&args.output, &inputs)?;
     let campaign = Campaign::load(&logs, args.model.as_deref())?;
-    let html = page::render(&campaign)
-        .map_err(|e| CliError::file(&args.output, format!("cannot write the report: {e}")))?;
-    out.write_all(html.as_bytes()).map_err(|e| out.error(e))?;
+    // Written as it is made; only a whole page is committed.
+    page::write(&campaign, &mut out).map_err(|e| match e {
+        PageError::Data(e) => CliError::file(&args.output, format!("cannot write the report: {e}")),
+        PageError::Write(e) => out.error(e),
+    })?;
     out.commit()
 }

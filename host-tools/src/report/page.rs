@@ -132,12 +132,88 @@ fn script_json(value: &impl Serialize) -> Result<String, String> {
         .map_err(|e| e.to_string())
 }
 
-/// The page of `campaign`.
+/// Why the page could not be written.
+#[derive(Debug)]
+pub enum PageError {
+    /// The data cannot be written as JSON.
+    Data(String),
+    /// The output failed.
+    Write(std::io::Error),
+}
+
+/// Bytes gathered before they are written.
+const PAGE_BUFFER: usize = 1 << 16;
+
+/// The page as it is written: short pieces gathered, long ones (the
+/// figures) written through, so the page is never held whole. The first
+/// error of the output is kept and ends the writing.
+struct Page<'a> {
+    out: &'a mut dyn std::io::Write,
+    buffer: String,
+    error: Option<std::io::Error>,
+}
+
+impl Page<'_> {
+    fn push_str(&mut self, s: &str) {
+        let _ = self.write_str(s);
+    }
+
+    fn send(&mut self, bytes: &[u8]) {
+        if self.error.is_none() {
+            self.error = self.out.write_all(bytes).err();
+        }
+    }
+
+    fn flush(&mut self) -> Result<(), PageError> {
+        let buffer = std::mem::take(&mut self.buffer);
+        self.send(buffer.as_bytes());
+        match self.error.take() {
+            Some(e) => Err(PageError::Write(e)),
+            None => Ok(()),
+        }
+    }
+}
+
+impl Write for Page<'_> {
+    fn write_str(&mut self, s: &str) -> std::fmt::Result {
+        if self.buffer.len() + s.len() > PAGE_BUFFER {
+            let buffer = std::mem::take(&mut self.buffer);
+            self.send(buffer.as_bytes());
+            self.buffer = buffer;
+            self.buffer.clear();
+        }
+        if s.len() > PAGE_BUFFER {
+            self.send(s.as_bytes());
+        } else {
+            self.buffer.push_str(s);
+        }
+        Ok(())
+    }
+}
+
+/// The page of `campaign`, whole.
 ///
 /// # Errors
 /// The data cannot be written as JSON.
 pub fn render(campaign: &Campaign) -> Result<String, String> {
-    let mut o = String::with_capacity(1 << 20);
+    let mut page = Vec::with_capacity(1 << 20);
+    write(campaign, &mut page).map_err(|e| match e {
+        PageError::Data(e) => e,
+        PageError::Write(e) => e.to_string(),
+    })?;
+    String::from_utf8(page).map_err(|e| e.to_string())
+}
+
+/// Writes the page of `campaign` to `out` as it is made.
+///
+/// # Errors
+/// The data cannot be written as JSON, or `out` failed.
+pub fn write(campaign: &Campaign, out: &mut dyn std::io::Write) -> Result<(), PageError> {
+    let mut o = Page {
+        out,
+        buffer: String::with_capacity(PAGE_BUFFER),
+        error: None,
+    };
     let title = match campaign.rides.as_slice() {
         [one] => format!("wobblog report: {}", one.name),
         rides => format!("wobblog report: {} runs", rides.len()),
@@ -157,20 +233,20 @@ pub fn render(campaign: &Campaign) -> Result<String, String> {
         ride_view(&mut o, k, ride);
     }
     let data: Vec<RideData> = campaign.rides.iter().map(RideData::of).collect();
+    let data = script_json(&data).map_err(PageError::Data)?;
     let _ = write!(
         o,
         "<pre id=\"selftest\" hidden></pre>\n\
          <footer>Made by wobblog {}. Charts: uPlot (MIT licence, in this file's source).</footer>\n\
-         <script type=\"application/json\" id=\"report-data\">{}</script>\n\
+         <script type=\"application/json\" id=\"report-data\">{data}</script>\n\
          <!--\n{}\n-->\n<script>\n{UPLOT_JS}\n</script>\n<script>\n{REPORT_JS}\n</script>\n</body>\n</html>\n",
         env!("CARGO_PKG_VERSION"),
-        script_json(&data)?,
         UPLOT_LICENSE.replace("--", "- -"),
     );
-    Ok(o)
+    o.flush()
 }
 
-fn nav(o: &mut String, campaign: &Campaign, title: &str) {
+fn nav(o: &mut Page<'_>, campaign: &Campaign, title: &str) {
     let _ = write!(
         o,
         "<header><h1>{}</h1><nav><a href=\"#campaign\">Campaign</a>",
@@ -186,7 +262,7 @@ fn opt(v: Option<f64>, unit: &str) -> String {
     v.map_or_else(|| "none".to_owned(), |v| format!("{v:.2} {unit}"))
 }
 
-fn campaign_view(o: &mut String, c: &Campaign) {
+fn campaign_view(o: &mut Page<'_>, c: &Campaign) {
     let m = &c.margin;
     let _ = write!(
         o,
@@ -272,7 +348,7 @@ fn speed_words(m: &crate::cmd::margin::Report) -> String {
     s
 }
 
-fn runs_table(o: &mut String, c: &Campaign) {
+fn runs_table(o: &mut Page<'_>, c: &Campaign) {
     o.push_str(
         "<section data-section=\"runs\"><h2>Runs</h2>\n<table class=\"runs\"><thead><tr>\
          <th>run</th><th>start (UTC)</th><th>duration (s)</th><th>distance (m)</th>\
@@ -310,7 +386,7 @@ fn runs_table(o: &mut String, c: &Campaign) {
     o.push_str("</tbody></table></section>\n");
 }
 
-fn figure(o: &mut String, section: &str, title: &str, svg: &Result<String, String>) {
+fn figure(o: &mut Page<'_>, section: &str, title: &str, svg: &Result<String, String>) {
     let _ = writeln!(
         o,
         "<section data-section=\"{section}\"><h2>{}</h2>",
@@ -327,7 +403,7 @@ fn figure(o: &mut String, section: &str, title: &str, svg: &Result<String, Strin
     o.push_str("</section>\n");
 }
 
-fn ride_view(o: &mut String, k: usize, r: &RideView) {
+fn ride_view(o: &mut Page<'_>, k: usize, r: &RideView) {
     let s = &r.summary;
     let _ = write!(
         o,
@@ -409,7 +485,7 @@ fn ride_lead(r: &RideView) -> String {
     )
 }
 
-fn events_list(o: &mut String, r: &RideView) {
+fn events_list(o: &mut Page<'_>, r: &RideView) {
     let _ = writeln!(
         o,
         "<section data-section=\"events\"><h3>Episodes and events</h3>\
@@ -431,7 +507,7 @@ fn events_list(o: &mut String, r: &RideView) {
     o.push_str("</section>\n");
 }
 
-fn event_row(o: &mut String, e: &EventLine) {
+fn event_row(o: &mut Page<'_>, e: &EventLine) {
     let utc = escape(e.utc.as_deref().unwrap_or("-"));
     let _ = writeln!(
         o,
@@ -447,7 +523,7 @@ fn event_row(o: &mut String, e: &EventLine) {
     );
 }
 
-fn damage(o: &mut String, r: &RideView) {
+fn damage(o: &mut Page<'_>, r: &RideView) {
     let s = &r.summary;
     let _ = writeln!(
         o,

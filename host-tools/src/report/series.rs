@@ -53,6 +53,8 @@ struct Bucket {
     first_s: f64,
     last_s: f64,
     frames: usize,
+    /// Whether the frames have a gap between them.
+    broken: bool,
     low: Vec<(f64, usize)>,
     high: Vec<(f64, usize)>,
 }
@@ -63,8 +65,14 @@ pub struct SeriesBuilder {
     period_s: f64,
     origin_s: f64,
     bucket_s: f64,
+    /// The close-look stretches, in time order, apart.
     detail_s: Vec<(f64, f64)>,
+    /// The first of `detail_s` not over before the last frame taken.
+    detail_at: usize,
     bucket: Option<Bucket>,
+    /// Whether the lines break before the next row with a value (after a
+    /// bucket with a gap in it).
+    broken: bool,
     last_s: Option<f64>,
     frame: usize,
 }
@@ -97,7 +105,9 @@ impl SeriesBuilder {
             origin_s: span_s.0,
             bucket_s,
             detail_s: if all { Vec::new() } else { budgeted(detail_s) },
+            detail_at: 0,
             bucket: None,
+            broken: false,
             last_s: None,
             frame: 0,
         }
@@ -106,25 +116,33 @@ impl SeriesBuilder {
     /// Takes the next frame in file order.
     pub fn push(&mut self, t_s: f64, values: &Values) {
         self.frame += 1;
-        if let Some(last) = self.last_s {
-            if t_s <= last {
-                self.out.frames_out_of_order += 1;
-                return;
-            }
-            if !follows(last, t_s, self.period_s) {
-                self.flush();
-                // A row of nothing between the two frames breaks the lines.
-                self.row(0.5 * (last + t_s), &[None; CHANNELS.len()]);
-            }
+        let last = self.last_s;
+        if last.is_some_and(|last| t_s <= last) {
+            self.out.frames_out_of_order += 1;
+            return;
         }
         self.last_s = Some(t_s);
-        let detail = self.detail_s.iter().any(|&(a, b)| (a..=b).contains(&t_s));
-        if self.bucket_s <= 0.0 || detail {
+        let thinned = self.bucket_s > 0.0 && !self.in_detail(t_s);
+        let index = ((t_s - self.origin_s) / self.bucket_s).floor() as i64;
+        if let Some(last) = last.filter(|&last| !follows(last, t_s, self.period_s)) {
+            match &mut self.bucket {
+                // A gap within a bucket being thinned breaks the lines
+                // after the bucket: however many gaps a bucket spans, it
+                // makes at most three rows.
+                Some(b) if thinned && b.index == index => b.broken = true,
+                _ => {
+                    self.flush();
+                    // A row of nothing between the two frames breaks the
+                    // lines.
+                    self.row(0.5 * (last + t_s), &[None; CHANNELS.len()]);
+                }
+            }
+        }
+        if !thinned {
             self.flush();
             self.row(t_s, &values.map(Some));
             return;
         }
-        let index = ((t_s - self.origin_s) / self.bucket_s).floor() as i64;
         if self.bucket.as_ref().is_some_and(|b| b.index != index) {
             self.flush();
         }
@@ -134,6 +152,7 @@ impl SeriesBuilder {
             first_s: t_s,
             last_s: t_s,
             frames: 0,
+            broken: false,
             low: values.iter().map(|&v| (v, frame)).collect(),
             high: values.iter().map(|&v| (v, frame)).collect(),
         });
@@ -150,6 +169,21 @@ impl SeriesBuilder {
         }
     }
 
+    /// Whether `t_s` is in a close-look stretch; the times asked about
+    /// only increase.
+    fn in_detail(&mut self, t_s: f64) -> bool {
+        while self
+            .detail_s
+            .get(self.detail_at)
+            .is_some_and(|&(_, b)| b < t_s)
+        {
+            self.detail_at += 1;
+        }
+        self.detail_s
+            .get(self.detail_at)
+            .is_some_and(|&(a, _)| a <= t_s)
+    }
+
     /// The display columns.
     #[must_use]
     pub fn finish(mut self) -> Series {
@@ -158,6 +192,11 @@ impl SeriesBuilder {
     }
 
     fn row(&mut self, t_s: f64, values: &[Option<f64>; CHANNELS.len()]) {
+        if std::mem::take(&mut self.broken) && values.iter().any(Option::is_some) {
+            if let Some(&before) = self.out.t.last() {
+                self.row(0.5 * (before + t_s), &[None; CHANNELS.len()]);
+            }
+        }
         self.out.t.push(round(t_s, 1e5));
         for (column, v) in self.out.columns.iter_mut().zip(values) {
             column.push(v.map(|v| round(v, 1e3)).filter(|v| v.is_finite()));
@@ -175,6 +214,7 @@ impl SeriesBuilder {
             let values: Vec<Option<f64>> = b.low.iter().map(|l| Some(l.0)).collect();
             let row: [Option<f64>; CHANNELS.len()] = std::array::from_fn(|c| values[c]);
             self.row(b.first_s, &row);
+            self.broken = b.broken;
             return;
         }
         let (mut first, mut second) = ([None; CHANNELS.len()], [None; CHANNELS.len()]);
@@ -190,6 +230,7 @@ impl SeriesBuilder {
         }
         self.row(b.first_s, &first);
         self.row(b.last_s, &second);
+        self.broken = b.broken;
     }
 }
 
@@ -275,6 +316,34 @@ mod tests {
         // Inside the detail stretch every frame is there.
         let inside = s.t.iter().filter(|t| (50.0..=51.0).contains(*t)).count();
         assert_eq!(inside, 101);
+    }
+
+    #[test]
+    fn gaps_in_a_long_ride_break_the_lines_in_rows_bounded_by_the_buckets() {
+        // A frame missing after every 20th: 50 000 gaps, 6 per bucket.
+        let n = 1_000_000;
+        let period = 0.01;
+        let times: Vec<f64> = (0..n)
+            .filter(|i| i % 21 != 20)
+            .map(|i| i as f64 * period)
+            .collect();
+        let span = (0.0, times[times.len() - 1]);
+        let mut b = SeriesBuilder::new(times.len(), period, span, &[]);
+        for (i, &t) in times.iter().enumerate() {
+            b.push(t, &frame((i % 5) as f64));
+        }
+        let s = b.finish();
+        let breaks = s.columns[0].iter().filter(|v| v.is_none()).count();
+        assert!(
+            s.t.len() <= 3 * OVERVIEW_ROWS / 2 + 10,
+            "{} rows",
+            s.t.len()
+        );
+        assert!(breaks > OVERVIEW_ROWS / 4, "{breaks} breaks");
+        assert!(s.t.windows(2).all(|w| w[0] < w[1]));
+        // Every bucket still has its extremes.
+        let highs = s.columns[0].iter().filter(|v| **v == Some(4.0)).count();
+        assert!(highs >= OVERVIEW_ROWS / 2 - 1, "{highs}");
     }
 
     #[test]
