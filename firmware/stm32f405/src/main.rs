@@ -66,7 +66,10 @@ fn main() -> ! {
     defmt::info!("{} starting", FIRMWARE);
     let reset = startup::take_reset_cause();
     defmt::info!("reset cause: {}", reset);
-    let streak = startup::take_panic_streak(reset);
+    let (streak, crystal_failed) = startup::take_panic_streak(reset);
+    if crystal_failed {
+        defmt::error!("crystal failed during the last run (clock security system): reset");
+    }
     let crystal = startup::start_hse();
     if !crystal {
         defmt::error!(
@@ -88,7 +91,7 @@ fn main() -> ! {
     }
     let boot_faults = [
         Some(reset.fault_code()),
-        (!crystal).then_some(boot::FAULT_HSE_FAILED),
+        boot::crystal_fault(crystal, crystal_failed),
         bor,
     ];
     for code in boot_faults.into_iter().flatten() {
