@@ -38,6 +38,13 @@ if cargo check -q --release -p wobble-stm32f405 --target "$TARGET" 2>"$root_buil
     exit 1
 fi
 grep -q "cd firmware/stm32f405 && cargo build --release" "$root_build_err"
+# Nor does an opt-level given in the environment make it the same image.
+if CARGO_PROFILE_RELEASE_OPT_LEVEL=z cargo check -q --release -p wobble-stm32f405 \
+    --target "$TARGET" 2>"$root_build_err"; then
+    echo "a release build from the root with CARGO_PROFILE_RELEASE_OPT_LEVEL=z was not refused" >&2
+    exit 1
+fi
+grep -q "cd firmware/stm32f405 && cargo build --release" "$root_build_err"
 rm -f "$root_build_err"
 # The memory plan (firmware/docs/board.md): fails when flash > 384 KiB (the
 # active slot of the field-update layout) or CCM > 64 KiB.

@@ -191,6 +191,34 @@ pub const PANIC_STREAK_CLEAR_US: u64 = 60_000_000;
 /// a debug probe's (probe-rs resets through the same SYSRESETREQ).
 pub const FAULT_RESET_MARK: u32 = 0x4641_4C54;
 
+/// The word the clock security system's NMI handler leaves beside the
+/// streak (in RAM that survives a reset) just before it resets the MCU. The
+/// handler itself logs nothing (a defmt call there could interrupt one in
+/// progress and corrupt the stream): the next boot, in thread mode, finds
+/// the mark ([`crystal_failed_last_run`]), logs the failure and records it.
+pub const CRYSTAL_FAILED_MARK: u32 = 0x4353_5346;
+
+/// Whether the last run ended in the clock security system's reset: the
+/// kept RAM is valid (its magic word held, not a power-on's noise) and
+/// holds [`CRYSTAL_FAILED_MARK`].
+#[must_use]
+pub const fn crystal_failed_last_run(kept_valid: bool, mark: u32) -> bool {
+    kept_valid && mark == CRYSTAL_FAILED_MARK
+}
+
+/// The crystal's system fault for this boot's log: [`FAULT_HSE_FAILED`]
+/// when it did not start now, and also when it failed during the last run
+/// but starts again (an intermittent crystal: its failure is recorded once
+/// instead of lost with the reset).
+#[must_use]
+pub const fn crystal_fault(started: bool, failed_last_run: bool) -> Option<u8> {
+    if !started || failed_last_run {
+        Some(FAULT_HSE_FAILED)
+    } else {
+        None
+    }
+}
+
 /// Whether a reset continues the streak of failed boots: a software reset
 /// the firmware's fault handler marked (`fault_marked`: a panic or a hard
 /// fault), and a watchdog reset (a hang; a hang at every boot would
@@ -286,6 +314,21 @@ mod tests {
 
     /// The streak after each boot of `boots` (cause, marked by the fault
     /// handler), starting from noise.
+    /// The clock security system's mark is read only from RAM that kept
+    /// its magic word, and only the mark itself counts; a crystal that
+    /// failed during the last run is recorded even when it starts again.
+    #[test]
+    fn a_crystal_failure_is_recorded_by_the_next_boot() {
+        assert!(crystal_failed_last_run(true, CRYSTAL_FAILED_MARK));
+        assert!(!crystal_failed_last_run(false, CRYSTAL_FAILED_MARK));
+        assert!(!crystal_failed_last_run(true, FAULT_RESET_MARK));
+        assert!(!crystal_failed_last_run(true, 0));
+        assert_eq!(crystal_fault(true, false), None);
+        assert_eq!(crystal_fault(false, false), Some(FAULT_HSE_FAILED));
+        assert_eq!(crystal_fault(true, true), Some(FAULT_HSE_FAILED));
+        assert_eq!(crystal_fault(false, true), Some(FAULT_HSE_FAILED));
+    }
+
     fn streaks(boots: &[(ResetCause, bool)]) -> Vec<u32> {
         let mut kept = None;
         boots

@@ -232,6 +232,8 @@ pub struct SharedStatus {
     /// Local time of the last GPS fix with a position, ms since boot; 0:
     /// none yet.
     last_fix_ms: AtomicU32,
+    /// UTC at boot, s since the Unix epoch (0: not known yet).
+    boot_unix_s: AtomicU32,
     /// Where the writer stands ([`CardHealth`] as a number).
     card: AtomicU32,
     /// Whether the writer should close the log (0/1).
@@ -270,11 +272,33 @@ impl SharedStatus {
     pub const fn new() -> Self {
         Self {
             last_fix_ms: AtomicU32::new(0),
+            boot_unix_s: AtomicU32::new(0),
             card: AtomicU32::new(0),
             stop: AtomicU32::new(0),
             writer_ops_max: AtomicU32::new(0),
             writer_open_ops_max: AtomicU32::new(0),
             writer_busy_max_us: AtomicU32::new(0),
+        }
+    }
+
+    /// The GPS task's (local time, UTC) pair: the UTC second at boot is
+    /// kept for the files' time stamps ([`crate::logger::GpsTime`]). A pair
+    /// before 1970 + 1 s of boot time (impossible) is ignored.
+    pub fn set_utc(&self, sync: crate::format::UtcSync) {
+        let boot_unix_s = (sync.unix_ms / 1000).saturating_sub(sync.t_us / 1_000_000);
+        if let Ok(s) = u32::try_from(boot_unix_s) {
+            if s > 0 {
+                self.boot_unix_s.store(s, Ordering::Relaxed);
+            }
+        }
+    }
+
+    /// UTC at `now_us` (µs since boot), seconds since the Unix epoch, once
+    /// the GPS has given it ([`Self::set_utc`]).
+    pub fn unix_s(&self, now_us: u64) -> Option<u64> {
+        match self.boot_unix_s.load(Ordering::Relaxed) {
+            0 => None,
+            s => Some(u64::from(s) + now_us / 1_000_000),
         }
     }
 

@@ -2,7 +2,9 @@
 //! runs it at the data clock with chip select held for each operation, and
 //! after any error identifies it again before the next access: a card that
 //! was missing, then inserted, then pulled; and one whose blocks keep
-//! failing their CRC, read or written, which then runs at half the clock.
+//! failing their CRC, read or written, which then runs at half the clock
+//! (a pulled card's unanswered write does not count) until clean transfers
+//! or a card identified after removal bring it back.
 
 mod sd_support;
 
@@ -14,7 +16,8 @@ use embedded_hal_mock::eh1::spi::{Mock, Transaction};
 use embedded_sdmmc::{Block, BlockCount, BlockDevice, BlockIdx, SdCardError};
 use sd_support::*;
 use wobble_core::drivers::sdcard::{
-    Card, CardHooks, ACQUIRE_RETRIES, CRC_ERRORS_BEFORE_SLOWING, IDENTIFICATION_CLOCK_HZ,
+    Card, CardHooks, ACQUIRE_RETRIES, CLEAN_TRANSFERS_BEFORE_RAISING, CRC_ERRORS_BEFORE_SLOWING,
+    IDENTIFICATION_CLOCK_HZ,
 };
 
 const DATA_CLOCK_HZ: u32 = 21_000_000;
@@ -252,6 +255,149 @@ fn repeated_write_crc_rejections_halve_the_data_clock() {
         assert!(matches!(write, Err(SdCardError::WriteError)), "{write:?}");
     }
     assert_eq!(card.data_clock_hz(), DATA_CLOCK_HZ / 2);
+    spi.done();
+    chip_select.done();
+}
+
+/// A block write answered by nothing: the data response reads 0xFF, as
+/// from a pulled card (MISO pulled up).
+fn unanswered_write(block: &Block) -> Spi {
+    [
+        command(24, 42, R1_READY),
+        byte(0xFE, NOTHING),
+        written(&block.contents),
+        written(&crc16(&block.contents).to_be_bytes()),
+        byte(0xFF, NOTHING),
+    ]
+    .concat()
+}
+
+/// A written block accepted, then the card free and its status clean.
+fn accepted_write(block: &Block) -> Spi {
+    [
+        command(24, 42, R1_READY),
+        byte(0xFE, NOTHING),
+        written(&block.contents),
+        written(&crc16(&block.contents).to_be_bytes()),
+        byte(0xFF, 0x05),
+        byte(0xFF, NOTHING),
+        command(13, 0, R1_READY),
+        byte(0xFF, 0x00),
+    ]
+    .concat()
+}
+
+fn crc_rejected_write(block: &Block) -> Spi {
+    [
+        command(24, 42, R1_READY),
+        byte(0xFE, NOTHING),
+        written(&block.contents),
+        written(&crc16(&block.contents).to_be_bytes()),
+        byte(0xFF, 0x0B),
+    ]
+    .concat()
+}
+
+/// A card pulled during writes (and pushed back each time) leaves the clock
+/// alone: its write errors are not CRC errors.
+#[test]
+fn a_pulled_cards_write_errors_do_not_slow_the_clock() {
+    let block = Block::new();
+    let identify = || identification([sdhc_identification(), csd_read()].concat());
+    let mut expectations = Vec::new();
+    let mut pins = Vec::new();
+    for _ in 0..CRC_ERRORS_BEFORE_SLOWING + 1 {
+        expectations.extend([identify(), operation(unanswered_write(&block))].concat());
+        pins.extend([&IDENTIFY_CS[..], &OPERATION_CS].concat());
+    }
+    let mut spi = Mock::new(&expectations);
+    let mut chip_select = PinMock::new(&cs(&pins));
+    let card = card(&spi, &chip_select);
+    for _ in 0..CRC_ERRORS_BEFORE_SLOWING + 1 {
+        let write = card.write(std::slice::from_ref(&block), BlockIdx(42));
+        assert!(matches!(write, Err(SdCardError::WriteError)), "{write:?}");
+    }
+    assert_eq!(card.data_clock_hz(), DATA_CLOCK_HZ);
+    take_clocks();
+    spi.done();
+    chip_select.done();
+}
+
+/// After the clock was lowered, enough clean transfers in a row bring it
+/// back up to the nominal clock.
+#[test]
+fn clean_transfers_restore_the_data_clock() {
+    let block = Block::new();
+    let identify = || identification([sdhc_identification(), csd_read()].concat());
+    let mut expectations = Vec::new();
+    let mut pins = Vec::new();
+    for _ in 0..CRC_ERRORS_BEFORE_SLOWING {
+        expectations.extend([identify(), operation(crc_rejected_write(&block))].concat());
+        pins.extend([&IDENTIFY_CS[..], &OPERATION_CS].concat());
+    }
+    expectations.extend(identify());
+    pins.extend(IDENTIFY_CS);
+    for _ in 0..CLEAN_TRANSFERS_BEFORE_RAISING {
+        expectations.extend(operation(accepted_write(&block)));
+        pins.extend(OPERATION_CS);
+    }
+    let mut spi = Mock::new(&expectations);
+    let mut chip_select = PinMock::new(&cs(&pins));
+    let card = card(&spi, &chip_select);
+    for _ in 0..CRC_ERRORS_BEFORE_SLOWING {
+        assert!(card
+            .write(std::slice::from_ref(&block), BlockIdx(42))
+            .is_err());
+    }
+    assert_eq!(card.data_clock_hz(), DATA_CLOCK_HZ / 2);
+    take_clocks();
+    for i in 0..CLEAN_TRANSFERS_BEFORE_RAISING {
+        assert_eq!(
+            card.data_clock_hz(),
+            DATA_CLOCK_HZ / 2,
+            "after {i} clean writes"
+        );
+        card.write(std::slice::from_ref(&block), BlockIdx(42))
+            .expect("written");
+    }
+    assert_eq!(card.data_clock_hz(), DATA_CLOCK_HZ);
+    assert_eq!(
+        take_clocks(),
+        [IDENTIFICATION_CLOCK_HZ, DATA_CLOCK_HZ / 2, DATA_CLOCK_HZ]
+    );
+    spi.done();
+    chip_select.done();
+}
+
+/// A slowed card pulled and a card identified in its place runs at the
+/// nominal clock again.
+#[test]
+fn a_card_identified_after_removal_runs_at_the_nominal_clock() {
+    let block = Block::new();
+    let identify = || identification([sdhc_identification(), csd_read()].concat());
+    let mut expectations = Vec::new();
+    let mut pins = Vec::new();
+    for _ in 0..CRC_ERRORS_BEFORE_SLOWING {
+        expectations.extend([identify(), operation(crc_rejected_write(&block))].concat());
+        pins.extend([&IDENTIFY_CS[..], &OPERATION_CS].concat());
+    }
+    expectations.extend([identify(), operation(unanswered_write(&block))].concat());
+    pins.extend([&IDENTIFY_CS[..], &OPERATION_CS].concat());
+    expectations.extend([identify(), operation(csd_read())].concat());
+    pins.extend([&IDENTIFY_CS[..], &OPERATION_CS].concat());
+    let mut spi = Mock::new(&expectations);
+    let mut chip_select = PinMock::new(&cs(&pins));
+    let card = card(&spi, &chip_select);
+    for _ in 0..=CRC_ERRORS_BEFORE_SLOWING {
+        assert!(card
+            .write(std::slice::from_ref(&block), BlockIdx(42))
+            .is_err());
+    }
+    assert_eq!(card.data_clock_hz(), DATA_CLOCK_HZ / 2);
+    take_clocks();
+    assert_eq!(card.num_blocks().ok(), Some(BlockCount(BLOCKS)));
+    assert_eq!(card.data_clock_hz(), DATA_CLOCK_HZ);
+    assert_eq!(take_clocks(), [IDENTIFICATION_CLOCK_HZ, DATA_CLOCK_HZ]);
     spi.done();
     chip_select.done();
 }

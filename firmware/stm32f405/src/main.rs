@@ -31,7 +31,7 @@ use wobble_core::boot;
 use wobble_core::channels::{RecordQueue, SharedStatus};
 use wobble_core::config;
 use wobble_core::format::Record;
-use wobble_core::logger::{CardLogger, FixedTime, LoggerConfig};
+use wobble_core::logger::{CardLogger, GpsTime, LoggerConfig};
 use {defmt_rtt as _, panic_probe as _};
 
 use wobble_stm32f405::adapters::card::SdCard;
@@ -66,7 +66,10 @@ fn main() -> ! {
     defmt::info!("{} starting", FIRMWARE);
     let reset = startup::take_reset_cause();
     defmt::info!("reset cause: {}", reset);
-    let streak = startup::take_panic_streak(reset);
+    let (streak, crystal_failed) = startup::take_panic_streak(reset);
+    if crystal_failed {
+        defmt::error!("crystal failed during the last run (clock security system): reset");
+    }
     let crystal = startup::start_hse();
     if !crystal {
         defmt::error!(
@@ -88,7 +91,7 @@ fn main() -> ! {
     }
     let boot_faults = [
         Some(reset.fault_code()),
-        (!crystal).then_some(boot::FAULT_HSE_FAILED),
+        boot::crystal_fault(crystal, crystal_failed),
         bor,
     ];
     for code in boot_faults.into_iter().flatten() {
@@ -152,9 +155,10 @@ fn main() -> ! {
     for fault in loaded.faults.records(t_us) {
         queue.push(Record::Fault(fault));
     }
+    // Files dated from the GPS's UTC once it is known (2020-01-01 before).
     let logger = CardLogger::new(
         card,
-        FixedTime::EPOCH,
+        GpsTime::new(&SHARED, || Instant::now().as_micros()),
         header(&config),
         LoggerConfig::DEFAULT,
     );
@@ -209,7 +213,7 @@ async fn selftest_task(parts: wobble_stm32f405::selftest::Parts, queue: &'static
 
 #[embassy_executor::task]
 async fn writer_task(
-    mut logger: CardLogger<'static, SdCard, FixedTime>,
+    mut logger: CardLogger<'static, SdCard, GpsTime<'static>>,
     queue: &'static RecordQueue,
 ) {
     if let Err(e) = writer::run(&mut logger, queue, &SHARED).await {

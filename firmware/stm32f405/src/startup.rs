@@ -13,8 +13,8 @@ use embassy_stm32::pac::{self, FLASH, RCC};
 use embassy_time::{block_for, Duration};
 
 use wobble_core::boot::{
-    optcr_with_bor_level3, panic_streak, BorCheck, BorLevel, ResetCause, FAULT_RESET_MARK,
-    FLASH_SR_ERRORS,
+    crystal_failed_last_run, optcr_with_bor_level3, panic_streak, BorCheck, BorLevel, ResetCause,
+    CRYSTAL_FAILED_MARK, FAULT_RESET_MARK, FLASH_SR_ERRORS,
 };
 
 use crate::clocks::HSE_STARTUP_TIMEOUT_MS;
@@ -222,26 +222,30 @@ unsafe fn DefaultHandler(irqn: i16) {
     defmt::error!("unexpected interrupt {}: masked", irqn);
 }
 
-/// The failure-reset streak kept across resets: a magic word, the count
-/// and the fault handler's mark ([`FAULT_RESET_MARK`]), in `.uninit` (not
+/// The failure-reset streak kept across resets: a magic word, the count,
+/// the fault handler's mark ([`FAULT_RESET_MARK`]) and the clock security
+/// handler's ([`CRYSTAL_FAILED_MARK`]), in `.uninit` (not
 /// zeroed at reset; noise after a power-on, which the magic word tells
 /// apart).
 #[link_section = ".uninit.PANIC_STREAK"]
-static mut PANIC_STREAK: MaybeUninit<[u32; 3]> = MaybeUninit::uninit();
+static mut PANIC_STREAK: MaybeUninit<[u32; 4]> = MaybeUninit::uninit();
 const STREAK_MAGIC: u32 = 0x5742_4C21;
 
 fn keep_streak(n: u32) {
     // SAFETY: written only in thread mode (boot, then the watchdog task)
     // and by the hard fault handler on its way to a reset, never borrowed.
-    unsafe { addr_of_mut!(PANIC_STREAK).write_volatile(MaybeUninit::new([STREAK_MAGIC, n, 0])) }
+    unsafe { addr_of_mut!(PANIC_STREAK).write_volatile(MaybeUninit::new([STREAK_MAGIC, n, 0, 0])) }
 }
 
 /// This boot's failure-reset streak (`wobble_core::boot::panic_streak`:
 /// panics, faults and watchdog resets in a row; a debug probe's reset is a
-/// fresh start), kept for the next boot with the fault mark cleared.
-pub fn take_panic_streak(cause: ResetCause) -> u32 {
-    // SAFETY: as in `keep_streak`; any bit pattern is a valid `[u32; 3]`.
-    let [magic, count, mark] = unsafe { addr_of_mut!(PANIC_STREAK).read_volatile().assume_init() };
+/// fresh start), kept for the next boot with the fault mark cleared; and
+/// whether the last run ended in the clock security system's reset
+/// (`boot::crystal_failed_last_run`, the mark cleared too).
+pub fn take_panic_streak(cause: ResetCause) -> (u32, bool) {
+    // SAFETY: as in `keep_streak`; any bit pattern is a valid `[u32; 4]`.
+    let [magic, count, mark, crystal] =
+        unsafe { addr_of_mut!(PANIC_STREAK).read_volatile().assume_init() };
     let valid = magic == STREAK_MAGIC;
     let n = panic_streak(
         valid.then_some(count),
@@ -249,7 +253,7 @@ pub fn take_panic_streak(cause: ResetCause) -> u32 {
         valid && mark == FAULT_RESET_MARK,
     );
     keep_streak(n);
-    n
+    (n, crystal_failed_last_run(valid, crystal))
 }
 
 /// The logger ran long enough: the next failure starts a new streak.
@@ -277,14 +281,24 @@ pub fn enable_clock_security() {
 }
 
 /// The crystal failed (the clock security system's NMI; nothing else
-/// raises it here). The CSS flag is cleared (else the NMI repeats) and the
-/// MCU resets: the boot then finds no crystal, runs the whole clock tree
-/// from the HSI and records system fault 9, so every timer, baud rate and
-/// sample time is right again instead of 16 MHz HSI under a 168 MHz set-up.
+/// raises it here). The CSS flag is cleared (else the NMI repeats), the
+/// failure is marked in RAM that survives the reset
+/// (`boot::CRYSTAL_FAILED_MARK`) and the MCU resets: the boot then logs it
+/// from thread mode and records system fault 9, finds no crystal and runs
+/// the whole clock tree from the HSI, so every timer, baud rate and sample
+/// time is right again instead of 16 MHz HSI under a 168 MHz set-up. No
+/// defmt here: the NMI preempts everything, a defmt call in progress
+/// included, and a second one inside it would corrupt the stream (its
+/// critical section cannot mask the NMI).
 #[exception]
 unsafe fn NonMaskableInt() {
     RCC.cir().modify(|w| w.set_cssc(true));
-    defmt::error!("crystal failed (clock security system): reset to run from the HSI");
+    // SAFETY: as in `mark_fault_reset`: nothing runs after this handler but
+    // the reset; a single word write.
+    unsafe {
+        let words = addr_of_mut!(PANIC_STREAK).cast::<u32>();
+        words.add(3).write_volatile(CRYSTAL_FAILED_MARK);
+    }
     cortex_m::peripheral::SCB::sys_reset()
 }
 

@@ -98,7 +98,10 @@ fn record(ev: GpsEvent, shared: &SharedStatus) -> Record<'static> {
             }
             Record::Gps(fix)
         }
-        GpsEvent::UtcSync(sync) => Record::UtcSync(sync),
+        GpsEvent::UtcSync(sync) => {
+            shared.set_utc(sync);
+            Record::UtcSync(sync)
+        }
         GpsEvent::Fault(fault) => Record::Fault(fault),
     }
 }

@@ -65,6 +65,9 @@ pub struct OperationSpi<B, CS> {
     clock: Clock,
     /// While an operation runs: when its budget ends.
     deadline_us: Option<u64>,
+    /// The last single byte received in the current (or last) operation:
+    /// after a failed write, the card's data response token.
+    last_byte: Option<u8>,
 }
 
 impl<B: SpiBus, CS: OutputPin> OperationSpi<B, CS> {
@@ -76,6 +79,7 @@ impl<B: SpiBus, CS: OutputPin> OperationSpi<B, CS> {
             cs,
             clock,
             deadline_us: None,
+            last_byte: None,
         }
     }
 
@@ -89,8 +93,15 @@ impl<B: SpiBus, CS: OutputPin> OperationSpi<B, CS> {
     /// # Errors
     /// [`Error::ChipSelect`].
     pub fn begin(&mut self) -> Result<(), Error<B::Error>> {
+        self.last_byte = None;
         self.deadline_us = Some((self.clock)().saturating_add(CARD_OPERATION_BUDGET_US));
         self.cs.set_low().map_err(|_| Error::ChipSelect)
+    }
+
+    /// The last single byte received since [`Self::begin`] (embedded-sdmmc
+    /// reads each response and token one byte at a time), if any.
+    pub fn last_byte(&self) -> Option<u8> {
+        self.last_byte
     }
 
     /// Deselects the card, then clocks one byte so that it releases MISO
@@ -130,6 +141,15 @@ impl<B: SpiBus, CS: OutputPin> OperationSpi<B, CS> {
                 Operation::DelayNs(_) => return Err(Error::Unsupported),
             }
             .map_err(Error::Bus)?;
+            match op {
+                Operation::Read(buf) | Operation::TransferInPlace(buf) if buf.len() == 1 => {
+                    self.last_byte = Some(buf[0]);
+                }
+                Operation::Transfer(read, _) if read.len() == 1 => {
+                    self.last_byte = Some(read[0]);
+                }
+                _ => {}
+            }
         }
         Ok(())
     }

@@ -15,7 +15,12 @@
 //! and does both before the next access. A card whose blocks keep failing
 //! their CRC, read or written (long wires, a marginal socket), runs at half
 //! the clock after [`CRC_ERRORS_BEFORE_SLOWING`] in a row, down to
-//! [`MIN_DATA_CLOCK_HZ`].
+//! [`MIN_DATA_CLOCK_HZ`]. Only a CRC failure counts ([`classify`]): a
+//! pulled card's write error (its data response reads 0xFF) does not. The
+//! clock goes back up: doubled (to the nominal clock at most) after
+//! [`CLEAN_TRANSFERS_BEFORE_RAISING`] block transfers in a row without an
+//! error, and straight to the nominal clock when a card that was gone is
+//! identified again (another card, or the same one seated anew).
 
 use core::cell::Cell;
 
@@ -38,6 +43,49 @@ pub const CRC_ERRORS_BEFORE_SLOWING: u32 = 3;
 /// The data clock is never lowered below this (8 × the identification
 /// clock: a 512-byte block still moves in under 2 ms).
 pub const MIN_DATA_CLOCK_HZ: u32 = 2_600_000;
+
+/// Error-free block transfers in a row after which a lowered data clock is
+/// doubled (at 100 blocks a second of logging: about 10 s).
+pub const CLEAN_TRANSFERS_BEFORE_RAISING: u32 = 1000;
+
+/// Mask of the status bits of a data response token (SD spec 7.3.3.1).
+const DATA_RESPONSE_MASK: u8 = 0x1F;
+/// Data response token: the data was rejected for a CRC error.
+const DATA_RESPONSE_CRC_ERROR: u8 = 0x0B;
+
+/// What a card error says about the card and its line.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum ErrorClass {
+    /// The signal was corrupted: a read block's CRC mismatch, or a written
+    /// block the card rejected for its CRC.
+    Crc,
+    /// Nobody answered: the bus read idle-high (a missing card pulled up),
+    /// a command or a data token never came.
+    Gone,
+    /// Anything else (the card refused a command, a bus or timing fault).
+    Other,
+}
+
+/// Classifies `error`; `last_byte` is the last byte received in the failed
+/// operation. embedded-sdmmc 0.10 reports every data response but
+/// "accepted" as the same [`SdCardError::WriteError`]: the token itself
+/// (0x0B a CRC error; 0xFF nothing on the line) tells them apart.
+pub fn classify(error: &SdCardError, last_byte: Option<u8>) -> ErrorClass {
+    match error {
+        SdCardError::CrcError(..) => ErrorClass::Crc,
+        SdCardError::WriteError => match last_byte {
+            Some(0xFF) => ErrorClass::Gone,
+            Some(b) if b & DATA_RESPONSE_MASK == DATA_RESPONSE_CRC_ERROR => ErrorClass::Crc,
+            _ => ErrorClass::Other,
+        },
+        SdCardError::CardNotFound
+        | SdCardError::TimeoutCommand(_)
+        | SdCardError::TimeoutACommand(_)
+        | SdCardError::TimeoutReadBuffer => ErrorClass::Gone,
+        _ => ErrorClass::Other,
+    }
+}
 
 /// The card driver with CRC checking on and [`ACQUIRE_RETRIES`]. Nothing is
 /// sent until the first block access (or `get_card_type`).
@@ -68,9 +116,13 @@ pub struct CardHooks<B> {
 pub struct Card<B: SpiBus, CS: OutputPin, D: DelayNs> {
     card: SdCard<OperationSpi<B, CS>, D>,
     hooks: CardHooks<B>,
+    nominal_clock_hz: u32,
     data_clock_hz: Cell<u32>,
     crc_errors_in_row: Cell<u32>,
+    clean_transfers: Cell<u32>,
     identified: Cell<bool>,
+    /// The last error said the card was gone.
+    gone: Cell<bool>,
 }
 
 impl<B: SpiBus, CS: OutputPin, D: DelayNs> Card<B, CS, D> {
@@ -80,9 +132,12 @@ impl<B: SpiBus, CS: OutputPin, D: DelayNs> Card<B, CS, D> {
         Self {
             card: sd_card(OperationSpi::new(bus, cs, hooks.now_us), delay),
             hooks,
+            nominal_clock_hz: data_clock_hz,
             data_clock_hz: Cell::new(data_clock_hz),
             crc_errors_in_row: Cell::new(0),
+            clean_transfers: Cell::new(0),
             identified: Cell::new(false),
+            gone: Cell::new(false),
         }
     }
 
@@ -106,6 +161,12 @@ impl<B: SpiBus, CS: OutputPin, D: DelayNs> Card<B, CS, D> {
             .map_err(|_| SdCardError::Transport)?;
         // Reading the size identifies the card and proves it answers.
         self.operation(|card| card.num_blocks())?;
+        if self.gone.replace(false) {
+            // A card was pulled: this one starts afresh.
+            self.data_clock_hz.set(self.nominal_clock_hz);
+            self.crc_errors_in_row.set(0);
+            self.clean_transfers.set(0);
+        }
         self.set_clock(self.data_clock_hz.get());
         self.identified.set(true);
         Ok(())
@@ -121,21 +182,31 @@ impl<B: SpiBus, CS: OutputPin, D: DelayNs> Card<B, CS, D> {
             .spi(OperationSpi::begin)
             .map_err(|_| SdCardError::Transport)
             .and_then(|()| op(&self.card));
+        let last_byte = self.card.spi(|s| s.last_byte());
         let ended = self.card.spi(OperationSpi::end);
         (self.hooks.after_operation)();
-        self.settle(result.and_then(|v| ended.map(|()| v).map_err(|_| SdCardError::Transport)))
+        self.settle(
+            result.and_then(|v| ended.map(|()| v).map_err(|_| SdCardError::Transport)),
+            last_byte,
+        )
     }
 
     /// Passes `result` on; after an error the card is identified again
-    /// before the next access, and CRC failures are counted.
-    fn settle<T>(&self, result: Result<T, SdCardError>) -> Result<T, SdCardError> {
+    /// before the next access, and CRC failures are counted ([`classify`]:
+    /// a written block's rejected CRC as much as a read one's mismatch, a
+    /// pulled card's silence not at all).
+    fn settle<T>(
+        &self,
+        result: Result<T, SdCardError>,
+        last_byte: Option<u8>,
+    ) -> Result<T, SdCardError> {
         if let Err(e) = &result {
             self.identified.set(false);
-            // embedded-sdmmc 0.10 reports a written block's rejected CRC
-            // (data response 0x0B) as a write error: the line is as bad
-            // going out as a read CRC mismatch shows it coming in.
-            if matches!(e, SdCardError::CrcError(..) | SdCardError::WriteError) {
-                self.count_crc_error();
+            self.clean_transfers.set(0);
+            match classify(e, last_byte) {
+                ErrorClass::Crc => self.count_crc_error(),
+                ErrorClass::Gone => self.gone.set(true),
+                ErrorClass::Other => {}
             }
         }
         result
@@ -151,8 +222,26 @@ impl<B: SpiBus, CS: OutputPin, D: DelayNs> Card<B, CS, D> {
         let result = self.operation(op);
         if result.is_ok() {
             self.crc_errors_in_row.set(0);
+            self.count_clean_transfer();
         }
         result
+    }
+
+    /// A lowered clock is doubled after enough clean transfers in a row.
+    fn count_clean_transfer(&self) {
+        let hz = self.data_clock_hz.get();
+        if hz >= self.nominal_clock_hz {
+            return;
+        }
+        let n = self.clean_transfers.get() + 1;
+        if n < CLEAN_TRANSFERS_BEFORE_RAISING {
+            self.clean_transfers.set(n);
+            return;
+        }
+        self.clean_transfers.set(0);
+        let faster = hz.saturating_mul(2).min(self.nominal_clock_hz);
+        self.data_clock_hz.set(faster);
+        self.set_clock(faster);
     }
 
     fn count_crc_error(&self) {

@@ -134,6 +134,63 @@ impl TimeSource for FixedTime {
     }
 }
 
+/// The files' time stamps from the GPS's UTC once it is known
+/// ([`crate::channels::SharedStatus::set_utc`]), [`FixedTime::EPOCH`]
+/// before. embedded-sdmmc 0.10 asks for the time when it creates a file
+/// (creation and modification time) and at every write (modification time,
+/// kept in the open file's directory entry in RAM): the entry reaches the
+/// card with the flush that writes it anyway, so the time costs no write of
+/// its own.
+#[derive(Clone, Copy)]
+pub struct GpsTime<'a> {
+    shared: &'a crate::channels::SharedStatus,
+    now_us: fn() -> u64,
+}
+
+impl<'a> GpsTime<'a> {
+    /// Time stamps from the UTC that `shared` holds, at `now_us` (µs since
+    /// boot).
+    pub const fn new(shared: &'a crate::channels::SharedStatus, now_us: fn() -> u64) -> Self {
+        Self { shared, now_us }
+    }
+}
+
+/// The FAT time stamp of `unix_s` (UTC), `None` outside FAT's 1980-2107
+/// (and embedded-sdmmc's 1970-2097).
+#[must_use]
+pub fn fat_timestamp(unix_s: u64) -> Option<embedded_sdmmc::Timestamp> {
+    const DAYS_1970_TO_2000: u64 = 10_957;
+    let days = unix_s / 86_400;
+    let secs = unix_s % 86_400;
+    let days_since_2000 = u16::try_from(days.checked_sub(DAYS_1970_TO_2000)?).ok()?;
+    let (year, month, day) = crate::format::UtcTime {
+        days_since_2000,
+        ms_of_day: 0,
+    }
+    .date();
+    if year < 1980 {
+        return None;
+    }
+    embedded_sdmmc::Timestamp::from_calendar(
+        u16::try_from(year).ok()?,
+        month as u8,
+        day as u8,
+        (secs / 3600) as u8,
+        (secs / 60 % 60) as u8,
+        (secs % 60) as u8,
+    )
+    .ok()
+}
+
+impl TimeSource for GpsTime<'_> {
+    fn get_timestamp(&self) -> embedded_sdmmc::Timestamp {
+        self.shared
+            .unix_s((self.now_us)())
+            .and_then(fat_timestamp)
+            .unwrap_or(FixedTime::EPOCH.0)
+    }
+}
+
 /// Where the logger stands.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]

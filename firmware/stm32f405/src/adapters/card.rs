@@ -31,8 +31,13 @@ fn set_clock(bus: &mut CardBus, hz: u32) {
     if bus.set_config(&spi_config(hz)).is_err() {
         defmt::warn!("card SPI: clock {} Hz refused", hz);
     } else if hz < CARD_SPI_HZ && hz > wobble_core::drivers::sdcard::IDENTIFICATION_CLOCK_HZ {
-        // Only after repeated CRC errors (logged at each identification).
-        defmt::warn!("card SPI: data clock lowered to {} Hz", hz);
+        // Lowered after repeated CRC errors, raised again step by step
+        // after clean transfers (logged at each identification and change).
+        defmt::warn!(
+            "card SPI: data clock {} Hz (nominal {} Hz)",
+            hz,
+            CARD_SPI_HZ
+        );
     }
 }
 
