@@ -244,7 +244,12 @@ fn stretches_under_two_seconds_are_not_analysed() {
 /// of 4 degrees, then a 6.5 Hz ring of 1.5 degrees decaying at 0.8/s), over
 /// small deterministic noise.
 fn kicked_ride() -> Run {
-    let mut ride = Ride::new(600.0, 3.0, 0.0, 0.5, 0.0);
+    kicked_ride_of(600.0)
+}
+
+/// [`kicked_ride`] lasting `duration_s`.
+fn kicked_ride_of(duration_s: f64) -> Run {
+    let mut ride = Ride::new(duration_s, 3.0, 0.0, 0.5, 0.0);
     let mut state = 0x9E37_79B9u32;
     for (t, s) in ride.t_s.iter().zip(ride.steer_deg.iter_mut()) {
         state ^= state << 13;
@@ -333,10 +338,13 @@ fn kicks_found_before_the_settled_time_are_final() {
 
 /// A stable episode that is one of the host's kicks takes the kick's values
 /// without a fit of its own: its fitted stretch is the kick's, to the
-/// sample, and its frequency and growth rate are the kick's.
+/// sample, and its frequency and growth rate are the kick's. The ride is
+/// long enough (25 min) for the episode search to measure episodes before
+/// the log ends, so frames must wait for the kicks.
 #[test]
 fn a_kicked_episode_is_the_kick_search_s_measurement() {
-    let run = kicked_ride();
+    let run = kicked_ride_of(1500.0);
+    assert!(run.len() > 2 * wobblog::analysis::search::CHUNK_FRAMES);
     // The wheel of the default configuration, as the run has no other.
     let wheel_m = wobblog::cmd::detect::wheel_circumference_m(&[]).unwrap();
     let kicks = wobblog::analysis::find_kicks(&run, wheel_m);
