@@ -3,6 +3,7 @@ frames in one pass, looks for a pending KeyboardInterrupt while it works
 without the GIL, instead of finishing first."""
 
 import _thread
+import signal
 import threading
 import time
 
@@ -20,7 +21,17 @@ def long_log(tmp_path_factory):
     return encode("\n".join(lines) + "\n", tmp_path_factory.mktemp("long"), "RUN00001")
 
 
-def test_ctrl_c_stops_open_before_it_ends(long_log):
+@pytest.fixture
+def ctrl_c_raises():
+    """Python's own SIGINT handler for the test: a process started in the
+    background by a non-interactive shell inherits SIGINT ignored, and then
+    Python installs no handler and `interrupt_main` does nothing."""
+    before = signal.signal(signal.SIGINT, signal.default_int_handler)
+    yield
+    signal.signal(signal.SIGINT, before)
+
+
+def test_ctrl_c_stops_open_before_it_ends(long_log, ctrl_c_raises):
     start = time.perf_counter()
     whole = wobblog.open(long_log).frames()
     uninterrupted = time.perf_counter() - start
