@@ -11,7 +11,7 @@ mod sd_support;
 use std::cell::{Cell, RefCell};
 
 use embedded_hal_mock::eh1::delay::NoopDelay;
-use embedded_hal_mock::eh1::digital::Mock as PinMock;
+use embedded_hal_mock::eh1::digital::{Mock as PinMock, State};
 use embedded_hal_mock::eh1::spi::{Mock, Transaction};
 use embedded_sdmmc::{Block, BlockCount, BlockDevice, BlockIdx, SdCardError};
 use sd_support::*;
@@ -229,24 +229,7 @@ fn a_written_block_reaches_the_card_whole() {
 #[test]
 fn repeated_write_crc_rejections_halve_the_data_clock() {
     let block = Block::new();
-    let crc_rejected = 0x0B;
-    let rejected_write = || {
-        [
-            command(24, 42, R1_READY),
-            byte(0xFE, NOTHING),
-            written(&block.contents),
-            written(&crc16(&block.contents).to_be_bytes()),
-            byte(0xFF, crc_rejected),
-        ]
-        .concat()
-    };
-    let identify = || identification([sdhc_identification(), csd_read()].concat());
-    let mut expectations = Vec::new();
-    let mut pins = Vec::new();
-    for _ in 0..CRC_ERRORS_BEFORE_SLOWING {
-        expectations.extend([identify(), operation(rejected_write())].concat());
-        pins.extend([&IDENTIFY_CS[..], &OPERATION_CS].concat());
-    }
+    let (expectations, pins) = crc_rejections(&block);
     let mut spi = Mock::new(&expectations);
     let mut chip_select = PinMock::new(&cs(&pins));
     let card = card(&spi, &chip_select);
@@ -287,6 +270,21 @@ fn accepted_write(block: &Block) -> Spi {
     .concat()
 }
 
+/// The card's side of [`CRC_ERRORS_BEFORE_SLOWING`] writes of `block`, each
+/// after an identification, that the card rejects for their CRC (what
+/// slows the clock), and the chip-select levels they take.
+fn crc_rejections(block: &Block) -> (Spi, Vec<State>) {
+    let identify = || identification([sdhc_identification(), csd_read()].concat());
+    let mut expectations = Vec::new();
+    let mut pins = Vec::new();
+    for _ in 0..CRC_ERRORS_BEFORE_SLOWING {
+        expectations.extend([identify(), operation(crc_rejected_write(block))].concat());
+        pins.extend([&IDENTIFY_CS[..], &OPERATION_CS].concat());
+    }
+    (expectations, pins)
+}
+
+/// A block write the card rejects for its CRC (data response 0x0B).
 fn crc_rejected_write(block: &Block) -> Spi {
     [
         command(24, 42, R1_READY),
@@ -329,12 +327,7 @@ fn a_pulled_cards_write_errors_do_not_slow_the_clock() {
 fn clean_transfers_restore_the_data_clock() {
     let block = Block::new();
     let identify = || identification([sdhc_identification(), csd_read()].concat());
-    let mut expectations = Vec::new();
-    let mut pins = Vec::new();
-    for _ in 0..CRC_ERRORS_BEFORE_SLOWING {
-        expectations.extend([identify(), operation(crc_rejected_write(&block))].concat());
-        pins.extend([&IDENTIFY_CS[..], &OPERATION_CS].concat());
-    }
+    let (mut expectations, mut pins) = crc_rejections(&block);
     expectations.extend(identify());
     pins.extend(IDENTIFY_CS);
     for _ in 0..CLEAN_TRANSFERS_BEFORE_RAISING {
@@ -375,12 +368,7 @@ fn clean_transfers_restore_the_data_clock() {
 fn a_card_identified_after_removal_runs_at_the_nominal_clock() {
     let block = Block::new();
     let identify = || identification([sdhc_identification(), csd_read()].concat());
-    let mut expectations = Vec::new();
-    let mut pins = Vec::new();
-    for _ in 0..CRC_ERRORS_BEFORE_SLOWING {
-        expectations.extend([identify(), operation(crc_rejected_write(&block))].concat());
-        pins.extend([&IDENTIFY_CS[..], &OPERATION_CS].concat());
-    }
+    let (mut expectations, mut pins) = crc_rejections(&block);
     expectations.extend([identify(), operation(unanswered_write(&block))].concat());
     pins.extend([&IDENTIFY_CS[..], &OPERATION_CS].concat());
     expectations.extend([identify(), operation(csd_read())].concat());
