@@ -2,6 +2,9 @@
 //! GPS's UTC (`logger::GpsTime`), in the directory entry that the flush
 //! writes anyway.
 
+mod card_support;
+use card_support::{fat32_image, PART_START_BLOCKS};
+
 use std::io::Read;
 use std::sync::atomic::{AtomicU64, Ordering};
 
@@ -11,30 +14,12 @@ use wobble_core::format::UtcSync;
 use wobble_core::logger::mock::MockCard;
 use wobble_core::logger::{fat_timestamp, FixedTime, GpsTime};
 
-const PART_START_BLOCKS: u64 = 1;
 const CARD_BYTES: u64 = 40 << 20;
 
 static NOW_US: AtomicU64 = AtomicU64::new(0);
 
 fn now_us() -> u64 {
     NOW_US.load(Ordering::Relaxed)
-}
-
-fn fat32_image() -> Vec<u8> {
-    let mut image = vec![0u8; CARD_BYTES as usize];
-    let start = (PART_START_BLOCKS * 512) as usize;
-    let blocks = (CARD_BYTES / 512 - PART_START_BLOCKS) as u32;
-    let opts = fatfs::FormatVolumeOptions::new()
-        .fat_type(fatfs::FatType::Fat32)
-        .bytes_per_cluster(512);
-    fatfs::format_volume(std::io::Cursor::new(&mut image[start..]), opts).expect("format");
-    let entry = &mut image[446..462];
-    entry[4] = 0x0C;
-    entry[8..12].copy_from_slice(&(PART_START_BLOCKS as u32).to_le_bytes());
-    entry[12..16].copy_from_slice(&blocks.to_le_bytes());
-    image[510] = 0x55;
-    image[511] = 0xAA;
-    image
 }
 
 /// 2026-12-04 04:05:06 UTC, s since the Unix epoch.
@@ -68,7 +53,7 @@ fn calendar_of_unix_seconds() {
 /// and the card writes of the second write and flush.
 fn ride<T: TimeSource>(time: T, between: impl FnOnce()) -> (Vec<u8>, u32) {
     NOW_US.store(5_000_000, Ordering::Relaxed);
-    let card = MockCard::new(fat32_image());
+    let card = MockCard::new(fat32_image(CARD_BYTES, 512));
     let volumes: VolumeManager<_, _, 4, 4, 1> = VolumeManager::new(card, time);
     let volume = volumes.open_raw_volume(VolumeIdx(0)).expect("volume");
     let root = volumes.open_root_dir(volume).expect("root");

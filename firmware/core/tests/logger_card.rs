@@ -1,6 +1,9 @@
 //! The SD logger against an in-memory FAT32 card: file naming, header,
 //! whole-block writes, flushing, power cuts, missing, removed and full cards.
 
+mod card_support;
+use card_support::{fat32_image, PART_START_BLOCKS};
+
 use std::io::{Read, Seek, SeekFrom, Write};
 
 use embedded_sdmmc::{Mode, VolumeIdx, VolumeManager};
@@ -14,8 +17,6 @@ use wobble_core::logger::{
     FAULT_CARD_FORMAT, FAULT_CARD_FULL, FAULT_CARD_WRITE,
 };
 
-/// Partition start: one MBR sector, then the FAT32 volume.
-const PART_START_BLOCKS: u64 = 1;
 /// Smallest comfortable FAT32 volume with 512-byte clusters (65 525 needed).
 const CARD_BYTES: u64 = 40 << 20;
 const FRAME_PERIOD_US: u64 = 10_000;
@@ -34,24 +35,6 @@ type Logger = CardLogger<'static, MockCard, FixedTime>;
 
 fn logger(card: MockCard) -> Logger {
     CardLogger::new(card, FixedTime::EPOCH, header(), LoggerConfig::DEFAULT)
-}
-
-/// A card image: an MBR with one FAT32 (LBA) partition, formatted.
-fn fat32_image() -> Vec<u8> {
-    let mut image = vec![0u8; CARD_BYTES as usize];
-    let start = (PART_START_BLOCKS * 512) as usize;
-    let blocks = (CARD_BYTES / 512 - PART_START_BLOCKS) as u32;
-    let opts = fatfs::FormatVolumeOptions::new()
-        .fat_type(fatfs::FatType::Fat32)
-        .bytes_per_cluster(512);
-    fatfs::format_volume(std::io::Cursor::new(&mut image[start..]), opts).expect("format");
-    let entry = &mut image[446..462];
-    entry[4] = 0x0C; // FAT32 with LBA addressing
-    entry[8..12].copy_from_slice(&(PART_START_BLOCKS as u32).to_le_bytes());
-    entry[12..16].copy_from_slice(&blocks.to_le_bytes());
-    image[510] = 0x55;
-    image[511] = 0xAA;
-    image
 }
 
 fn with_fs<R>(
@@ -155,7 +138,7 @@ fn run(log: &mut Logger, from: u64, to: u64) {
 
 #[test]
 fn fresh_card_gets_run_one_with_header_then_every_frame() {
-    let mut log = logger(MockCard::new(fat32_image()));
+    let mut log = logger(MockCard::new(fat32_image(CARD_BYTES, 512)));
     run(&mut log, 0, 3000);
     assert_eq!(log.state(), LoggerState::Logging { run: 1 });
     log.close(3000 * FRAME_PERIOD_US).expect("close");
@@ -173,7 +156,7 @@ fn fresh_card_gets_run_one_with_header_then_every_frame() {
 
 #[test]
 fn a_closed_log_reads_back_through_a_new_file_system_on_the_same_card() {
-    let mut log = logger(MockCard::new(fat32_image()));
+    let mut log = logger(MockCard::new(fat32_image(CARD_BYTES, 512)));
     run(&mut log, 0, 700);
     log.close(700 * FRAME_PERIOD_US).expect("close");
     assert_eq!(log.stats().frames_on_card, 700);
@@ -196,7 +179,7 @@ fn a_closed_log_reads_back_through_a_new_file_system_on_the_same_card() {
 
 #[test]
 fn each_power_on_takes_the_next_free_run_number() {
-    let mut image = fat32_image();
+    let mut image = fat32_image(CARD_BYTES, 512);
     for run_no in 1..=3 {
         let mut log = logger(MockCard::new(image));
         run(&mut log, 0, 10);
@@ -214,7 +197,7 @@ fn each_power_on_takes_the_next_free_run_number() {
 
 #[test]
 fn flushes_keep_the_file_size_within_one_flush_period() {
-    let mut log = logger(MockCard::new(fat32_image()));
+    let mut log = logger(MockCard::new(fat32_image(CARD_BYTES, 512)));
     // No close: what a reader sees at any moment is what the last flush said.
     let mut start = 0;
     for end in [130u64, 777, 1500] {
@@ -242,7 +225,7 @@ fn flushes_keep_the_file_size_within_one_flush_period() {
 
 #[test]
 fn card_absent_at_boot_is_reported_with_the_exact_loss() {
-    let card = MockCard::new(fat32_image());
+    let card = MockCard::new(fat32_image(CARD_BYTES, 512));
     card.set_removed(true);
     let mut log = logger(card);
     run(&mut log, 0, 350);
@@ -295,7 +278,7 @@ fn an_exfat_card_is_unusable_not_absent_and_never_written() {
     log.with_device(|c| {
         assert_eq!(c.writes(), 0);
         assert_eq!(c.image(), exfat_image());
-        c.set_image(fat32_image());
+        c.set_image(fat32_image(CARD_BYTES, 512));
     });
     run(&mut log, 350, 600);
     assert_eq!(log.state(), LoggerState::Logging { run: 1 });
@@ -327,7 +310,7 @@ fn an_exfat_card_is_unusable_not_absent_and_never_written() {
 fn queue_dropouts_while_the_card_is_absent_join_the_count() {
     // The queue dropped 37 frames while the writer was busy with a card
     // that then went away: its dropout record must not vanish with them.
-    let card = MockCard::new(fat32_image());
+    let card = MockCard::new(fat32_image(CARD_BYTES, 512));
     card.set_removed(true);
     let mut log = logger(card);
     run(&mut log, 0, 100);
@@ -350,7 +333,7 @@ fn queue_dropouts_while_the_card_is_absent_join_the_count() {
 
 #[test]
 fn card_pulled_mid_run_loses_only_what_was_not_on_it() {
-    let mut log = logger(MockCard::new(fat32_image()));
+    let mut log = logger(MockCard::new(fat32_image(CARD_BYTES, 512)));
     run(&mut log, 0, 1234);
     log.with_device(|c| c.set_removed(true));
     run(&mut log, 1234, 1700);
@@ -388,7 +371,7 @@ fn card_pulled_mid_run_loses_only_what_was_not_on_it() {
 
 #[test]
 fn full_card_keeps_logging_and_counts_the_loss() {
-    let mut image = fat32_image();
+    let mut image = fat32_image(CARD_BYTES, 512);
     fill_card(&mut image, 16 * 1024);
     let mut log = logger(MockCard::new(image));
     run(&mut log, 0, 2000);
@@ -422,7 +405,7 @@ fn full_card_keeps_logging_and_counts_the_loss() {
 /// FAT), and a card that has room again is logged to.
 #[test]
 fn a_card_out_of_run_numbers_counts_as_full() {
-    let mut image = fat32_image();
+    let mut image = fat32_image(CARD_BYTES, 512);
     with_fs(&mut image, |fs| {
         fs.root_dir().create_file("RUN99999.WBL").expect("create");
     });
@@ -460,7 +443,7 @@ proptest! {
     /// loses at most one flush period, and never damages a written block.
     #[test]
     fn power_cut_loses_at_most_one_flush_period(cut_after_writes in 1u32..400) {
-        let card = MockCard::new(fat32_image());
+        let card = MockCard::new(fat32_image(CARD_BYTES, 512));
         card.set_fuel(Some(cut_after_writes));
         let mut log = logger(card);
         let mut flushed_frames = 0u32;

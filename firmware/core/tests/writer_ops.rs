@@ -3,6 +3,9 @@
 //! is sized for the worst iteration (`channels::WRITER_OPS_PER_ITERATION`),
 //! so no iteration of a long ride may make more, whatever the cluster size.
 
+mod card_support;
+use card_support::fat32_image;
+
 use core::future::Future;
 use core::pin::pin;
 use core::task::{Context, Poll, Waker};
@@ -28,24 +31,6 @@ fn header() -> HeaderSpec<'static> {
         sample_rate_hz: 100,
         config: &CONFIG,
     }
-}
-
-/// A card image: an MBR with one FAT32 partition at block 1, formatted
-/// with `cluster` bytes per cluster.
-fn fat32_image(cluster: u32) -> Vec<u8> {
-    let mut image = vec![0u8; CARD_BYTES as usize];
-    let blocks = (CARD_BYTES / 512 - 1) as u32;
-    let opts = fatfs::FormatVolumeOptions::new()
-        .fat_type(fatfs::FatType::Fat32)
-        .bytes_per_cluster(cluster);
-    fatfs::format_volume(std::io::Cursor::new(&mut image[512..]), opts).expect("format");
-    let entry = &mut image[446..462];
-    entry[4] = 0x0C;
-    entry[8..12].copy_from_slice(&1u32.to_le_bytes());
-    entry[12..16].copy_from_slice(&blocks.to_le_bytes());
-    image[510] = 0x55;
-    image[511] = 0xAA;
-    image
 }
 
 fn frame(i: u64) -> Record<'static> {
@@ -84,7 +69,7 @@ fn ride(frames: u64) -> impl Iterator<Item = (u64, Record<'static>)> {
 /// push, as `writer::run` does) while a file is open.
 fn iterations(cluster: u32, frames: u64) -> Vec<CardOps> {
     let mut log = CardLogger::new(
-        MockCard::new(fat32_image(cluster)),
+        MockCard::new(fat32_image(CARD_BYTES, cluster)),
         FixedTime::EPOCH,
         header(),
         LoggerConfig::DEFAULT,
@@ -169,7 +154,7 @@ fn the_writer_task_reports_its_worst_iterations() {
     let queue = RecordQueue::new();
     let shared = SharedStatus::new();
     let mut log = CardLogger::new(
-        MockCard::new(fat32_image(512)),
+        MockCard::new(fat32_image(CARD_BYTES, 512)),
         FixedTime::EPOCH,
         header(),
         LoggerConfig::DEFAULT,
