@@ -2,7 +2,7 @@
 //! whole-block writes, flushing, power cuts, missing, removed and full cards.
 
 mod card_support;
-use card_support::{fat32_image, PART_START_BLOCKS};
+use card_support::{fat32_image, header, PART_START_BLOCKS};
 
 use std::io::{Read, Seek, SeekFrom, Write};
 
@@ -13,8 +13,8 @@ use wobble_core::format::{
 };
 use wobble_core::logger::mock::MockCard;
 use wobble_core::logger::{
-    CardLogger, FixedTime, HeaderSpec, LoggerConfig, LoggerState, FAULT_CARD_ABSENT,
-    FAULT_CARD_FORMAT, FAULT_CARD_FULL, FAULT_CARD_WRITE,
+    CardLogger, FixedTime, LoggerConfig, LoggerState, FAULT_CARD_ABSENT, FAULT_CARD_FORMAT,
+    FAULT_CARD_FULL, FAULT_CARD_WRITE,
 };
 
 /// Smallest comfortable FAT32 volume with 512-byte clusters (65 525 needed).
@@ -22,19 +22,15 @@ const CARD_BYTES: u64 = 40 << 20;
 const FRAME_PERIOD_US: u64 = 10_000;
 const CONFIG: [&str; 2] = ["sample_rate_hz=100", "flush_period_ms=500"];
 
-fn header() -> HeaderSpec<'static> {
-    HeaderSpec {
-        firmware: "test",
-        device_id: [7; 12],
-        sample_rate_hz: 100,
-        config: &CONFIG,
-    }
-}
-
 type Logger = CardLogger<'static, MockCard, FixedTime>;
 
 fn logger(card: MockCard) -> Logger {
-    CardLogger::new(card, FixedTime::EPOCH, header(), LoggerConfig::DEFAULT)
+    CardLogger::new(
+        card,
+        FixedTime::EPOCH,
+        header(&CONFIG),
+        LoggerConfig::DEFAULT,
+    )
 }
 
 fn with_fs<R>(

@@ -4,7 +4,7 @@
 //! so no iteration of a long ride may make more, whatever the cluster size.
 
 mod card_support;
-use card_support::fat32_image;
+use card_support::{fat32_image, header};
 
 use core::future::Future;
 use core::pin::pin;
@@ -18,20 +18,11 @@ use wobble_core::channels::{
 };
 use wobble_core::format::{Frame, FrameStatus, GpsFix, Record};
 use wobble_core::logger::mock::MockCard;
-use wobble_core::logger::{CardLogger, CardOps, FixedTime, HeaderSpec, LoggerConfig, LoggerState};
+use wobble_core::logger::{CardLogger, CardOps, FixedTime, LoggerConfig, LoggerState};
 
 const CARD_BYTES: u64 = 40 << 20;
 const FRAME_PERIOD_US: u64 = 10_000;
 const CONFIG: [&str; 1] = ["sample_rate_hz=100"];
-
-fn header() -> HeaderSpec<'static> {
-    HeaderSpec {
-        firmware: "test",
-        device_id: [7; 12],
-        sample_rate_hz: 100,
-        config: &CONFIG,
-    }
-}
 
 fn frame(i: u64) -> Record<'static> {
     Record::Frame(Frame {
@@ -71,7 +62,7 @@ fn iterations(cluster: u32, frames: u64) -> Vec<CardOps> {
     let mut log = CardLogger::new(
         MockCard::new(fat32_image(CARD_BYTES, cluster)),
         FixedTime::EPOCH,
-        header(),
+        header(&CONFIG),
         LoggerConfig::DEFAULT,
     );
     let mut out = Vec::new();
@@ -156,7 +147,7 @@ fn the_writer_task_reports_its_worst_iterations() {
     let mut log = CardLogger::new(
         MockCard::new(fat32_image(CARD_BYTES, 512)),
         FixedTime::EPOCH,
-        header(),
+        header(&CONFIG),
         LoggerConfig::DEFAULT,
     );
     let mut records = ride(3_000).map(|(_, r)| r).peekable();

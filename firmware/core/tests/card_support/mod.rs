@@ -1,5 +1,18 @@
 //! Card images for the logger's tests, formatted by the `fatfs` crate (an
 //! implementation independent of the logger's).
+#![allow(dead_code)] // Each test file uses the helpers it needs.
+
+use wobble_core::logger::HeaderSpec;
+
+/// The header of a 100 Hz test logger with `config` lines.
+pub fn header(config: &'static [&'static str]) -> HeaderSpec<'static> {
+    HeaderSpec {
+        firmware: "test",
+        device_id: [7; 12],
+        sample_rate_hz: 100,
+        config,
+    }
+}
 
 /// The partition starts at this block, after the MBR.
 pub const PART_START_BLOCKS: u64 = 1;
