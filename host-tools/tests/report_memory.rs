@@ -109,6 +109,7 @@ fn ride(frames: usize) -> Ride {
         episodes: Vec::new(),
         distance_m: 0.0,
         max_speed_mps: 0.0,
+        host_kicks: None,
     }
 }
 

@@ -22,6 +22,7 @@ use wobble_core::format::KickRingDown;
 
 use super::kicks::{find_kicks, Kick, KickSearch};
 use super::run::{read_rows, stream_rows, Run};
+use super::Ride;
 use crate::cmd::detect::wheel_circumference_m;
 use crate::summary::{Summary, SummaryBuilder};
 use crate::CliError;
@@ -192,7 +193,7 @@ pub const CARD_SPEED_SPAN_S: f64 = 2.0;
 
 /// The mean wheel speed over `[t, t + CARD_SPEED_SPAN_S]` for each of some
 /// times `t`, gathered from frames in file order (a log's or a run's).
-struct SpeedsAfter {
+pub struct SpeedsAfter {
     /// Each time, the sum of the speeds in its span and their count, in
     /// time order.
     spans: Vec<(f64, f64, usize)>,
@@ -200,7 +201,8 @@ struct SpeedsAfter {
 
 impl SpeedsAfter {
     /// The speeds after the card records of `records` that have none.
-    fn for_records(records: &[KickRingDown]) -> Self {
+    #[must_use]
+    pub fn for_records(records: &[KickRingDown]) -> Self {
         let mut times: Vec<f64> = records
             .iter()
             .map(CardKick::from)
@@ -214,12 +216,15 @@ impl SpeedsAfter {
         }
     }
 
-    fn is_empty(&self) -> bool {
+    /// Whether no record needs a speed (then no frame need be pushed).
+    #[must_use]
+    pub fn is_empty(&self) -> bool {
         self.spans.is_empty()
     }
 
     /// Takes a frame at `t_s` with wheel speed `speed_mps`.
-    fn push(&mut self, t_s: f64, speed_mps: f64) {
+    /// Adds the frame at `t_s` with wheel speed `speed_mps`.
+    pub fn push(&mut self, t_s: f64, speed_mps: f64) {
         // Every span holding `t_s` starts at or before it and less than a
         // span (and rounding) before it.
         let first = self
@@ -234,7 +239,9 @@ impl SpeedsAfter {
     }
 
     /// The mean speed over the span after `t_s` (`None`: no frame in it).
-    fn after(&self, t_s: f64) -> Option<f64> {
+    /// The mean speed after the record at `t_s`, if frames followed it.
+    #[must_use]
+    pub fn after(&self, t_s: f64) -> Option<f64> {
         let i = self.spans.partition_point(|s| s.0 < t_s);
         let &(from, sum, n) = self.spans.get(i)?;
         (from == t_s && n > 0).then(|| sum / n as f64)
@@ -294,6 +301,29 @@ pub fn load_campaign_kicks(
     }
     let kicks = combine(host, &summary.kick_records, prefer, |t| speeds.after(t));
     Ok((summary, kicks))
+}
+
+/// The kicks of the log `ride` analysed (in time order), taken as
+/// `prefer` says: what [`load_campaign_kicks`] gives for the same log
+/// without reading it again, the host's kicks being those the analysis
+/// measured. `speeds` holds the log's frames' speeds after its card
+/// records that have none ([`SpeedsAfter::for_records`]).
+///
+/// # Errors
+/// The log's config is refused, as for every kick command.
+pub fn ride_campaign_kicks(
+    ride: &Ride,
+    prefer: Prefer,
+    speeds: &SpeedsAfter,
+) -> Result<Vec<CampaignKick>, CliError> {
+    wheel_circumference_m(&ride.summary.config)?;
+    let host = match (&ride.host_kicks, prefer) {
+        (Some(kicks), Prefer::Host | Prefer::Best) => kicks.clone(),
+        _ => Vec::new(),
+    };
+    Ok(combine(host, &ride.summary.kick_records, prefer, |t| {
+        speeds.after(t)
+    }))
 }
 
 /// The kicks of a log (in time order) from the host's measurements `host`

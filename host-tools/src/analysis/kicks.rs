@@ -315,10 +315,16 @@ fn envelope(x: &[f64], window: usize) -> Vec<f64> {
         .collect()
 }
 
+/// The `q` quantile of `v` (the element at `q` of the way through it in
+/// order), by selection rather than a sort: the search takes one of each
+/// piece of up to [`PIECE_FRAMES`] frames, where sorting was a fifth of
+/// the time an analysis of a kick campaign took.
 fn quantile(mut v: Vec<f64>, q: f64) -> f64 {
-    v.sort_by(f64::total_cmp);
     let i = ((v.len() as f64 - 1.0) * q).round() as usize;
-    v.get(i).copied().unwrap_or(0.0)
+    if i >= v.len() {
+        return 0.0;
+    }
+    *v.select_nth_unstable_by(i, f64::total_cmp).1
 }
 
 impl Stretch<'_> {
@@ -449,5 +455,20 @@ mod tests {
             assert_eq!(search.most_held(), 0, "{fs}");
             assert!(search.finish().is_empty(), "{fs}");
         }
+    }
+
+    /// The quantile is the element at its place in sorted order, worked
+    /// out here by sorting; nothing for no values.
+    #[test]
+    fn quantile_is_the_sorted_element() {
+        let v: Vec<f64> = (0..1001).map(|i| f64::from((i * 7919) % 1001)).collect();
+        let mut sorted = v.clone();
+        sorted.sort_by(f64::total_cmp);
+        for q in [0.0_f64, 0.2, 0.5, 0.999, 1.0] {
+            let i = (1000.0 * q).round() as usize;
+            assert_eq!(quantile(v.clone(), q), sorted[i], "{q}");
+        }
+        assert_eq!(quantile(vec![3.0, 1.0, 2.0], 0.2), 1.0);
+        assert_eq!(quantile(Vec::new(), 0.2), 0.0);
     }
 }

@@ -16,7 +16,7 @@ use std::path::{Path, PathBuf};
 use super::campaign_kicks::MATCH_S;
 use super::filter::follows;
 use super::kick_episodes::give_kick_values;
-use super::kicks::KickSearch;
+use super::kicks::{Kick, KickSearch};
 use super::run::{log_name, stream_rows};
 use super::search::EpisodeSearch;
 use super::{Episode, Run};
@@ -40,6 +40,9 @@ pub struct Ride {
     pub distance_m: f64,
     /// Highest wheel speed, m/s.
     pub max_speed_mps: f64,
+    /// The kicks the host measured, as `wobblog margin` finds them
+    /// (`None` when the log's config gives no wheel).
+    pub host_kicks: Option<Vec<Kick>>,
 }
 
 impl Ride {
@@ -142,8 +145,8 @@ impl Analyser {
             kicks
         });
         let mut episodes = self.search.finish(&summary.losses);
-        if let Some(kicks) = kicks {
-            give_kick_values(&mut episodes, kicks, &summary.kick_records);
+        if let Some(kicks) = &kicks {
+            give_kick_values(&mut episodes, kicks.clone(), &summary.kick_records);
         }
         Ride {
             path: path.to_path_buf(),
@@ -151,6 +154,7 @@ impl Analyser {
             summary,
             distance_m: self.distance_m,
             max_speed_mps: self.max_speed_mps,
+            host_kicks: kicks,
         }
     }
 }

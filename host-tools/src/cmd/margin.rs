@@ -242,11 +242,28 @@ pub fn campaign(
     keys: &[String],
 ) -> Result<(Report, Margin, Result<(), CliError>), CliError> {
     let (rows, result) = gather(logs, prefer);
+    let (report, margin) = campaign_of(rows, trend, ride_margin, params, keys)?;
+    Ok((report, margin, result))
+}
+
+/// The report of the kicks `rows` and the prediction made from them, with
+/// the model in `params` fitted to them (its `keys`) when given: what
+/// [`campaign`] makes of the kicks it gathers.
+///
+/// # Errors
+/// The model's parameter file cannot be read or fitted.
+pub fn campaign_of(
+    rows: Vec<KickRow>,
+    trend: Trend,
+    ride_margin: f64,
+    params: Option<&Path>,
+    keys: &[String],
+) -> Result<(Report, Margin), CliError> {
     let (mut report, margin) = report(rows, trend, ride_margin);
     if let Some(params) = params {
         add_model(&mut report, params, keys)?;
     }
-    Ok((report, margin, result))
+    Ok((report, margin))
 }
 
 /// Fits `keys` (the default ones when empty) of the model in `params` to

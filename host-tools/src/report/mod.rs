@@ -13,10 +13,9 @@ pub mod track;
 
 use std::path::{Path, PathBuf};
 
-use crate::analysis::campaign_kicks::Prefer;
 use crate::analysis::margin::{Trend, RIDE_MARGIN};
-use crate::cmd::logs::for_each_log;
-use crate::cmd::margin::{self, Report as MarginReport};
+use crate::cmd::logs::{for_each_log, warn_losses};
+use crate::cmd::margin::{self, KickRow, Report as MarginReport};
 use crate::cmd::model::episodes::LoggedEpisode;
 use crate::plot::modes::ModePlot;
 use crate::plot::svg_inline;
@@ -48,14 +47,29 @@ impl Campaign {
     /// missed a run would mislead.
     pub fn load(logs: &[PathBuf], params: Option<&Path>) -> Result<Self, CliError> {
         let mut rides = Vec::new();
-        // The losses are warned of once, as `margin` reads the kicks below.
         for_each_log(logs, "reading", |log| {
-            rides.push(RideView::load(log)?);
+            let ride = RideView::load(log)?;
+            warn_losses(log, &ride.summary);
+            rides.push(ride);
             Ok(())
         })?;
-        let (margin, prediction, read) =
-            margin::campaign(logs, Prefer::Best, Trend::Line, RIDE_MARGIN, params, &[])?;
-        read?;
+        // The kicks as `margin` gathers them: log by log, each in time
+        // order (moved, not copied: a log can hold 100 000 card records).
+        let rows = rides
+            .iter_mut()
+            .flat_map(|r| {
+                let log = &r.path;
+                std::mem::take(&mut r.kicks)
+                    .into_iter()
+                    .map(|kick| KickRow {
+                        log: log.clone(),
+                        kick,
+                        used: false,
+                    })
+            })
+            .collect();
+        let (margin, prediction) =
+            margin::campaign_of(rows, Trend::Line, RIDE_MARGIN, params, &[])?;
         let margin_words = margin::answer_text(&margin, logs.len());
         let margin_svg = svg_inline(&margin::figure(&margin, prediction));
         let modes_svg = match params {

@@ -12,6 +12,7 @@ use wobble_core::format::{Event, Record};
 use super::series::{Series, SeriesBuilder, Values, CHANNELS};
 use super::spectrogram::{Spectrogram, SpectrogramBuilder};
 use super::track::TrackBuilder;
+use crate::analysis::campaign_kicks::{ride_campaign_kicks, CampaignKick, Prefer, SpeedsAfter};
 use crate::analysis::roll::RollStream;
 use crate::analysis::run::read_rows;
 use crate::analysis::{Episode, Ride, Run, Stability};
@@ -79,22 +80,39 @@ pub struct RideView {
     pub track_svg: Option<String>,
     /// The damage in words, as `info` and `margin` warn.
     pub damage: Vec<String>,
+    /// The run's kicks as `margin` takes them (`Prefer::Best`), until the
+    /// campaign takes them over ([`super::Campaign::load`]).
+    #[serde(skip)]
+    pub kicks: Vec<CampaignKick>,
 }
 
 impl RideView {
     /// Reads and analyses the log at `path` in two passes over it, neither
     /// holding the run: the first finds the episodes (the `Ride` analysis
     /// every command makes), the second draws the frames around them
-    /// ([`Drawing`]) and lists the log's events.
+    /// ([`Drawing`]), lists the log's events and gives the speeds after
+    /// the card's kick records that have none, so the kicks `margin` takes
+    /// need no pass of their own.
+    ///
+    /// # Errors
+    /// The log cannot be read or has no frames, or its config is refused.
     pub fn load(path: &Path) -> Result<Self, CliError> {
         let ride = Ride::load(path)?;
         let mut drawing = Drawing::new(&ride);
         let mut listing = EventListing::new(&ride.summary.utc_syncs);
+        let mut speeds = SpeedsAfter::for_records(&ride.summary.kick_records);
+        let need_speeds = !speeds.is_empty();
         read_rows(
             path,
             |event| listing.observe(event),
-            |row| drawing.push(row),
+            |row| {
+                drawing.push(row);
+                if need_speeds {
+                    speeds.push(row.t_s, row.speed_mps);
+                }
+            },
         )?;
+        let kicks = ride_campaign_kicks(&ride, Prefer::Best, &speeds)?;
         let drawn = drawing.finish();
         let events = listing.finish(&ride);
         let config = log_config(&ride.summary.config, &[]).ok();
@@ -119,6 +137,7 @@ impl RideView {
             channels: CHANNELS,
             episodes: ride.episodes,
             summary: ride.summary,
+            kicks,
         })
     }
 }
