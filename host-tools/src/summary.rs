@@ -89,6 +89,9 @@ pub struct Summary {
     pub damaged_blocks: u64,
     /// Bytes that were not valid blocks.
     pub bytes_skipped: u64,
+    /// Whole blocks of zeros: space reserved or never written, no loss
+    /// (a block missing from the sequence is counted in `lost_blocks`).
+    pub unwritten_blocks: u64,
     /// Records in valid blocks that could not be read.
     pub bad_records: u64,
     /// Frames whose time went backwards.
@@ -330,6 +333,7 @@ impl SummaryBuilder {
         s.frames_lost = stats.frames_lost;
         s.damaged_blocks = stats.damaged_blocks;
         s.bytes_skipped = stats.bytes_skipped;
+        s.unwritten_blocks = stats.unwritten_blocks;
         s.bad_records = stats.bad_records;
         s.time_jumps = stats.time_jumps;
         s.forward_time_jumps = stats.forward_time_jumps;

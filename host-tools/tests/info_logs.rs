@@ -86,3 +86,30 @@ fn an_unreadable_log_is_named_and_the_others_still_reported() {
     assert_eq!(stdout.lines().count(), 1, "{stdout}");
     assert!(stdout.contains("RUN00001.WBL"), "{stdout}");
 }
+
+/// Blocks of zeros after a log's data (space reserved ahead of it, or a
+/// card image padded) are counted as unwritten, not as lost or skipped,
+/// and no command warns of them; the frames are those of the log alone.
+#[test]
+fn zeros_after_the_data_are_unwritten_not_lost() {
+    let dir = tempfile::tempdir().unwrap();
+    let log = dir.path().join("RUN00001.WBL");
+    let mut bytes = std::fs::read(golden("clean.WBL")).unwrap();
+    bytes.extend([0u8; 4 * 512]);
+    std::fs::write(&log, &bytes).unwrap();
+    let info = info_json(&log);
+    assert_eq!(info["unwritten_blocks"], 4);
+    assert_eq!(info["bytes_skipped"], 0);
+    assert_eq!(info["lost_blocks"], 0);
+    let alone = info_json(&golden("clean.WBL"));
+    assert_eq!(info["samples"], alone["samples"]);
+    let out = wobblog().arg("info").arg(&log).output().unwrap();
+    assert!(out.status.success());
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert!(text.contains("unwritten:    4 blocks of zeros"), "{text}");
+    assert!(
+        out.stderr.is_empty(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}

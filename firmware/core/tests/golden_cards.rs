@@ -21,8 +21,16 @@ use wobble_core::format::header::header_records;
 use wobble_core::format::*;
 
 /// The names of the cards, each a situation FORMAT.md describes.
-const CARDS: [&str; 8] = [
-    "clean", "dropout", "powercut", "timejump", "repeated", "gps", "alert", "marker",
+const CARDS: [&str; 9] = [
+    "clean",
+    "dropout",
+    "powercut",
+    "timejump",
+    "repeated",
+    "gps",
+    "alert",
+    "marker",
+    "aheadfill",
 ];
 
 fn golden_dir() -> PathBuf {
@@ -114,6 +122,14 @@ fn card(name: &str) -> Vec<u8> {
             let mut torn = *enc.snapshot().unwrap();
             torn[256..].copy_from_slice(&flushed[256..]);
             out.push(torn);
+            out
+        }
+        "aheadfill" => {
+            // Blocks of zeros after the data: space reserved ahead of it
+            // (FORMAT.md, "Unwritten space").
+            records.extend(frames(0, 30, 20_000));
+            let mut out = blocks(records);
+            out.extend([[0; BLOCK_LEN]; 3]);
             out
         }
         "timejump" => {

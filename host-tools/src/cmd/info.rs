@@ -140,6 +140,13 @@ fn render(path: &std::path::Path, s: &Summary) -> String {
         "lost blocks:  {} ({} frames), {} damaged, {} bytes skipped",
         s.lost_blocks, s.frames_lost, s.damaged_blocks, s.bytes_skipped
     );
+    if s.unwritten_blocks > 0 {
+        let _ = writeln!(
+            o,
+            "unwritten:    {} blocks of zeros (space reserved or never written: no data lost)",
+            s.unwritten_blocks
+        );
+    }
     if s.repeated_blocks + s.out_of_range > 0 {
         let _ = writeln!(
             o,

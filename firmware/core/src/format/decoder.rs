@@ -170,6 +170,11 @@ pub struct DecodeStats {
     pub rewritten_blocks: u64,
     /// Values the firmware cannot have written, dropped or replaced.
     pub out_of_range: u64,
+    /// Whole blocks of zeros at block offsets: space reserved ahead of the
+    /// data or never written (`FORMAT.md`, "Unwritten space"), holding
+    /// nothing. Not skipped bytes: a block missing from the sequence is
+    /// still a gap.
+    pub unwritten_blocks: u64,
 }
 
 /// What the decoder remembers of the valid block numbered highest so far.
@@ -321,6 +326,12 @@ impl Decoder {
         let mut crc = CrcWindow::default();
         while chunk.len() - pos >= BLOCK_LEN {
             let block = as_block(&chunk[pos..]);
+            if at(pos) % BLOCK_LEN as u64 == 0 && is_unwritten(block) {
+                self.flush_skip(&mut skip, chunk, pos, visit);
+                self.stats.unwritten_blocks += 1;
+                pos += BLOCK_LEN;
+                continue;
+            }
             let parsed = if block[..MAGIC.len()] == MAGIC {
                 BlockHeader::parse_with_crc(block, crc.crc_at(chunk, pos))
             } else {
@@ -352,7 +363,7 @@ impl Decoder {
                             self.stats.damaged_blocks += 1;
                         }
                     }
-                    pos = next_marker(chunk, pos + 1);
+                    pos = next_unwritten(chunk, base, pos, next_marker(chunk, pos + 1));
                 }
             }
         }
@@ -627,6 +638,27 @@ fn next_marker(chunk: &[u8], from: usize) -> usize {
         .map(|i| from + i)
         .find(|&at| usize::from(u16::from_le_bytes([chunk[at + 6], chunk[at + 7]])) <= PAYLOAD_LEN)
         .unwrap_or(limit)
+}
+
+/// Whether `block` is all zeros: reserved or never written.
+fn is_unwritten(block: &Block) -> bool {
+    block.iter().all(|&b| b == 0)
+}
+
+/// The first block of zeros at a block offset (of the stream, whose byte
+/// `base` is `chunk[0]`) after `pos` and before `next`, else `next`:
+/// unwritten space after a damaged block ends its skipped stretch.
+fn next_unwritten(chunk: &[u8], base: u64, pos: usize, next: usize) -> usize {
+    let len = BLOCK_LEN as u64;
+    // Stream offset of `chunk[pos]`, rounded up past `pos` to a block offset.
+    let first = ((base + pos as u64) / len + 1) * len - base;
+    usize::try_from(first)
+        .ok()
+        .into_iter()
+        .flat_map(|first| (first..next).step_by(BLOCK_LEN))
+        .take_while(|&p| p + BLOCK_LEN <= chunk.len())
+        .find(|&p| is_unwritten(as_block(&chunk[p..])))
+        .unwrap_or(next)
 }
 
 fn as_block(bytes: &[u8]) -> &Block {
