@@ -217,6 +217,14 @@ fn card_full_keeps_sampling_and_counts_the_loss() {
     });
     let log = logs.first().expect("the run's file");
     let lost = out.number("END", "card_frames_lost").expect("END line");
+    eprintln!(
+        "DEBUG {:?} {:?}",
+        out.lines
+            .iter()
+            .filter(|l| !l.starts_with("STALL"))
+            .collect::<Vec<_>>(),
+        logs.iter().map(|l| l.frames.len()).collect::<Vec<_>>()
+    );
     assert!(lost > 0);
     // Each attempt on the full card searches its FAT for a free cluster,
     // hundreds of block reads at the card's latency: the writer falls

@@ -10,23 +10,29 @@
 //! records a second: 100 frames, a 20 Hz GPS, and now and then a UTC pair,
 //! an alert, a kick, a marker or a fault. The writer drains the queue once
 //! per iteration (`app::writer`): a poll (a flush every 500 ms: the open
-//! block's snapshot, the directory entry, FSInfo) and one record's push
-//! (which writes a block when it closes one, and at a cluster boundary
+//! block's snapshot, and the directory entry and FSInfo when the data nears
+//! the size the entry states; between flushes one block of zeros written
+//! ahead of the data, `logger`) and one record's push (which writes a
+//! block when it closes one; at the end of the file, a cluster boundary
 //! reads and writes both FATs). Counted with a counting device
-//! (`logger::ops`) over ten minutes of ride on FAT32 cards with 512-byte to
-//! 4 KiB clusters (`tests/writer_ops.rs`), one iteration while logging
-//! makes at most [`WRITER_OPS_PER_ITERATION`] = 14 card operations, and the
-//! slowest by the SD specification is [`WORST_ITERATION_OPS`]: 8 writes and
-//! 5 reads. The specification lets an SDHC/SDXC card stay busy
-//! [`CARD_WRITE_STALL_US`] = 500 ms on a write and [`CARD_READ_STALL_US`] =
-//! 100 ms on a read: 8 × 0.5 s + 5 × 0.1 s = 4.5 s
+//! (`logger::ops`) over ten minutes of ride on FAT cards with 512-byte to
+//! 4 KiB clusters (`tests/writer_ops.rs`), before the logger wrote zeros
+//! ahead of its data, one iteration while logging made at most
+//! [`WRITER_OPS_PER_ITERATION`] = 14 card operations, and the slowest by
+//! the SD specification was [`WORST_ITERATION_OPS`]: 8 writes and 5 reads.
+//! Writing ahead, iterations make at most 10 (6 writes, 3 reads) on empty
+//! and nearly full cards, 11 in the writer task's own test; the sizing
+//! keeps the earlier bound as margin. The specification lets an SDHC/SDXC
+//! card stay busy [`CARD_WRITE_STALL_US`] = 500 ms on a write and
+//! [`CARD_READ_STALL_US`] = 100 ms on a read: 8 × 0.5 s + 5 × 0.1 s = 4.5 s
 //! ([`WORST_ITERATION_US`]), during which the writer drains nothing:
 //! 4.5 s × 125 /s = 563 records. [`QUEUE_LEN`] = 576 records hold
 //! [`QUEUE_HOLDS_US`] = 4.608 s: the worst iteration, at least
 //! [`MIN_QUEUE_US`] = 4 s, and more than one operation at the writer's
 //! 1.5 s budget (`drivers::sd_spi::CARD_OPERATION_BUDGET_US`). A longer
 //! stall (a fragmented card whose free-cluster search reads many FAT
-//! blocks, a card past the specification) costs frames, counted and logged
+//! blocks, the search of the whole FAT where the zeros ahead find the card
+//! full, a card past the specification) costs frames, counted and logged
 //! as a dropout.
 //!
 //! 576 records of 64 bytes (on the MCU) are 36 KiB: the board keeps the

@@ -23,6 +23,7 @@ use embedded_sdmmc::{Block, BlockDevice, BlockIdx};
 use crate::boot::{BorCheck, ResetCause};
 use crate::drivers::icm42688::reg::WHO_AM_I_VALUE;
 use crate::imu_clock::NOMINAL_PERIOD_US;
+use crate::logger::layout::{u16_at, u32_at, FatLayout};
 
 /// How long the rider turns the bar and spins the wheel, µs.
 pub const TEST_WINDOW_US: u64 = 10_000_000;
@@ -513,43 +514,19 @@ pub fn read_report<'a>(
 /// block read per 128 (FAT32) or 256 (FAT16) clusters: some 8000 reads on
 /// a 32 GB card of 32 KiB clusters.
 pub fn fat_free_mib<D: BlockDevice>(card: &D) -> Option<u32> {
+    let layout = FatLayout::of(card)?;
     let mut block = [Block::new()];
     let mut read = |idx: u32| -> Option<[u8; 512]> {
         card.read(&mut block, BlockIdx(idx)).ok()?;
         Some(block[0].contents)
     };
-    let u16_at = |b: &[u8; 512], at: usize| u32::from(u16::from_le_bytes([b[at], b[at + 1]]));
-    let u32_at =
-        |b: &[u8; 512], at: usize| u32::from_le_bytes([b[at], b[at + 1], b[at + 2], b[at + 3]]);
-    // MBR: partition entry 0 at 446, its first block at +8.
-    let mbr = read(0)?;
-    let start = u32_at(&mbr, 446 + 8);
-    let boot = read(start)?;
-    let per_cluster = u32::from(boot[13]);
-    if u16_at(&boot, 11) != 512 || per_cluster == 0 || boot[16] == 0 {
-        return None;
-    }
-    // The BIOS parameter block (FAT specification, section 3): 16-bit
-    // fields where they are not 0, else their 32-bit FAT32 successors.
-    let or32 = |small: u32, large: u32| if small != 0 { small } else { large };
-    let fat_sectors = or32(u16_at(&boot, 22), u32_at(&boot, 36));
-    let total = or32(u16_at(&boot, 19), u32_at(&boot, 32));
-    let reserved = u16_at(&boot, 14);
-    let root_sectors = (u16_at(&boot, 17) * 32).div_ceil(512);
-    let meta = reserved
-        .checked_add(u32::from(boot[16]).checked_mul(fat_sectors)?)?
-        .checked_add(root_sectors)?;
-    let clusters = total.checked_sub(meta)? / per_cluster;
-    // The type follows from the cluster count alone (section 3.5).
-    let entry_bytes: u32 = match clusters {
-        0..4085 => return None,
-        4085..65525 => 2,
-        _ => 4,
-    };
-    if u64::from(clusters + 2) * u64::from(entry_bytes) > u64::from(fat_sectors) * 512 {
-        return None;
-    }
-    let fat = start.checked_add(reserved)?;
+    let FatLayout {
+        fat_start: fat,
+        entry_bytes,
+        clusters,
+        per_cluster,
+        ..
+    } = layout;
     let mut free = 0u32;
     let mut sector = None;
     let mut data = [0u8; 512];

@@ -4,7 +4,7 @@
 //! so no iteration of a long ride may make more, whatever the cluster size.
 
 mod card_support;
-use card_support::{fat32_image, header};
+use card_support::{fat32_image, fill_card, header};
 
 use core::future::Future;
 use core::pin::pin;
@@ -13,8 +13,7 @@ use core::task::{Context, Poll, Waker};
 use embassy_time::{Duration, MockDriver};
 use wobble_core::app::writer;
 use wobble_core::channels::{
-    iteration_stall_us, RecordQueue, SharedStatus, WORST_ITERATION_OPS, WORST_ITERATION_US,
-    WRITER_OPS_PER_ITERATION,
+    iteration_stall_us, RecordQueue, SharedStatus, WORST_ITERATION_US, WRITER_OPS_PER_ITERATION,
 };
 use wobble_core::format::{Frame, FrameStatus, GpsFix, Record};
 use wobble_core::logger::mock::MockCard;
@@ -56,11 +55,12 @@ fn ride(frames: u64) -> impl Iterator<Item = (u64, Record<'static>)> {
     })
 }
 
-/// Card operations of each writer iteration (a poll, then one record's
-/// push, as `writer::run` does) while a file is open.
-fn iterations(cluster: u32, frames: u64) -> Vec<CardOps> {
+/// Card operations of each writer iteration (a poll, a block of zeros
+/// ahead, then one record's push, as `writer::run` does with no backlog) while a file is open on the card `image`,
+/// and the blocks written.
+fn iterations(image: Vec<u8>, frames: u64) -> (Vec<CardOps>, u32) {
     let mut log = CardLogger::new(
-        MockCard::new(fat32_image(CARD_BYTES, cluster)),
+        MockCard::new(image),
         FixedTime::EPOCH,
         header(&CONFIG),
         LoggerConfig::DEFAULT,
@@ -70,6 +70,8 @@ fn iterations(cluster: u32, frames: u64) -> Vec<CardOps> {
         let logging = matches!(log.state(), LoggerState::Logging { .. });
         let before = log.card_ops();
         log.poll(t);
+        // The writer keeps up: the queue is empty before each record.
+        log.write_ahead(t);
         log.push(&rec, t);
         if logging {
             out.push(log.card_ops().since(before));
@@ -77,13 +79,28 @@ fn iterations(cluster: u32, frames: u64) -> Vec<CardOps> {
     }
     assert_eq!(log.state(), LoggerState::Logging { run: 1 });
     assert_eq!(log.stats().frames_lost, 0);
-    out
+    (out, log.stats().blocks_written)
 }
 
-/// FAT32 cards with clusters of one block (a FAT update at every block
-/// written) to 4 KiB: no iteration makes more operations, or takes longer
-/// by the SD specification's limits, than the queue is sized for, and the
-/// worst iterations are exactly that (the sizing is not loose either).
+/// The most operations of any of `its`, and the slowest by the SD
+/// specification.
+fn worst(its: &[CardOps]) -> (u32, CardOps) {
+    let most = its.iter().map(|o| o.total()).max().unwrap_or(0);
+    let slow = its
+        .iter()
+        .copied()
+        .max_by_key(|&o| iteration_stall_us(o))
+        .unwrap_or_default();
+    (most, slow)
+}
+
+/// Cards with clusters of one block (a FAT update at every block written)
+/// to 4 KiB, empty and too full for the zeros the logger writes ahead: no
+/// iteration makes more operations, or takes longer by the SD
+/// specification's limits, than the queue is sized for, and with the zeros
+/// ahead none makes more than 10. The one iteration that finds the card
+/// full searches the whole FAT for a free cluster: a stall the queue is not
+/// sized for (see `channels`).
 /// Larger clusters need a card image too large for a test (65 525
 /// clusters at least); they allocate less often and cost less.
 #[test]
@@ -91,37 +108,50 @@ fn no_writer_iteration_exceeds_the_queue_sizing() {
     let (mut most_ops, mut slowest) = (0, CardOps::default());
     for cluster in [512, 1024, 4096] {
         // Ten minutes of ride: thousands of blocks, 1200 flushes.
-        let its = iterations(cluster, 60_000);
-        let worst = its.iter().map(|o| o.total()).max().unwrap_or(0);
-        let slow = its
-            .iter()
-            .copied()
-            .max_by_key(|&o| iteration_stall_us(o))
-            .unwrap_or_default();
-        let busy = its.iter().filter(|o| o.total() > 0).count();
-        println!(
-            "cluster {cluster} B: {} iterations, {busy} with card operations, at most {worst} \
-             operations in one; slowest by the specification {slow:?}: {} ms",
-            its.len(),
-            iteration_stall_us(slow) / 1000
-        );
-        assert!(
-            worst <= WRITER_OPS_PER_ITERATION,
-            "cluster {cluster}: an iteration made {worst} card operations"
-        );
-        assert!(
-            iteration_stall_us(slow) <= WORST_ITERATION_US,
-            "cluster {cluster}: {slow:?}"
-        );
-        // Most iterations only encode: a block closes every dozen records.
-        assert!(busy * 4 < its.len());
-        most_ops = most_ops.max(worst);
-        if iteration_stall_us(slow) > iteration_stall_us(slowest) {
-            slowest = slow;
+        let (its, blocks) = iterations(fat32_image(CARD_BYTES, cluster), 60_000);
+        let (ahead_most, _) = worst(&its);
+        assert!(ahead_most <= 10, "cluster {cluster}: {ahead_most}");
+        // Room for the ride and 16 KiB more: the zeros ahead stop about
+        // 20 s before the end, and every block then extends the file.
+        let mut full = fat32_image(CARD_BYTES, cluster);
+        fill_card(&mut full, (u64::from(blocks) + 32) * 512);
+        let (mut full_its, _) = iterations(full, 60_000);
+        // Where the zeros ahead find the card full, embedded-sdmmc has
+        // searched the whole FAT for a free cluster (as a full card's last
+        // block always made it): a stall outside the sizing, once.
+        let searches = full_its.iter().filter(|o| o.reads > 10).count();
+        assert!(searches <= 1, "cluster {cluster}: {searches}");
+        full_its.retain(|o| o.reads <= 10);
+        for (card, its) in [("empty", &its), ("nearly full", &full_its)] {
+            let (most, slow) = worst(its);
+            let busy = its.iter().filter(|o| o.total() > 0).count();
+            println!(
+                "cluster {cluster} B, {card}: {} iterations, {busy} with card operations, at \
+                 most {most} operations in one; slowest by the specification {slow:?}: {} ms",
+                its.len(),
+                iteration_stall_us(slow) / 1000
+            );
+            assert!(
+                most <= WRITER_OPS_PER_ITERATION,
+                "cluster {cluster}, {card}: an iteration made {most} card operations"
+            );
+            assert!(
+                iteration_stall_us(slow) <= WORST_ITERATION_US,
+                "cluster {cluster}, {card}: {slow:?}"
+            );
+            // Most iterations only encode: a block closes every dozen
+            // records, and a block of zeros goes ahead about as often.
+            assert!(busy * 4 < its.len());
+            most_ops = most_ops.max(most);
+            if iteration_stall_us(slow) > iteration_stall_us(slowest) {
+                slowest = slow;
+            }
         }
     }
-    assert_eq!(most_ops, WRITER_OPS_PER_ITERATION);
-    assert_eq!(slowest, WORST_ITERATION_OPS);
+    // The sizing keeps the bound measured before the zeros ahead: loose
+    // by a few operations now, never short.
+    assert!(most_ops >= 10, "{most_ops}");
+    assert!(iteration_stall_us(slowest) >= 3_000_000, "{slowest:?}");
 }
 
 /// Polls `future` to its end, advancing the mock clock by 1 ms whenever it

@@ -3,8 +3,9 @@
 //! the card likes while the sampler preempts it.
 //!
 //! One iteration is a [`CardLogger::poll`] (a flush when one is due, an
-//! attempt to open a card without one) and the push of one record (which
-//! writes a block when it closes one). The card operations of each
+//! attempt to open a card without one), with no record waiting a block of
+//! zeros ahead of the data ([`CardLogger::write_ahead`]), and the push of
+//! one record (which writes a block when it closes one). The card operations of each
 //! iteration and its busy time are counted ([`SharedStatus::writer`]): the
 //! queue is sized for the worst iteration (`channels`), and the figures
 //! show how close a card came to it.
@@ -38,6 +39,10 @@ pub async fn run<D: BlockDevice, T: TimeSource>(
         // while the queue holds what the sampler makes meanwhile.
         let start = Instant::now().as_micros();
         logger.poll(start);
+        if queue.is_empty() {
+            // Nothing waiting: a block of zeros ahead of the data.
+            logger.write_ahead(start);
+        }
         let mut busy_us = Instant::now().as_micros().saturating_sub(start);
         shared.set_card(logger.state().into());
         let next = select(queue.pop(), Timer::after_millis(IDLE_POLL_MS)).await;

@@ -14,9 +14,23 @@
 //! - **Whole blocks**: block `seq` of the [`BlockEncoder`] is written at file
 //!   offset `seq * 512`, so embedded-sdmmc never does a read-modify-write.
 //! - **Bounded power-loss window**: every `flush_period_ms` the open block is
-//!   written as a snapshot at its own offset and the file is flushed, which
-//!   updates the directory entry's size. The file is never closed and
+//!   written as a snapshot at its own offset. The file is never closed and
 //!   reopened per write; it is closed once, by [`CardLogger::close`].
+//! - **Written ahead, its entry seldom rewritten**: between flushes the
+//!   logger writes blocks of zeros ahead of its data, up to
+//!   [`AHEAD_BLOCKS`] (the decoder counts them as unwritten space), and
+//!   writes its data blocks into them straight to the card blocks
+//!   embedded-sdmmc gave them. The directory entry (whose sector holds up
+//!   to 15 earlier rides' entries) and FAT32's FSInfo sector are rewritten
+//!   only when the data comes within [`ENTRY_MARGIN_BLOCKS`] of the size
+//!   the entry states: about once per [`AHEAD_BLOCKS`] blocks of data
+//!   instead of at every flush, and the FAT chain is extended ahead of the
+//!   data too. A block written into the space ahead is on the card, inside
+//!   the file, the moment it is written.
+//!   (embedded-sdmmc 0.10 walks a file's cluster chain from its start for
+//!   every seek backwards, so the data cannot go through it once the zeros
+//!   are ahead; it tells the card block of each block through
+//!   [`CountingDevice::last_write`].)
 //! - **Card missing, removed or full**: logging goes on without the card.
 //!   Frames that never reached it are counted, and when a card is back the new
 //!   file carries a fault record ([`crate::format::FaultSource::Card`], codes
@@ -28,6 +42,7 @@
 //! Everything is blocking (embedded-sdmmc is): the writer runs in thread mode
 //! while the sampler preempts it from a higher-priority executor.
 
+pub mod layout;
 #[cfg(feature = "mock")]
 pub mod mock;
 pub mod ops;
@@ -35,10 +50,11 @@ pub mod ops;
 use core::ops::ControlFlow;
 
 use embedded_sdmmc::{
-    BlockDevice, Error as FsError, Mode, RawDirectory, RawFile, RawVolume, ShortFileName,
+    BlockDevice, BlockIdx, Error as FsError, Mode, RawDirectory, RawFile, RawVolume, ShortFileName,
     TimeSource, VolumeIdx, VolumeManager,
 };
 
+use self::layout::FatLayout;
 pub use self::ops::{CardOps, CountingDevice};
 use crate::format::header::header_records;
 use crate::format::{
@@ -70,6 +86,16 @@ pub const FULL_RETRY_PERIODS: u64 = 10;
 
 /// Highest run number a short file name `RUNnnnnn.WBL` can hold.
 pub const MAX_RUN: u32 = 99_999;
+
+/// Blocks of zeros the logger keeps written ahead of its data (128 KiB,
+/// some 40 s of a ride): the file's size in its directory entry covers
+/// them, so the entry is rewritten about once per this many blocks.
+pub const AHEAD_BLOCKS: u32 = 256;
+
+/// The directory entry is rewritten (to cover the zeros ahead) once the
+/// data comes within this many blocks of the size it states: more than a
+/// flush period's blocks at the highest record rate.
+pub const ENTRY_MARGIN_BLOCKS: u32 = 16;
 
 /// Timing of the logger.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -218,8 +244,13 @@ pub struct LoggerStats {
     pub files_opened: u32,
     /// Sealed blocks written.
     pub blocks_written: u32,
-    /// Successful flushes (snapshot + directory entry).
+    /// Successful flushes (snapshot, and the directory entry when due).
     pub flushes: u32,
+    /// Rewrites of the open file's directory entry (and FSInfo) while
+    /// logging, closing included.
+    pub entry_writes: u32,
+    /// Blocks of zeros written ahead of the data.
+    pub ahead_writes: u32,
     /// Frames a reader finds in the current file: in blocks that the file
     /// size of the last flush covers, in their latest written version.
     /// Frames past it are lost if the card goes now.
@@ -267,8 +298,10 @@ pub struct CardLogger<'a, D: BlockDevice, T: TimeSource> {
     open: Option<OpenFile>,
     next_try_us: u64,
     next_flush_us: u64,
-    /// Blocks the directory entry's file size covers (as of the last flush).
-    size_blocks: u32,
+    /// Where the open file's blocks are.
+    blocks: FileBlocks,
+    /// When the last flush was made.
+    flushed_at_us: Option<u64>,
     /// Frames in the blocks written so far, whether or not the file size
     /// covers them yet.
     frames_written: u32,
@@ -316,7 +349,8 @@ impl<'a, D: BlockDevice, T: TimeSource> CardLogger<'a, D, T> {
             open: None,
             next_try_us: 0,
             next_flush_us: 0,
-            size_blocks: 0,
+            blocks: FileBlocks::NONE,
+            flushed_at_us: None,
             frames_written: 0,
             faults_unreported: [0; FAULT_CARD_CODES],
             stats: LoggerStats::default(),
@@ -396,7 +430,11 @@ impl<'a, D: BlockDevice, T: TimeSource> CardLogger<'a, D, T> {
         }
         self.flush(now_us);
         let f = self.open.take().ok_or(CloseError::Card)?;
+        // Closing rewrites the entry once more (its size and time).
         let closed = self.fs.close_file(f.file).is_ok();
+        if closed {
+            self.stats.entry_writes = self.stats.entry_writes.saturating_add(1);
+        }
         self.release(f.dir, f.volume);
         if closed {
             Ok(())
@@ -437,7 +475,7 @@ impl<'a, D: BlockDevice, T: TimeSource> CardLogger<'a, D, T> {
         // A block that closes is the one open now.
         let seq = self.encoder.open_seq();
         let written = match self.encoder.push(rec) {
-            Ok(Some(block)) => Some(write_block(&self.fs, f.file, seq, block)),
+            Ok(Some(block)) => Some(self.blocks.write(&self.fs, f.file, seq, block)),
             Ok(None) => None,
             Err(_) => {
                 self.stats.encode_errors = self.stats.encode_errors.saturating_add(1);
@@ -450,7 +488,7 @@ impl<'a, D: BlockDevice, T: TimeSource> CardLogger<'a, D, T> {
                 // The closed block holds every frame before `rec`; it only
                 // counts once a flush has put its offset inside the file
                 // size (the snapshot block being overwritten already is).
-                if seq < self.size_blocks {
+                if seq < self.blocks.size {
                     self.stats.frames_on_card = frames_before;
                 }
                 self.frames_written = frames_before;
@@ -463,19 +501,20 @@ impl<'a, D: BlockDevice, T: TimeSource> CardLogger<'a, D, T> {
     /// Snapshot of the open block plus a file flush.
     fn flush(&mut self, now_us: u64) {
         let Some(f) = self.open else { return };
+        self.flushed_at_us = Some(now_us);
         self.next_flush_us = now_us.saturating_add(u64::from(self.config.flush_period_ms) * 1000);
         let seq = self.encoder.open_seq();
-        let (snapshot, size_blocks) = match self.encoder.snapshot() {
+        let (snapshot, data_blocks) = match self.encoder.snapshot() {
             Some(block) => (
-                write_block(&self.fs, f.file, seq, block),
+                self.blocks.write(&self.fs, f.file, seq, block),
                 seq.saturating_add(1),
             ),
             None => (Ok(()), seq),
         };
-        match snapshot.and_then(|()| self.fs.flush_file(f.file)) {
+        let entry = snapshot.and_then(|()| self.update_entry(f.file, data_blocks));
+        match entry {
             Ok(()) => {
                 self.stats.flushes = self.stats.flushes.saturating_add(1);
-                self.size_blocks = size_blocks;
                 self.stats.frames_on_card = self.encoder.frames_total();
                 self.frames_written = self.encoder.frames_total();
                 // Whatever was pending is now in this file, on the card.
@@ -503,8 +542,43 @@ impl<'a, D: BlockDevice, T: TimeSource> CardLogger<'a, D, T> {
         self.frames_written = 0;
         self.encoder = BlockEncoder::new();
         self.stats.frames_on_card = 0;
-        self.size_blocks = 0;
+        self.blocks = FileBlocks::NONE;
         self.next_try_us = self.retry_at(now_us);
+    }
+
+    /// Writes one block of zeros ahead of the data, if fewer than
+    /// [`AHEAD_BLOCKS`] are and no flush was made at `now_us`: the writer
+    /// calls it when it has no record waiting (`app::writer`), so the zeros
+    /// never hold up a backlog. A full card stops the zeros, not the
+    /// logging: the data takes what space is left.
+    pub fn write_ahead(&mut self, now_us: u64) {
+        let Some(f) = self.open else { return };
+        let open_seq = self.encoder.open_seq();
+        let b = &mut self.blocks;
+        let full = b.held >= open_seq.saturating_add(AHEAD_BLOCKS);
+        if b.ahead_stopped || full || self.flushed_at_us == Some(now_us) {
+            return;
+        }
+        match b.write(&self.fs, f.file, b.held, &[0; BLOCK_LEN]) {
+            Ok(()) => self.stats.ahead_writes = self.stats.ahead_writes.saturating_add(1),
+            Err(FsError::DiskFull | FsError::NotEnoughSpace) => b.ahead_stopped = true,
+            Err(e) => self.fail(fault_code(&e), now_us),
+        }
+    }
+
+    /// Rewrites the directory entry (and FSInfo) if the data, `data_blocks`
+    /// long, is not covered by the size it states with
+    /// [`ENTRY_MARGIN_BLOCKS`] to spare, and the file has grown since.
+    fn update_entry(&mut self, file: RawFile, data_blocks: u32) -> Result<(), FsError<D::Error>> {
+        let b = &mut self.blocks;
+        let uncovered = data_blocks > b.size;
+        let near = data_blocks.saturating_add(ENTRY_MARGIN_BLOCKS) > b.size;
+        if uncovered || (near && b.held > b.size) {
+            self.fs.flush_file(file)?;
+            self.stats.entry_writes = self.stats.entry_writes.saturating_add(1);
+            b.size = b.held.max(data_blocks);
+        }
+        Ok(())
     }
 
     fn release(&mut self, dir: RawDirectory, volume: RawVolume) {
@@ -563,7 +637,12 @@ impl<'a, D: BlockDevice, T: TimeSource> CardLogger<'a, D, T> {
         self.stats.files_opened = self.stats.files_opened.saturating_add(1);
         self.encoder = BlockEncoder::new();
         self.stats.frames_on_card = 0;
-        self.size_blocks = 0;
+        self.blocks = FileBlocks::NONE;
+        // Blocks embedded-sdmmc gives the file past the data region are
+        // not written into directly (the zeros stop there).
+        self.blocks.data_end = self
+            .fs
+            .device(|d| FatLayout::of(&*d).map_or(0, |l| l.data_end()));
         let info = LogInfo {
             t_us: now_us,
             firmware: self.header.firmware,
@@ -622,6 +701,72 @@ impl<'a, D: BlockDevice, T: TimeSource> CardLogger<'a, D, T> {
             });
             self.encode(&rec, now_us);
         }
+    }
+}
+
+/// Where the open file's blocks are (see the module docs).
+struct FileBlocks {
+    /// Blocks the directory entry's file size covers (as of its last
+    /// rewrite).
+    size: u32,
+    /// Blocks the file holds: data, then zeros written ahead.
+    held: u32,
+    /// The card block of file block `seq` at `[seq % AHEAD_BLOCKS]`, for
+    /// the open block and those ahead of it (0: not known; block 0 is the
+    /// card's MBR, never a file's).
+    card: [u32; AHEAD_BLOCKS as usize],
+    /// The card refused to grow the file ahead (full), or gave it a block
+    /// past the data region: no more zeros.
+    ahead_stopped: bool,
+    /// The block after the volume's data region (0: not known, no zeros).
+    data_end: u32,
+}
+
+impl FileBlocks {
+    /// No file.
+    const NONE: Self = Self {
+        size: 0,
+        held: 0,
+        card: [0; AHEAD_BLOCKS as usize],
+        ahead_stopped: false,
+        data_end: 0,
+    };
+
+    /// Writes `block` as block `seq` of `file`: straight to its card block
+    /// when it lies in the zeros written ahead, else through embedded-sdmmc
+    /// at the end of the file (which grows), learning its card block.
+    fn write<D: BlockDevice, T: TimeSource>(
+        &mut self,
+        fs: &Volumes<D, T>,
+        file: RawFile,
+        seq: u32,
+        block: &Block,
+    ) -> Result<(), FsError<D::Error>> {
+        let slot = (seq % AHEAD_BLOCKS) as usize;
+        if seq < self.held && self.card[slot] != 0 {
+            let at = BlockIdx(self.card[slot]);
+            let contents = embedded_sdmmc::Block { contents: *block };
+            return fs
+                .device(|d| d.write(core::slice::from_ref(&contents), at))
+                .map_err(FsError::DeviceError);
+        }
+        // Past the end (or a block whose card block is not known:
+        // embedded-sdmmc then seeks back through the chain).
+        write_block(fs, file, seq, block)?;
+        // The file's block is the last card write of embedded-sdmmc's
+        // write, after any FAT update; its first bytes tell it is.
+        self.card[slot] = match fs.device(|d| d.last_write()) {
+            Some((at, head)) if block.starts_with(&head) && at.0 != 0 => at.0,
+            _ => 0,
+        };
+        if self.card[slot] >= self.data_end {
+            // Past the data region (a full volume): written through
+            // embedded-sdmmc from now on, as it places it.
+            self.card[slot] = 0;
+            self.ahead_stopped = true;
+        }
+        self.held = self.held.max(seq.saturating_add(1));
+        Ok(())
     }
 }
 

@@ -43,14 +43,21 @@ impl CardOps {
     }
 }
 
+/// How many leading bytes of the last block written [`CountingDevice`]
+/// keeps, to tell which block it was.
+pub const WRITTEN_HEAD_LEN: usize = 24;
+
 /// A block device that counts the operations made on it (see the module
-/// docs). Failed operations count too: the card was asked.
+/// docs). Failed operations count too: the card was asked. It also keeps
+/// where the last single block written went, and its first bytes: the
+/// logger learns so where embedded-sdmmc put a block of its file.
 #[derive(Debug)]
 pub struct CountingDevice<D> {
     inner: D,
     reads: Cell<u32>,
     writes: Cell<u32>,
     other: Cell<u32>,
+    last_write: Cell<Option<(BlockIdx, [u8; WRITTEN_HEAD_LEN])>>,
 }
 
 impl<D> CountingDevice<D> {
@@ -61,7 +68,15 @@ impl<D> CountingDevice<D> {
             reads: Cell::new(0),
             writes: Cell::new(0),
             other: Cell::new(0),
+            last_write: Cell::new(None),
         }
+    }
+
+    /// The card block of the last successful one-block write and the
+    /// block's first [`WRITTEN_HEAD_LEN`] bytes (`None` before any, or when
+    /// the last write failed or was of several blocks).
+    pub fn last_write(&self) -> Option<(BlockIdx, [u8; WRITTEN_HEAD_LEN])> {
+        self.last_write.get()
     }
 
     /// Operations so far.
@@ -103,7 +118,14 @@ impl<D: BlockDevice> BlockDevice for CountingDevice<D> {
 
     fn write(&self, blocks: &[Block], start: BlockIdx) -> Result<(), Self::Error> {
         bump(&self.writes);
-        self.inner.write(blocks, start)
+        self.last_write.set(None);
+        self.inner.write(blocks, start)?;
+        if let [one] = blocks {
+            let mut head = [0; WRITTEN_HEAD_LEN];
+            head.copy_from_slice(&one.contents[..WRITTEN_HEAD_LEN]);
+            self.last_write.set(Some((start, head)));
+        }
+        Ok(())
     }
 
     fn num_blocks(&self) -> Result<BlockCount, Self::Error> {
@@ -139,6 +161,16 @@ mod tests {
         assert_eq!(ops.total(), 5);
         // Blocks moved are the card's business: three written, one command each call.
         assert_eq!(dev.inner().writes(), 3);
+        // Only a one-block write is remembered.
+        assert_eq!(dev.last_write(), None);
+        let mut one = Block::new();
+        one.contents[..3].copy_from_slice(b"abc");
+        dev.write(core::slice::from_ref(&one), BlockIdx(6))
+            .expect("write");
+        let (at, head) = dev.last_write().expect("remembered");
+        assert_eq!((at, &head[..4]), (BlockIdx(6), &b"abc\0"[..]));
+        assert!(dev.write(core::slice::from_ref(&one), BlockIdx(8)).is_err());
+        assert_eq!(dev.last_write(), None);
         let later = CardOps {
             reads: 1,
             writes: 7,

@@ -36,3 +36,48 @@ pub fn fat32_image(card_bytes: u64, cluster: u32) -> Vec<u8> {
     image[511] = 0xAA;
     image
 }
+
+/// Runs `f` on the FAT volume of `image` (mounted by `fatfs`).
+pub fn with_fs<R>(
+    image: &mut [u8],
+    f: impl FnOnce(&fatfs::FileSystem<std::io::Cursor<&mut [u8]>>) -> R,
+) -> R {
+    let start = (PART_START_BLOCKS * 512) as usize;
+    let fs = fatfs::FileSystem::new(
+        std::io::Cursor::new(&mut image[start..]),
+        fatfs::FsOptions::new(),
+    )
+    .expect("mount");
+    f(&fs)
+}
+
+/// The contents of a file, as the directory entry's size says.
+pub fn read_file(image: &[u8], name: &str) -> Option<Vec<u8>> {
+    use std::io::Read;
+    let mut image = image.to_vec();
+    with_fs(&mut image, |fs| {
+        let mut file = fs.root_dir().open_file(name).ok()?;
+        let mut data = Vec::new();
+        file.read_to_end(&mut data).ok()?;
+        Some(data)
+    })
+}
+
+/// Fills the card but `free_bytes` with a file.
+pub fn fill_card(image: &mut [u8], free_bytes: u64) {
+    use std::io::{Seek, SeekFrom, Write};
+    with_fs(image, |fs| {
+        let stats = fs.stats().expect("stats");
+        let free = stats.free_clusters() as u64 * stats.cluster_size() as u64;
+        let mut file = fs.root_dir().create_file("FILLER.BIN").expect("create");
+        let chunk = vec![0xA5u8; 1 << 16];
+        let mut left = free - free_bytes;
+        while left > 0 {
+            let n = left.min(chunk.len() as u64) as usize;
+            file.write_all(&chunk[..n]).expect("fill");
+            left -= n as u64;
+        }
+        file.flush().expect("flush");
+        file.seek(SeekFrom::Start(0)).expect("seek");
+    });
+}
