@@ -5,7 +5,10 @@
 //! flush except those of the one block the cut hit, which the decoder
 //! reports, loses at most one flush period plus what queued behind a busy
 //! card, and its file system is at worst in the documented state of an
-//! unclosed file.
+//! unclosed file. Every cut's card also holds an earlier ride, which must
+//! come back whole: the logger rewrites the sectors it shares with it (the
+//! root directory's, FSInfo, the FAT's) seldom, and a cut during one of
+//! those writes leaves its other entries as they were.
 
 use std::path::Path;
 
@@ -19,6 +22,8 @@ const FRAMES: u32 = 1200;
 /// Highest block write a cut is put before.
 const MAX_CUT_WRITE: u32 = 150;
 const CUTS: usize = 100;
+/// The first block writes of a ride, each cut before.
+const OPENING_WRITES: u32 = 24;
 /// Frames a flush period holds.
 const FLUSH_FRAMES: u64 = LoggerConfig::DEFAULT.flush_period_ms as u64 / 10;
 /// Records waiting in the queue at the cut (not yet handed to the logger):
@@ -32,7 +37,9 @@ const TORN_CUTS: usize = 40;
 fn power_cut_at_100_random_block_writes() {
     let bundle = qemu::bundle(FRAMES).expect("fixtures");
     let mut rng = Rng::new(0xC07);
-    let mut cuts: Vec<u32> = Vec::new();
+    // Every write of the file's opening (its entry, the FAT, FSInfo, the
+    // header, the first flushes), then random ones.
+    let mut cuts: Vec<u32> = (1..=OPENING_WRITES).collect();
     while cuts.len() < CUTS {
         let w = rng.range(1.0, f64::from(MAX_CUT_WRITE) + 1.0) as u32;
         if !cuts.contains(&w) {
@@ -60,6 +67,33 @@ fn on_two_workers<T: Sync, R: Send>(items: &[T], run: impl Fn(&T) -> R + Sync) -
             .flat_map(|h| h.join().expect("worker"))
             .collect()
     })
+}
+
+/// Frames of the earlier ride on the card.
+const EARLIER_FRAMES: u64 = 3_000;
+
+/// An earlier ride of 30 s as the card holds it (frames only).
+fn earlier_ride() -> Vec<u8> {
+    use wobble_core::format::{BlockEncoder, Frame, FrameStatus, Record};
+    let mut encoder = BlockEncoder::new();
+    let mut bytes = Vec::new();
+    for i in 0..EARLIER_FRAMES {
+        let frame = Record::Frame(Frame {
+            t_us: i * 10_000,
+            accel: [(i % 700) as i16, 0, 2048],
+            gyro: [0, (i % 50) as i16, 0],
+            steer_cdeg: (i % 500) as i16,
+            wheel_count: i as u16,
+            wheel_edge_age_us: 100,
+            speed_mm_s: 3000,
+            status: FrameStatus(0),
+        });
+        if let Some(block) = encoder.push(&frame).expect("encode") {
+            bytes.extend_from_slice(block);
+        }
+    }
+    bytes.extend_from_slice(encoder.snapshot().expect("open block"));
+    bytes
 }
 
 /// Runs one cut before block write `write`; returns (write, frames sampled,
@@ -118,8 +152,13 @@ struct Cut {
 /// plus the queue, and the file system at worst unclosed.
 fn cut_run(bundle: &qemu::Bundle, base: &Path, name: &str, scenario: Scenario) -> Cut {
     let dir = qemu::work_dir(base, name).expect("dir");
-    let out =
-        qemu::run(&bundle.setup(dir.clone(), scenario), |_| Ok(()), |_| {}).expect("qemu run");
+    let earlier = earlier_ride();
+    let out = qemu::run(
+        &bundle.setup(dir.clone(), scenario),
+        |card| qemu::card::put_file(card, "RUN00001.WBL", &earlier),
+        |_| {},
+    )
+    .expect("qemu run");
     assert_eq!(out.code, 3, "{name}: the cut happened: {:?}", out.lines);
     let sampled = out.number("CUT", "frames").expect("CUT line");
     let fsck = qemu::card::fsck(&out.card).expect("fsck");
@@ -129,12 +168,24 @@ fn cut_run(bundle: &qemu::Bundle, base: &Path, name: &str, scenario: Scenario) -
         .filter(|p| !qemu::is_unclosed_file_state(p))
         .collect();
     assert!(worse.is_empty(), "{name}: {}", fsck.text);
+    // The earlier ride byte for byte.
+    let files = qemu::card::root_files(&out.card).expect("files");
+    let kept = files.iter().find(|(file, _)| file == "RUN00001.WBL");
+    assert_eq!(
+        kept.map(|k| &k.1),
+        Some(&earlier),
+        "{name}: the earlier ride"
+    );
     let logs = match decode::logs(&out.card, &dir) {
         Ok(logs) => logs,
         // No valid block yet: the cut came before the first flush.
-        Err(e) if e.contains("RUN00001.WBL") => Vec::new(),
+        Err(e) if e.contains("RUN00002.WBL") => Vec::new(),
         Err(e) => panic!("{name}: {e}"),
     };
+    let logs: Vec<_> = logs
+        .into_iter()
+        .filter(|l| l.name != "RUN00001.WBL")
+        .collect();
     let frames: Vec<u64> = logs
         .iter()
         .flat_map(|l| l.frames.iter().map(|f| out.frame_index(f.t_us)))
