@@ -244,6 +244,9 @@ pub struct SharedStatus {
     card: AtomicU32,
     /// Whether the writer should close the log (0/1).
     stop: AtomicU32,
+    /// Whether the supply is below the power-fail threshold now (0/1), and
+    /// how often it fell below it since boot (high bits).
+    power: AtomicU32,
     /// Most card operations of one writer iteration with a file open.
     writer_ops_max: AtomicU32,
     /// Most card operations of one writer iteration that opened a card.
@@ -281,6 +284,7 @@ impl SharedStatus {
             boot_unix_s: AtomicU32::new(0),
             card: AtomicU32::new(0),
             stop: AtomicU32::new(0),
+            power: AtomicU32::new(0),
             writer_ops_max: AtomicU32::new(0),
             writer_open_ops_max: AtomicU32::new(0),
             writer_busy_max_us: AtomicU32::new(0),
@@ -348,6 +352,34 @@ impl SharedStatus {
     /// Whether a stop was requested.
     pub fn stop_requested(&self) -> bool {
         self.stop.load(Ordering::Acquire) != 0
+    }
+
+    /// The supply fell below the power-fail threshold (`low`), or came
+    /// back above it: the board's power-voltage-detector interrupt on both
+    /// edges. While it is low the writer closes the log and leaves the card
+    /// alone (`app::writer`).
+    pub fn set_power_low(&self, low: bool) {
+        // Bit 0: low now; bits 1..: the falls counted.
+        let _ = self
+            .power
+            .fetch_update(Ordering::AcqRel, Ordering::Acquire, |p| {
+                let falls = p >> 1;
+                Some(match (low, p & 1 == 1) {
+                    (true, false) => (falls.saturating_add(1) << 1) | 1,
+                    (true, true) => p,
+                    (false, _) => falls << 1,
+                })
+            });
+    }
+
+    /// Whether the supply is below the power-fail threshold now.
+    pub fn power_low(&self) -> bool {
+        self.power.load(Ordering::Acquire) & 1 == 1
+    }
+
+    /// How often the supply fell below the threshold since boot.
+    pub fn power_falls(&self) -> u32 {
+        self.power.load(Ordering::Acquire) >> 1
     }
 
     /// The writer finished an iteration of `ops` card operations that kept
@@ -630,6 +662,21 @@ mod tests {
 
     /// The sampler sees the writer's card as the logger stands: an exFAT
     /// card is not shown as a missing one.
+    #[test]
+    fn power_falls_are_counted_once_each() {
+        let s = SharedStatus::new();
+        assert!(!s.power_low());
+        s.set_power_low(true);
+        s.set_power_low(true);
+        assert!(s.power_low());
+        assert_eq!(s.power_falls(), 1);
+        s.set_power_low(false);
+        assert!(!s.power_low());
+        s.set_power_low(false);
+        s.set_power_low(true);
+        assert_eq!((s.power_low(), s.power_falls()), (true, 2));
+    }
+
     #[test]
     fn the_card_is_shared_as_the_logger_stands() {
         use crate::logger::LoggerState;

@@ -11,12 +11,13 @@ use core::pin::pin;
 use core::task::{Context, Poll, Waker};
 
 use embassy_time::{Duration, MockDriver};
+use embedded_sdmmc::{Block, BlockCount, BlockDevice, BlockIdx};
 use wobble_core::app::writer;
 use wobble_core::channels::{
     iteration_stall_us, RecordQueue, SharedStatus, WORST_ITERATION_US, WRITER_OPS_PER_ITERATION,
 };
-use wobble_core::format::{Frame, FrameStatus, GpsFix, Record};
-use wobble_core::logger::mock::MockCard;
+use wobble_core::format::{Decoder, Event, Frame, FrameStatus, GpsFix, Record};
+use wobble_core::logger::mock::{MockCard, MockError};
 use wobble_core::logger::{CardLogger, CardOps, FixedTime, LoggerConfig, LoggerState};
 
 const CARD_BYTES: u64 = 40 << 20;
@@ -211,4 +212,118 @@ fn the_writer_task_reports_its_worst_iterations() {
     assert!(figures.ops_max <= WRITER_OPS_PER_ITERATION);
     assert_eq!(log.stats().frames_lost, 0);
     assert_eq!(log.stats().frames_on_card, 3_000);
+}
+
+/// A card whose writes are counted outside the logger.
+struct Watched<'a> {
+    card: MockCard,
+    writes: &'a core::cell::Cell<u32>,
+}
+
+impl BlockDevice for Watched<'_> {
+    type Error = MockError;
+
+    fn read(&self, blocks: &mut [Block], start: BlockIdx) -> Result<(), MockError> {
+        self.card.read(blocks, start)
+    }
+
+    fn write(&self, blocks: &[Block], start: BlockIdx) -> Result<(), MockError> {
+        self.writes.set(self.writes.get() + 1);
+        self.card.write(blocks, start)
+    }
+
+    fn num_blocks(&self) -> Result<BlockCount, MockError> {
+        self.card.num_blocks()
+    }
+}
+
+/// Frames in a log file, and the frames its dropout records count.
+fn frames_in(file: &[u8]) -> (u32, u32) {
+    let (mut frames, mut dropped) = (0, 0);
+    Decoder::new().feed(file, true, &mut |e| match e {
+        Event::Record(Record::Frame(_)) => frames += 1,
+        Event::Record(Record::Dropout(d)) => dropped += d.frames_lost,
+        _ => {}
+    });
+    (frames, dropped)
+}
+
+/// The supply falls below the power-fail threshold mid-ride: the writer
+/// closes the file at once (every frame it had is on the card, in a file
+/// closed cleanly), writes nothing to the card while the supply stays low,
+/// and opens a new file when it is back; the frames the queue could not
+/// hold meanwhile are counted in the new file's dropout record.
+#[test]
+fn a_failing_supply_closes_the_file_and_leaves_the_card_alone() {
+    let queue = RecordQueue::new();
+    let shared = SharedStatus::new();
+    let writes = core::cell::Cell::new(0);
+    let card = Watched {
+        card: MockCard::new(fat32_image(CARD_BYTES, 512)),
+        writes: &writes,
+    };
+    let mut log = CardLogger::new(
+        card,
+        FixedTime::EPOCH,
+        header(&CONFIG),
+        LoggerConfig::DEFAULT,
+    );
+    let records: Vec<Record<'static>> = ride(3_000).map(|(_, r)| r).collect();
+    let mut frames_before = 0;
+    let mut writes_while_low = (0, 0);
+    let producer = async {
+        let settle = || async {
+            for _ in 0..20 {
+                MockDriver::get().advance(Duration::from_millis(10));
+                embassy_futures::yield_now().await;
+            }
+        };
+        let mut frames = 0;
+        for (k, rec) in records.iter().enumerate() {
+            if k == 2_000 {
+                while !queue.is_empty() {
+                    embassy_futures::yield_now().await;
+                }
+                frames_before = frames;
+                shared.set_power_low(true);
+                settle().await;
+                let closed_at = writes.get();
+                settle().await;
+                writes_while_low = (closed_at, writes.get());
+            }
+            if k == 2_800 {
+                shared.set_power_low(false);
+            }
+            if matches!(rec, Record::Frame(_)) {
+                MockDriver::get().advance(Duration::from_micros(FRAME_PERIOD_US));
+                frames += 1;
+            }
+            // While the supply is low the queue fills, then drops.
+            let _ = queue.push(*rec);
+            while !shared.power_low() && !queue.is_empty() {
+                embassy_futures::yield_now().await;
+            }
+        }
+        shared.request_stop();
+    };
+    let (closed, ()) = drive(embassy_futures::join::join(
+        writer::run(&mut log, &queue, &shared),
+        producer,
+    ));
+    closed.expect("the second file closed");
+    assert_eq!(shared.power_falls(), 1);
+    assert_eq!(
+        writes_while_low.0, writes_while_low.1,
+        "card writes while low"
+    );
+    let image = log.into_device().card.image();
+    let first = card_support::read_file(&image, "RUN00001.WBL").expect("first file");
+    let second = card_support::read_file(&image, "RUN00002.WBL").expect("second file");
+    let (first_frames, first_dropped) = frames_in(&first);
+    let (second_frames, dropped) = frames_in(&second);
+    // Every frame before the fall is in the first file, closed cleanly.
+    assert_eq!((first_frames, first_dropped), (frames_before, 0));
+    // Every frame after it is in the second file or counted dropped.
+    assert!(dropped > 0);
+    assert_eq!(first_frames + second_frames + dropped, 3_000);
 }

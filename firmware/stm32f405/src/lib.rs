@@ -11,6 +11,7 @@ pub mod assembly;
 pub mod ccm;
 pub mod clocks;
 pub mod pins;
+pub mod power;
 pub mod selftest;
 pub mod startup;
 pub mod watchdog;

@@ -7,6 +7,7 @@
 //! |---|---|---|
 //! | interrupt (UART4 vector) | high | 100 Hz sampler |
 //! | interrupt (UART5 vector) | medium | GPS |
+//! | interrupt (PVD vector) | low | supply below 2.9 V (a flag for the writer) |
 //! | thread mode | low | SD writer (blocking), watchdog feeder |
 #![no_std]
 #![no_main]
@@ -14,7 +15,7 @@
 use wobble_stm32f405::assembly::{
     card_and_config, header, marker_held, sampler_parts, Ports, FIRMWARE,
 };
-use wobble_stm32f405::{adapters, ccm, clocks, startup, watchdog};
+use wobble_stm32f405::{adapters, ccm, clocks, power, startup, watchdog};
 
 use cortex_m_rt::entry;
 use embassy_executor::{Executor, InterruptExecutor};
@@ -52,6 +53,11 @@ unsafe fn UART4() {
 }
 
 #[interrupt]
+fn PVD() {
+    power::on_interrupt(&SHARED);
+}
+
+#[interrupt]
 unsafe fn UART5() {
     // SAFETY: the vector belongs to this executor alone (UART5 is unused).
     unsafe { EXECUTOR_MEDIUM.on_interrupt() }
@@ -79,6 +85,9 @@ fn main() -> ! {
     }
     let mut board = Board::new(embassy_stm32::init(clocks::config(crystal)));
     startup::enable_flash_accelerator();
+    // The writer closes the log when VDD falls below 2.9 V, and opens no
+    // file before it is above.
+    power::start(&SHARED);
     if crystal {
         startup::enable_clock_security();
     }

@@ -2,6 +2,10 @@
 //! thread mode, where embedded-sdmmc's blocking writes may take as long as
 //! the card likes while the sampler preempts it.
 //!
+//! While the supply is below the power-fail threshold
+//! ([`SharedStatus::power_low`]) the writer closes the file and touches the
+//! card no more until it is back.
+//!
 //! One iteration is a [`CardLogger::poll`] (a flush when one is due, an
 //! attempt to open a card without one), with no record waiting a block of
 //! zeros ahead of the data ([`CardLogger::write_ahead`]), and the push of
@@ -32,7 +36,24 @@ pub async fn run<D: BlockDevice, T: TimeSource>(
     queue: &RecordQueue,
     shared: &SharedStatus,
 ) -> Result<(), CloseError> {
+    // How the last file closed for a failing supply went.
+    let mut power_closed = Err(CloseError::NoFile);
     loop {
+        if shared.power_low() {
+            // The supply is failing: the file closed now, while the card
+            // still has the voltage to take a few writes (the queue waits,
+            // and drops what does not fit, counted), and no card access
+            // until the supply is back, which opens a new file.
+            if matches!(logger.state(), LoggerState::Logging { .. }) {
+                power_closed = logger.close(Instant::now().as_micros());
+                shared.set_card(logger.state().into());
+            }
+            if shared.stop_requested() {
+                return power_closed;
+            }
+            Timer::after_millis(IDLE_POLL_MS).await;
+            continue;
+        }
         let logging = matches!(logger.state(), LoggerState::Logging { .. });
         let ops_before = logger.card_ops();
         // Polled before the first record too: the card is opened at boot,
