@@ -566,17 +566,14 @@ impl<'a, D: BlockDevice, T: TimeSource> CardLogger<'a, D, T> {
         }
     }
 
-    /// Rewrites the directory entry (and FSInfo) if the data, `data_blocks`
-    /// long, is not covered by the size it states with
-    /// [`ENTRY_MARGIN_BLOCKS`] to spare, and the file has grown since.
+    /// Rewrites the directory entry (and FSInfo) when [`entry_due`]: its
+    /// size then covers every block the file holds.
     fn update_entry(&mut self, file: RawFile, data_blocks: u32) -> Result<(), FsError<D::Error>> {
         let b = &mut self.blocks;
-        let uncovered = data_blocks > b.size;
-        let near = data_blocks.saturating_add(ENTRY_MARGIN_BLOCKS) > b.size;
-        if uncovered || (near && b.held > b.size) {
+        if entry_due(data_blocks, b.size, b.held) {
             self.fs.flush_file(file)?;
             self.stats.entry_writes = self.stats.entry_writes.saturating_add(1);
-            b.size = b.held.max(data_blocks);
+            b.size = b.held;
         }
         Ok(())
     }
@@ -702,6 +699,15 @@ impl<'a, D: BlockDevice, T: TimeSource> CardLogger<'a, D, T> {
             self.encode(&rec, now_us);
         }
     }
+}
+
+/// Whether the directory entry is due for a rewrite: the data, `data`
+/// blocks long, has fewer than [`ENTRY_MARGIN_BLOCKS`] to spare in the
+/// `size` the entry states, and the file holds more (`held`, never less
+/// than `data`) than that size. Without zeros ahead (`held == data`) that
+/// is every flush that has new data, as it was before them.
+fn entry_due(data: u32, size: u32, held: u32) -> bool {
+    data.saturating_add(ENTRY_MARGIN_BLOCKS) > size && held > size
 }
 
 /// Where the open file's blocks are (see the module docs).
@@ -831,6 +837,20 @@ fn run_file_name<E: core::fmt::Debug + core::error::Error>(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_entry_is_due_within_its_margin_when_the_file_holds_more() {
+        // A new file: nothing stated yet, a header block held.
+        assert!(entry_due(0, 0, 1));
+        // 16 blocks to spare: not yet; 15: due.
+        assert!(!entry_due(100, 116, 300));
+        assert!(entry_due(101, 116, 300));
+        // Nothing held beyond the stated size: a rewrite would change nothing.
+        assert!(!entry_due(110, 116, 116));
+        // Without zeros ahead: due whenever there is new data.
+        assert!(entry_due(117, 116, 117));
+        assert!(!entry_due(116, 116, 116));
+    }
 
     #[test]
     fn run_names_round_trip() {
