@@ -9,11 +9,10 @@ use std::f64::consts::TAU;
 use std::fs::File;
 use std::path::Path;
 
-use analysis_support::{stdout_of, wobblog, Extras, Ride};
+use analysis_support::{kick_record, stdout_of, wobblog, Extras, Ride};
 use parquet::file::reader::{FileReader, SerializedFileReader};
 use parquet::record::Field;
 use serde_json::Value;
-use wobble_core::format::{KickRingDown, Record};
 use wobble_model::fit::{fit, Observation, Weights};
 use wobblog::analysis::campaign_kicks::{campaign_kicks, load_campaign_kicks, Prefer, Source};
 use wobblog::analysis::{find_episodes, Episode, Run, Stability};
@@ -255,20 +254,6 @@ fn a_kick_has_margins_sigma_in_every_command() {
     assert_ne!(format!("{value:.6}"), format!("{own_value:.6}"));
 }
 
-/// A card record of a kick at `t_s` (6.9 Hz, sigma -1.1 +- 0.05 1/s),
-/// with the speed the board measured, if any.
-fn record(t_s: f64, speed_mm_s: Option<u16>) -> Record<'static> {
-    Record::Kick(KickRingDown {
-        t_us: (t_s * 1e6).round() as u64,
-        speed_mm_s,
-        freq_chz: 690,
-        sigma_milli_per_s: -1100,
-        sigma_se_milli_per_s: 50,
-        amp_cdeg: 140,
-        segments: 9,
-    })
-}
-
 /// `margin` reads a log's kicks as it streams by (in bounded memory): the
 /// same kicks as the run loaded whole gives, a card record without a speed
 /// taking the mean wheel speed over the 2 s after it.
@@ -285,9 +270,9 @@ fn streamed_kicks_are_the_whole_runs() {
         // One record beside the host's kick, two alone (one without a
         // speed).
         records: vec![
-            record(KICK_S, Some(4000)),
-            record(8.0, None),
-            record(30.0, Some(5000)),
+            kick_record(KICK_S, Some(4000)),
+            kick_record(8.0, None),
+            kick_record(30.0, Some(5000)),
         ],
         ..Extras::default()
     };

@@ -7,8 +7,7 @@ mod analysis_support;
 
 use std::path::{Path, PathBuf};
 
-use analysis_support::{kick_pass, write_log, Extras};
-use wobble_core::format::{KickRingDown, Record};
+use analysis_support::{kick_pass, kick_record, write_log, Extras};
 use wobblog::analysis::campaign_kicks::{
     load_campaign_kicks, ride_campaign_kicks, Prefer, Source, SpeedsAfter,
 };
@@ -17,19 +16,6 @@ use wobblog::analysis::run::read_rows;
 use wobblog::analysis::Ride;
 use wobblog::cmd::margin;
 use wobblog::report::Campaign;
-
-/// A card record of a kick at `t_s` with the board's speed, if any.
-fn record(t_s: f64, speed_mm_s: Option<u16>) -> Record<'static> {
-    Record::Kick(KickRingDown {
-        t_us: (t_s * 1e6).round() as u64,
-        speed_mm_s,
-        freq_chz: 650,
-        sigma_milli_per_s: -800,
-        sigma_se_milli_per_s: 60,
-        amp_cdeg: 120,
-        segments: 8,
-    })
-}
 
 /// Kick passes from 2 to 3.5 m/s of a bicycle that wobbles at 4 m/s; the
 /// second pass's card also recorded its kick (with its speed) and two
@@ -41,9 +27,9 @@ fn campaign(dir: &Path) -> Vec<PathBuf> {
             let extras = Extras {
                 records: if i == 1 {
                     vec![
-                        record(3.05, Some(2500)),
-                        record(6.0, None),
-                        record(8.5, Some(2400)),
+                        kick_record(3.05, Some(2500)),
+                        kick_record(6.0, None),
+                        kick_record(8.5, Some(2400)),
                     ]
                 } else {
                     Vec::new()

@@ -7,13 +7,13 @@
 //! every flush. Both rides decode whole.
 
 mod card_support;
-use card_support::{fat32_image, header, read_file, PART_START_BLOCKS};
+use card_support::{fat32_image, header, read_file, ride, FRAME_PERIOD_US, PART_START_BLOCKS};
 
 use std::cell::RefCell;
 use std::collections::HashMap;
 
 use embedded_sdmmc::{Block, BlockCount, BlockDevice, BlockIdx};
-use wobble_core::format::{DecodeStats, Decoder, Event, Frame, FrameStatus, GpsFix, Record};
+use wobble_core::format::{DecodeStats, Decoder, Event};
 use wobble_core::logger::mock::{MockCard, MockError};
 use wobble_core::logger::{CardLogger, FixedTime, LoggerConfig, LoggerState, AHEAD_BLOCKS};
 
@@ -58,37 +58,16 @@ fn shared_sectors(image: &[u8]) -> (u32, u32) {
     (root, part + u16_at(48))
 }
 
-/// `frames` frames at 100 Hz with a 20 Hz GPS from time `t0_us`, pushed
-/// and polled as the writer does; returns the time after the last.
-fn ride(log: &mut CardLogger<'_, Tally, FixedTime>, t0_us: u64, frames: u64) -> u64 {
-    for i in 0..frames {
-        let t = t0_us + i * 10_000;
+/// A ride of `frames` frames at 100 Hz with a 20 Hz GPS, each record
+/// polled and pushed as the writer does with no backlog; returns the time
+/// after the last.
+fn ride_into(log: &mut CardLogger<'_, Tally, FixedTime>, frames: u64) -> u64 {
+    for (t, rec) in ride(frames) {
         log.poll(t);
         log.write_ahead(t);
-        log.push(
-            &Record::Frame(Frame {
-                t_us: t,
-                accel: [i as i16, 3, 2048],
-                gyro: [(i % 97) as i16, 2, 3],
-                steer_cdeg: (i % 300) as i16,
-                wheel_count: i as u16,
-                wheel_edge_age_us: 100,
-                speed_mm_s: 4000,
-                status: FrameStatus(0),
-            }),
-            t,
-        );
-        if i % 5 == 0 {
-            let fix = GpsFix {
-                t_us: t,
-                lat_e7: Some(520_000_000 + i as i32),
-                lon_e7: Some(43_000_000),
-                ..GpsFix::default()
-            };
-            log.push(&Record::Gps(fix), t);
-        }
+        log.push(&rec, t);
     }
-    t0_us + frames * 10_000
+    frames * FRAME_PERIOD_US
 }
 
 fn decoded(file: &[u8]) -> DecodeStats {
@@ -112,7 +91,7 @@ fn an_hour_rewrites_the_directory_and_fsinfo_sectors_seldom() {
         LoggerConfig::DEFAULT,
     );
     // An earlier ride of a minute, closed: its entry shares the sector.
-    let t = ride(&mut log, 0, 6_000);
+    let t = ride_into(&mut log, 6_000);
     log.close(t).expect("closed");
     let mut log = CardLogger::new(
         log.into_device(),
@@ -121,7 +100,7 @@ fn an_hour_rewrites_the_directory_and_fsinfo_sectors_seldom() {
         LoggerConfig::DEFAULT,
     );
     log.with_device(|d| d.writes.borrow_mut().clear());
-    let end = ride(&mut log, 0, HOUR_FRAMES);
+    let end = ride_into(&mut log, HOUR_FRAMES);
     assert_eq!(log.state(), LoggerState::Logging { run: 2 });
     let stats = log.stats();
     let tally = |log: &CardLogger<'_, Tally, FixedTime>, block: u32| {

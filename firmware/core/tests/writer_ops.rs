@@ -4,7 +4,7 @@
 //! so no iteration of a long ride may make more, whatever the cluster size.
 
 mod card_support;
-use card_support::{fat32_image, fill_card, header};
+use card_support::{fat32_image, fill_card, header, ride, FRAME_PERIOD_US};
 
 use core::future::Future;
 use core::pin::pin;
@@ -16,45 +16,12 @@ use wobble_core::app::writer;
 use wobble_core::channels::{
     iteration_stall_us, RecordQueue, SharedStatus, WORST_ITERATION_US, WRITER_OPS_PER_ITERATION,
 };
-use wobble_core::format::{Decoder, Event, Frame, FrameStatus, GpsFix, Record};
+use wobble_core::format::{Decoder, Event, Record};
 use wobble_core::logger::mock::{MockCard, MockError};
 use wobble_core::logger::{CardLogger, CardOps, FixedTime, LoggerConfig, LoggerState};
 
 const CARD_BYTES: u64 = 40 << 20;
-const FRAME_PERIOD_US: u64 = 10_000;
 const CONFIG: [&str; 1] = ["sample_rate_hz=100"];
-
-fn frame(i: u64) -> Record<'static> {
-    Record::Frame(Frame {
-        t_us: i * FRAME_PERIOD_US,
-        accel: [i as i16, (i % 1000) as i16 - 500, 2048],
-        gyro: [(i % 97) as i16, 2, 3],
-        steer_cdeg: (i % 300) as i16,
-        wheel_count: i as u16,
-        wheel_edge_age_us: 100,
-        speed_mm_s: 4000,
-        status: FrameStatus(0),
-    })
-}
-
-fn fix(i: u64) -> Record<'static> {
-    Record::Gps(GpsFix {
-        t_us: i * FRAME_PERIOD_US,
-        lat_e7: Some(520_000_000 + i as i32),
-        lon_e7: Some(43_000_000 - i as i32),
-        ..GpsFix::default()
-    })
-}
-
-/// The records of `frames` frames at 100 Hz with a 20 Hz GPS: what the
-/// writer drains.
-fn ride(frames: u64) -> impl Iterator<Item = (u64, Record<'static>)> {
-    (0..frames).flat_map(|i| {
-        let t = i * FRAME_PERIOD_US;
-        let gps = (i % 5 == 0).then(|| (t, fix(i)));
-        core::iter::once((t, frame(i))).chain(gps)
-    })
-}
 
 /// Card operations of each writer iteration (a poll, a block of zeros
 /// ahead, then one record's push, as `writer::run` does with no backlog) while a file is open on the card `image`,

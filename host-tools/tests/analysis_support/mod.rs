@@ -9,9 +9,9 @@ use std::path::Path;
 use assert_cmd::Command;
 use wobble_core::format::header::header_records;
 use wobble_core::format::{
-    quantise_i16, quantise_i32, quantise_u16, Alert, BlockEncoder, FixMode, Frame, GpsFix, LogInfo,
-    Marker, Record, UtcSync, UtcTime, ACCEL_COUNTS_PER_G, EDGE_AGE_NONE, GYRO_COUNTS_PER_DPS,
-    STEER_COUNTS_PER_DEG,
+    quantise_i16, quantise_i32, quantise_u16, Alert, BlockEncoder, FixMode, Frame, GpsFix,
+    KickRingDown, LogInfo, Marker, Record, UtcSync, UtcTime, ACCEL_COUNTS_PER_G, EDGE_AGE_NONE,
+    GYRO_COUNTS_PER_DPS, STEER_COUNTS_PER_DEG,
 };
 use wobblog::analysis::{Episode, Run};
 
@@ -498,4 +498,18 @@ pub fn kick_pass(speed: f64, wobble_mps: f64, freq_hz: f64, seed: u32) -> Ride {
         *s += push + ring + noise;
     }
     ride
+}
+
+/// A card record of a kick at `t_s` (6.9 Hz, sigma -1.1 +- 0.05 1/s),
+/// with the speed the board measured, if any.
+pub fn kick_record(t_s: f64, speed_mm_s: Option<u16>) -> Record<'static> {
+    Record::Kick(KickRingDown {
+        t_us: (t_s * 1e6).round() as u64,
+        speed_mm_s,
+        freq_chz: 690,
+        sigma_milli_per_s: -1100,
+        sigma_se_milli_per_s: 50,
+        amp_cdeg: 140,
+        segments: 9,
+    })
 }

@@ -2,7 +2,11 @@
 //! implementation independent of the logger's).
 #![allow(dead_code)] // Each test file uses the helpers it needs.
 
+use wobble_core::format::{Frame, FrameStatus, GpsFix, Record};
 use wobble_core::logger::HeaderSpec;
+
+/// Frames 10 ms apart.
+pub const FRAME_PERIOD_US: u64 = 10_000;
 
 /// The header of a 100 Hz test logger with `config` lines.
 pub fn header(config: &'static [&'static str]) -> HeaderSpec<'static> {
@@ -80,4 +84,37 @@ pub fn fill_card(image: &mut [u8], free_bytes: u64) {
         file.flush().expect("flush");
         file.seek(SeekFrom::Start(0)).expect("seek");
     });
+}
+
+/// Frame `i` of a test ride (every channel moving).
+pub fn frame(i: u64) -> Record<'static> {
+    Record::Frame(Frame {
+        t_us: i * FRAME_PERIOD_US,
+        accel: [i as i16, (i % 1000) as i16 - 500, 2048],
+        gyro: [(i % 97) as i16, 2, 3],
+        steer_cdeg: (i % 300) as i16,
+        wheel_count: i as u16,
+        wheel_edge_age_us: 100,
+        speed_mm_s: 4000,
+        status: FrameStatus(0),
+    })
+}
+
+pub fn fix(i: u64) -> Record<'static> {
+    Record::Gps(GpsFix {
+        t_us: i * FRAME_PERIOD_US,
+        lat_e7: Some(520_000_000 + i as i32),
+        lon_e7: Some(43_000_000 - i as i32),
+        ..GpsFix::default()
+    })
+}
+
+/// The records of `frames` frames at 100 Hz with a 20 Hz GPS, with their
+/// times: what the writer drains.
+pub fn ride(frames: u64) -> impl Iterator<Item = (u64, Record<'static>)> {
+    (0..frames).flat_map(|i| {
+        let t = i * FRAME_PERIOD_US;
+        let gps = (i % 5 == 0).then(|| (t, fix(i)));
+        core::iter::once((t, frame(i))).chain(gps)
+    })
 }
