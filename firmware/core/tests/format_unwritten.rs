@@ -109,3 +109,45 @@ fn a_block_with_one_byte_set_is_not_unwritten() {
     );
     assert_eq!(stats.unwritten_blocks, 1);
 }
+
+#[test]
+fn zeros_after_garbage_start_at_the_next_block_offset_in_any_chunks() {
+    // The log, 100 bytes of garbage, then 4 blocks' worth of zeros: the
+    // garbage stretch runs to the next block offset, 3 whole blocks of
+    // zeros follow at block offsets, and 100 bytes of zeros end the file.
+    let mut file = log();
+    let end = file.len() as u64;
+    file.extend_from_slice(&[0x55; 100]);
+    for _ in 0..4 {
+        file.extend_from_slice(&ZEROS);
+    }
+    let (events, stats) = decode_events(&file);
+    assert_eq!(
+        skips(&events),
+        [
+            (end, BLOCK_LEN as u64, SkipCause::Garbage),
+            (end + 4 * BLOCK_LEN as u64, 100, SkipCause::TruncatedTail)
+        ]
+    );
+    assert_eq!(stats.unwritten_blocks, 3);
+    for chunk in [100, 513, 700, 1000, 1536] {
+        assert_eq!(stats_in_chunks(&file, chunk), stats, "chunks of {chunk}");
+    }
+}
+
+#[test]
+fn a_damaged_block_before_the_zeros_is_skipped_alone_in_any_chunks() {
+    let mut file = log();
+    let blocks = file.len() / BLOCK_LEN;
+    file[(blocks - 2) * BLOCK_LEN + 100] ^= 0x40;
+    file.truncate((blocks - 1) * BLOCK_LEN);
+    for _ in 0..5 {
+        file.extend_from_slice(&ZEROS);
+    }
+    let (_, stats) = decode_events(&file);
+    assert_eq!((stats.damaged_blocks, stats.unwritten_blocks), (1, 5));
+    assert_eq!(stats.bytes_skipped, BLOCK_LEN as u64);
+    for chunk in [100, 513, 700, 1000, 1536] {
+        assert_eq!(stats_in_chunks(&file, chunk), stats, "chunks of {chunk}");
+    }
+}
