@@ -660,8 +660,6 @@ mod tests {
         }
     }
 
-    /// The sampler sees the writer's card as the logger stands: an exFAT
-    /// card is not shown as a missing one.
     #[test]
     fn power_falls_are_counted_once_each() {
         let s = SharedStatus::new();
@@ -677,6 +675,8 @@ mod tests {
         assert_eq!((s.power_low(), s.power_falls()), (true, 2));
     }
 
+    /// The sampler sees the writer's card as the logger stands: an exFAT
+    /// card is not shown as a missing one.
     #[test]
     fn the_card_is_shared_as_the_logger_stands() {
         use crate::logger::LoggerState;

@@ -25,6 +25,14 @@ fn skips(events: &[Event<'_>]) -> Vec<(u64, u64, SkipCause)> {
         .collect()
 }
 
+/// Asserts that `file` fed in chunks of several sizes gives `stats`, as
+/// whole.
+fn same_in_chunks(file: &[u8], stats: DecodeStats) {
+    for chunk in [100, 512, 513, 700, 777, 1000, 1536, 4096] {
+        assert_eq!(stats_in_chunks(file, chunk), stats, "chunks of {chunk}");
+    }
+}
+
 /// The stats of `file` fed in chunks of `chunk` bytes.
 fn stats_in_chunks(file: &[u8], chunk: usize) -> DecodeStats {
     let mut dec = Decoder::new();
@@ -50,9 +58,7 @@ fn zeros_after_the_data_are_no_loss() {
     assert_eq!(stats.unwritten_blocks, 7);
     assert_eq!((stats.bytes_skipped, stats.blocks_lost), (0, 0));
     // However the stream is cut into chunks.
-    for chunk in [100, 512, 777, 4096] {
-        assert_eq!(stats_in_chunks(&file, chunk), stats, "chunks of {chunk}");
-    }
+    same_in_chunks(&file, stats);
 }
 
 #[test]
@@ -130,9 +136,7 @@ fn zeros_after_garbage_start_at_the_next_block_offset_in_any_chunks() {
         ]
     );
     assert_eq!(stats.unwritten_blocks, 3);
-    for chunk in [100, 513, 700, 1000, 1536] {
-        assert_eq!(stats_in_chunks(&file, chunk), stats, "chunks of {chunk}");
-    }
+    same_in_chunks(&file, stats);
 }
 
 #[test]
@@ -147,7 +151,5 @@ fn a_damaged_block_before_the_zeros_is_skipped_alone_in_any_chunks() {
     let (_, stats) = decode_events(&file);
     assert_eq!((stats.damaged_blocks, stats.unwritten_blocks), (1, 5));
     assert_eq!(stats.bytes_skipped, BLOCK_LEN as u64);
-    for chunk in [100, 513, 700, 1000, 1536] {
-        assert_eq!(stats_in_chunks(&file, chunk), stats, "chunks of {chunk}");
-    }
+    same_in_chunks(&file, stats);
 }

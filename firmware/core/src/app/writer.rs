@@ -9,8 +9,8 @@
 //! One iteration is a [`CardLogger::poll`] (a flush when one is due, an
 //! attempt to open a card without one), with no record waiting a block of
 //! zeros ahead of the data ([`CardLogger::write_ahead`]), and the push of
-//! one record (which writes a block when it closes one). The card operations of each
-//! iteration and its busy time are counted ([`SharedStatus::writer`]): the
+//! one record (which writes a block when it closes one). The card
+//! operations of each iteration and its busy time are counted ([`SharedStatus::writer`]): the
 //! queue is sized for the worst iteration (`channels`), and the figures
 //! show how close a card came to it.
 

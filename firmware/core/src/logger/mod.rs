@@ -431,16 +431,11 @@ impl<'a, D: BlockDevice, T: TimeSource> CardLogger<'a, D, T> {
         self.flush(now_us);
         let f = self.open.take().ok_or(CloseError::Card)?;
         // Closing rewrites the entry once more (its size and time).
-        let closed = self.fs.close_file(f.file).is_ok();
-        if closed {
-            self.stats.entry_writes = self.stats.entry_writes.saturating_add(1);
-        }
+        let closed = self.fs.close_file(f.file);
         self.release(f.dir, f.volume);
-        if closed {
-            Ok(())
-        } else {
-            Err(CloseError::Card)
-        }
+        closed.map_err(|_| CloseError::Card)?;
+        self.stats.entry_writes = self.stats.entry_writes.saturating_add(1);
+        Ok(())
     }
 
     fn count_lost(&mut self, frames: u32) {
