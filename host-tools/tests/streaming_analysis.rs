@@ -7,7 +7,7 @@ mod analysis_support;
 use std::f64::consts::TAU;
 
 use analysis_support::{assert_same_episode as assert_same, wobble, Ride, FS_HZ};
-use wobblog::analysis::kicks::KickSearch;
+use wobblog::analysis::kicks::{self, KickSearch};
 use wobblog::analysis::roll::RollStream;
 use wobblog::analysis::search::EpisodeSearch;
 use wobblog::analysis::{Cut, Episode, Run, Stability};
@@ -272,7 +272,7 @@ fn kicked_ride_of(duration_s: f64) -> Run {
 /// Kicks of `run` searched in pieces of `piece` frames, and the most
 /// frames held.
 fn kicks(run: &Run, piece: usize) -> (Vec<wobblog::analysis::Kick>, usize) {
-    let mut search = KickSearch::with_piece(run.sample_rate_hz(), 2.18, piece);
+    let mut search = KickSearch::with_piece(kicks::WOBBLE, run.sample_rate_hz(), 2.18, piece);
     for i in 0..run.len() {
         search.push(run.t_s[i], run.steer_deg[i], run.speed_mps[i]);
     }
@@ -315,7 +315,7 @@ fn kicks_found_before_the_settled_time_are_final() {
     let kept: Vec<usize> = (0..run.len())
         .filter(|&i| !(300.0..301.0).contains(&run.t_s[i]))
         .collect();
-    let mut search = KickSearch::with_piece(run.sample_rate_hz(), 2.18, 6000);
+    let mut search = KickSearch::with_piece(kicks::WOBBLE, run.sample_rate_hz(), 2.18, 6000);
     let mut seen = Vec::new();
     for &i in &kept {
         search.push(run.t_s[i], run.steer_deg[i], run.speed_mps[i]);

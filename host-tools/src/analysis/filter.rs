@@ -83,9 +83,16 @@ impl Biquad {
 /// band's edges barely touch a wobble.
 #[must_use]
 pub fn wobble_band(x: &[f64], fs_hz: f64) -> Vec<f64> {
+    band_pass(x, (4.0, 12.0), fs_hz)
+}
+
+/// Zero-phase band-pass of `x` between `(low, high)` Hz: a Butterworth
+/// high-pass and low-pass section, each run forwards and backwards.
+#[must_use]
+pub fn band_pass(x: &[f64], (low_hz, high_hz): (f64, f64), fs_hz: f64) -> Vec<f64> {
     let mut y = x.to_vec();
-    Biquad::butterworth(Pass::High, 4.0, fs_hz).filtfilt(&mut y);
-    Biquad::butterworth(Pass::Low, 12.0, fs_hz).filtfilt(&mut y);
+    Biquad::butterworth(Pass::High, low_hz, fs_hz).filtfilt(&mut y);
+    Biquad::butterworth(Pass::Low, high_hz, fs_hz).filtfilt(&mut y);
     y
 }
 

@@ -54,9 +54,132 @@ use std::f64::consts::TAU;
 
 use serde::Serialize;
 
-use super::filter::{follows, wobble_band};
+use super::filter::{band_pass, follows};
 use super::run::Run;
 use super::sinefit::fit_mode;
+
+/// The mode a kick is searched for and measured in.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum KickMode {
+    /// The 4-12 Hz steering oscillation, in the steering angle.
+    #[default]
+    Wobble,
+    /// The 0.15-3 Hz roll and steer oscillation, in the roll rate
+    /// ([`super::weave`]).
+    Weave,
+}
+
+impl KickMode {
+    /// The signal the mode's kicks are searched in, at frame `i` of `run`:
+    /// the steering angle (degrees) for the wobble, the roll rate (deg/s,
+    /// the gyroscope's forward axis) for the weave.
+    #[must_use]
+    pub fn signal(self, run: &Run, i: usize) -> f64 {
+        match self {
+            Self::Wobble => run.steer_deg[i],
+            Self::Weave => run.gyro_dps[i][0],
+        }
+    }
+
+    /// Lower case, as in the command line and the outputs.
+    #[must_use]
+    pub const fn as_str(self) -> &'static str {
+        match self {
+            Self::Wobble => "wobble",
+            Self::Weave => "weave",
+        }
+    }
+}
+
+/// How kicks of one mode are found and fitted: the steps of the module
+/// documentation, each with its number.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Band {
+    /// The zero-phase band-pass the signal goes through, Hz.
+    pub pass_hz: (f64, f64),
+    /// Moving-RMS window of the envelope, s.
+    pub envelope_window_s: f64,
+    /// Envelope a kick's ring must reach, in the signal's unit...
+    pub kick_min: f64,
+    /// ... and this many times the stretch's background.
+    pub kick_over_background: f64,
+    /// A kick rises out of at least this long below the threshold, s.
+    pub quiet_before_s: f64,
+    /// A kick's envelope reaches its peak within this of rising above the
+    /// threshold, s.
+    pub max_rise_s: f64,
+    /// The fit starts this long after the envelope's peak, s.
+    pub skip_after_peak_s: f64,
+    /// The fit ends where the envelope is back at this many times the
+    /// background...
+    pub fit_end_over_background: f64,
+    /// ... and lasts no longer than this, s.
+    pub max_fit_s: f64,
+    /// A fit spans at least this long, s.
+    pub min_fit_s: f64,
+    /// The first guess of the frequency counts zero crossings over this
+    /// much of the fit's start, s.
+    pub head_s: f64,
+    /// Fits are trusted for frequencies in this band, Hz.
+    pub freq_band_hz: (f64, f64),
+    /// Whether a wheel harmonic near the ring is fitted as a tone.
+    pub wheel_tones: bool,
+    /// Whether the signal is a rate (deg/s): a kick's amplitude is then
+    /// that of its integral (degrees), the rate's over the frequency.
+    pub rate_signal: bool,
+    /// The fit's standard error of sigma is scaled by this...
+    pub se_factor: f64,
+    /// ... and an error this large (1/s) is added in quadrature.
+    pub sd_floor_per_s: f64,
+}
+
+/// The wobble's kicks, in the steering angle (degrees).
+pub const WOBBLE: Band = Band {
+    pass_hz: (4.0, 12.0),
+    envelope_window_s: ENVELOPE_WINDOW_S,
+    kick_min: KICK_MIN_DEG,
+    kick_over_background: KICK_OVER_BACKGROUND,
+    quiet_before_s: QUIET_BEFORE_S,
+    max_rise_s: MAX_RISE_S,
+    skip_after_peak_s: SKIP_AFTER_PEAK_S,
+    fit_end_over_background: FIT_END_OVER_BACKGROUND,
+    max_fit_s: MAX_FIT_S,
+    min_fit_s: MIN_FIT_S,
+    head_s: 1.0,
+    freq_band_hz: FREQ_BAND_HZ,
+    wheel_tones: true,
+    rate_signal: false,
+    se_factor: SE_FACTOR,
+    sd_floor_per_s: SD_FLOOR_PER_S,
+};
+
+impl Band {
+    /// The band of `mode`.
+    #[must_use]
+    pub const fn of(mode: KickMode) -> Self {
+        match mode {
+            KickMode::Wobble => WOBBLE,
+            KickMode::Weave => super::weave::WEAVE,
+        }
+    }
+
+    /// The standard uncertainty of a kick's sigma from the fit's standard
+    /// error `se`: `sqrt((se_factor se)^2 + sd_floor^2)`.
+    #[must_use]
+    pub fn stated_sd(&self, se: f64) -> f64 {
+        (self.se_factor * se).hypot(self.sd_floor_per_s)
+    }
+
+    /// Consecutive pieces of a stretch share this much, s: more than a
+    /// kick's rise, skip and longest fit, and the band-pass's settling at
+    /// the piece's end; at least [`PIECE_OVERLAP_S`].
+    #[must_use]
+    pub fn piece_overlap_s(&self) -> f64 {
+        (self.max_rise_s + self.skip_after_peak_s + self.max_fit_s + 1.0 / self.pass_hz.0)
+            .max(PIECE_OVERLAP_S)
+    }
+}
 
 /// Envelope a kick's ring must reach, degrees.
 pub const KICK_MIN_DEG: f64 = 0.3;
@@ -112,7 +235,7 @@ pub const SD_FLOOR_PER_S: f64 = 0.0275;
 /// alone, 57 % within two (`host-tools/docs/kick-testing.md`).
 #[must_use]
 pub fn stated_sd(se: f64) -> f64 {
-    (SE_FACTOR * se).hypot(SD_FLOOR_PER_S)
+    WOBBLE.stated_sd(se)
 }
 
 /// One kick's ring-down.
@@ -151,13 +274,19 @@ pub const PIECE_FRAMES: usize = super::search::MAX_WINDOW_FRAMES;
 /// rising after. Each piece has its own background.
 pub const PIECE_OVERLAP_S: f64 = 10.0;
 
-/// Every kick of `run`, in time order: the frames go through a
+/// Every wobble kick of `run`, in time order: the frames go through a
 /// [`KickSearch`], as when a command streams a log.
 #[must_use]
 pub fn find_kicks(run: &Run, wheel_circumference_m: f64) -> Vec<Kick> {
-    let mut search = KickSearch::new(run.sample_rate_hz(), wheel_circumference_m);
+    find_mode_kicks(run, wheel_circumference_m, KickMode::Wobble)
+}
+
+/// Every kick of `mode` in `run`, in time order.
+#[must_use]
+pub fn find_mode_kicks(run: &Run, wheel_circumference_m: f64, mode: KickMode) -> Vec<Kick> {
+    let mut search = KickSearch::for_mode(mode, run.sample_rate_hz(), wheel_circumference_m);
     for i in 0..run.len() {
-        search.push(run.t_s[i], run.steer_deg[i], run.speed_mps[i]);
+        search.push(run.t_s[i], mode.signal(run, i), run.speed_mps[i]);
     }
     search.finish()
 }
@@ -166,12 +295,13 @@ pub fn find_kicks(run: &Run, wheel_circumference_m: f64) -> Vec<Kick> {
 /// run: each evenly sampled stretch between gaps is searched alone (no fit
 /// reaches across a gap), in pieces of at most [`PIECE_FRAMES`].
 pub struct KickSearch {
+    band: Band,
     fs: f64,
     circumference_m: f64,
     piece: usize,
     overlap: usize,
     t_s: Vec<f64>,
-    steer_deg: Vec<f64>,
+    signal: Vec<f64>,
     speed_mps: Vec<f64>,
     kicks: Vec<Kick>,
     /// Every kick rising before this is in `kicks`, s.
@@ -181,29 +311,38 @@ pub struct KickSearch {
 }
 
 impl KickSearch {
-    /// A search over frames nominally `fs_hz` apart, on a wheel of
-    /// `wheel_circumference_m` (its harmonics are fitted beside a ring).
+    /// A search for wobble kicks over frames nominally `fs_hz` apart, on
+    /// a wheel of `wheel_circumference_m` (its harmonics are fitted beside
+    /// a ring).
     #[must_use]
     pub fn new(fs_hz: f64, wheel_circumference_m: f64) -> Self {
-        Self::with_piece(fs_hz, wheel_circumference_m, PIECE_FRAMES)
+        Self::for_mode(KickMode::Wobble, fs_hz, wheel_circumference_m)
     }
 
-    /// A search in pieces of `piece` frames (at least twice the overlap;
-    /// tests use short pieces).
+    /// A search for kicks of `mode`: [`Self::push`] takes the mode's
+    /// [`KickMode::signal`].
     #[must_use]
-    pub fn with_piece(fs_hz: f64, wheel_circumference_m: f64, piece: usize) -> Self {
+    pub fn for_mode(mode: KickMode, fs_hz: f64, wheel_circumference_m: f64) -> Self {
+        Self::with_piece(Band::of(mode), fs_hz, wheel_circumference_m, PIECE_FRAMES)
+    }
+
+    /// A search of `band` in pieces of `piece` frames (at least twice the
+    /// overlap; tests use short pieces).
+    #[must_use]
+    pub fn with_piece(band: Band, fs_hz: f64, wheel_circumference_m: f64, piece: usize) -> Self {
         let overlap = if fs_hz.is_finite() && fs_hz > 0.0 {
-            (PIECE_OVERLAP_S * fs_hz).ceil() as usize
+            (band.piece_overlap_s() * fs_hz).ceil() as usize
         } else {
             0
         };
         Self {
+            band,
             fs: fs_hz,
             circumference_m: wheel_circumference_m,
             piece: piece.max(2 * overlap).max(1),
             overlap,
             t_s: Vec::new(),
-            steer_deg: Vec::new(),
+            signal: Vec::new(),
             speed_mps: Vec::new(),
             kicks: Vec::new(),
             settled_s: f64::NEG_INFINITY,
@@ -211,8 +350,9 @@ impl KickSearch {
         }
     }
 
-    /// Takes the next frame in file order: time, steering angle, speed.
-    pub fn push(&mut self, t_s: f64, steer_deg: f64, speed_mps: f64) {
+    /// Takes the next frame in file order: time, the mode's signal
+    /// (steering angle, degrees, for the wobble), speed.
+    pub fn push(&mut self, t_s: f64, signal: f64, speed_mps: f64) {
         if !(self.fs.is_finite() && self.fs > 0.0) {
             return;
         }
@@ -224,7 +364,7 @@ impl KickSearch {
             }
         }
         self.t_s.push(t_s);
-        self.steer_deg.push(steer_deg);
+        self.signal.push(signal);
         self.speed_mps.push(speed_mps);
         self.most_held = self.most_held.max(self.t_s.len());
         if self.t_s.len() >= self.piece {
@@ -268,8 +408,9 @@ impl KickSearch {
     /// `until` (all of them without it).
     fn search(&mut self, until: Option<usize>) {
         let stretch = Stretch {
+            band: &self.band,
             t_s: &self.t_s,
-            steer_deg: &self.steer_deg,
+            signal: &self.signal,
             speed_mps: &self.speed_mps,
             fs: self.fs,
         };
@@ -285,15 +426,16 @@ impl KickSearch {
     /// Forgets the first `n` frames held.
     fn clear(&mut self, n: usize) {
         self.t_s.drain(..n);
-        self.steer_deg.drain(..n);
+        self.signal.drain(..n);
         self.speed_mps.drain(..n);
     }
 }
 
 /// One evenly sampled stretch.
 struct Stretch<'a> {
+    band: &'a Band,
     t_s: &'a [f64],
-    steer_deg: &'a [f64],
+    signal: &'a [f64],
     speed_mps: &'a [f64],
     fs: f64,
 }
@@ -334,13 +476,14 @@ impl Stretch<'_> {
 
     fn kicks(&self, circumference_m: f64) -> Vec<Kick> {
         let n = self.t_s.len();
-        if n < self.samples(MIN_STRETCH_S) {
+        let b = self.band;
+        if n < self.samples(MIN_STRETCH_S.max(2.0 * b.min_fit_s)) {
             return Vec::new();
         }
-        let band = wobble_band(self.steer_deg, self.fs);
-        let env = envelope(&band, self.samples(ENVELOPE_WINDOW_S).max(3));
+        let band = band_pass(self.signal, b.pass_hz, self.fs);
+        let env = envelope(&band, self.samples(b.envelope_window_s).max(3));
         let background = quantile(env.clone(), BACKGROUND_QUANTILE);
-        let threshold = KICK_MIN_DEG.max(KICK_OVER_BACKGROUND * background);
+        let threshold = b.kick_min.max(b.kick_over_background * background);
         let mut kicks = Vec::new();
         let mut i = 0;
         let mut last_end: Option<usize> = None;
@@ -356,9 +499,9 @@ impl Stretch<'_> {
                 .max_by(|&a, &b| env[a].total_cmp(&env[b]))
                 .unwrap_or(rise);
             i = end;
-            let quiet_before = last_end.is_none_or(|e| rise >= e + self.samples(QUIET_BEFORE_S));
+            let quiet_before = last_end.is_none_or(|e| rise >= e + self.samples(b.quiet_before_s));
             last_end = Some(end);
-            if peak - rise > self.samples(MAX_RISE_S) || rise == 0 || !quiet_before {
+            if peak - rise > self.samples(b.max_rise_s) || rise == 0 || !quiet_before {
                 // Grew by itself, was already ringing at the start, or is
                 // the tail of the last ring rising out of the noise again.
                 continue;
@@ -387,26 +530,27 @@ impl Stretch<'_> {
         (rise, peak, next): (usize, usize, usize),
         circumference_m: f64,
     ) -> Option<Kick> {
-        let start = peak + self.samples(SKIP_AFTER_PEAK_S);
-        let floor = FIT_END_OVER_BACKGROUND * background;
-        let last = (start + self.samples(MAX_FIT_S)).min(next.saturating_sub(1));
+        let b = self.band;
+        let start = peak + self.samples(b.skip_after_peak_s);
+        let floor = b.fit_end_over_background * background;
+        let last = (start + self.samples(b.max_fit_s)).min(next.saturating_sub(1));
         let stop = (start..last).find(|&k| env[k] <= floor).unwrap_or(last);
-        if stop < start + self.samples(MIN_FIT_S) {
+        if stop < start + self.samples(b.min_fit_s) {
             return None;
         }
         let t = &self.t_s[start..stop];
         let x = &band[start..stop];
         let duration = t[t.len() - 1] - t[0];
         let sigma0 = ((env[stop].max(1e-3) / env[start].max(1e-3)).ln() / duration).min(-0.05);
-        // Zero crossings of the first second, where the ring stands well
+        // Zero crossings of the fit's start, where the ring stands well
         // above the noise.
-        let head = &x[..x.len().min(self.samples(1.0))];
+        let head = &x[..x.len().min(self.samples(b.head_s))];
         let crossings = head
             .windows(2)
             .filter(|w| (w[0] < 0.0) != (w[1] < 0.0))
             .count();
         let freq0 = crossings as f64 * self.fs / (2.0 * head.len() as f64);
-        if !(FREQ_BAND_HZ.0..FREQ_BAND_HZ.1).contains(&freq0) {
+        if !(b.freq_band_hz.0..b.freq_band_hz.1).contains(&freq0) {
             return None;
         }
         let speed = self.speed_mps[start..stop].iter().sum::<f64>() / t.len() as f64;
@@ -418,20 +562,24 @@ impl Stretch<'_> {
                 beat < TONE_SEARCH_HZ && beat * duration >= MIN_TONE_BEATS
             })
             .min_by(|a, b| (a - freq0).abs().total_cmp(&(b - freq0).abs()))
-            .filter(|_| wheel_hz > 0.0);
+            .filter(|_| b.wheel_tones && wheel_hz > 0.0);
         let fit = fit_mode(t, x, sigma0, TAU * freq0, tone.map(|f| TAU * f))?;
         let freq = fit.omega_rad_s / TAU;
         let plausible = fit.residual_rel <= MAX_RESIDUAL_REL
-            && (FREQ_BAND_HZ.0..FREQ_BAND_HZ.1).contains(&freq)
+            && (b.freq_band_hz.0..b.freq_band_hz.1).contains(&freq)
             && fit.sigma_se_per_s.is_finite();
         plausible.then(|| Kick {
             t_s: self.t_s[rise],
             speed_mps: speed,
             freq_hz: freq,
             sigma_per_s: fit.sigma_per_s,
-            sigma_sd_per_s: stated_sd(fit.sigma_se_per_s),
+            sigma_sd_per_s: b.stated_sd(fit.sigma_se_per_s),
             sigma_se_fit_per_s: fit.sigma_se_per_s,
-            amp_deg: fit.log_amp.exp(),
+            amp_deg: if b.rate_signal {
+                fit.log_amp.exp() / fit.omega_rad_s
+            } else {
+                fit.log_amp.exp()
+            },
             fit_s: [t[0], t[t.len() - 1]],
             residual_rel: fit.residual_rel,
         })

@@ -13,10 +13,11 @@ pub mod roll;
 pub mod run;
 pub mod search;
 pub mod sinefit;
+pub mod weave;
 
 pub use censor::Cut;
 pub use episodes::{find_episodes, wobble_speed_mps, Episode, Measured, Stability};
-pub use kicks::{find_kicks, Kick};
+pub use kicks::{find_kicks, find_mode_kicks, Kick, KickMode};
 pub use ride::Ride;
 pub use roll::estimate_roll_deg;
 pub use run::Run;

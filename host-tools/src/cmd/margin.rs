@@ -8,6 +8,7 @@ use std::path::{Path, PathBuf};
 use serde::Serialize;
 
 use crate::analysis::campaign_kicks::{load_campaign_kicks, CampaignKick, Prefer};
+use crate::analysis::kicks::KickMode;
 use crate::analysis::margin::{predict_with, KickPoint, Margin, Trend, RIDE_MARGIN};
 use crate::cmd::logs::{expand, for_each_log, print, print_json, warn_losses};
 use crate::cmd::margin_model::{estimate, ModelEstimate, DEFAULT_PARAMS};
@@ -55,6 +56,12 @@ pub struct Args {
     #[arg(long, value_name = "PERCENT", default_value_t = 100.0 * RIDE_MARGIN,
           value_parser = parse_percent)]
     pub ride_margin: f64,
+    /// The mode whose critical speed is predicted: `wobble` (from kicks
+    /// below the wobble speed, in the steering angle) or `weave` (the
+    /// weave speed, where the weave turns stable, from kicks above it, in
+    /// the roll rate; the host's kicks only, no `--plot` or `--model`).
+    #[arg(long, value_enum, default_value_t = KickMode::Wobble)]
+    pub mode: KickMode,
 }
 
 /// A riding margin in per cent: a number from 0 to 90.
@@ -200,6 +207,9 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         ImageKind::of(plot)?;
     }
     let logs = crate::inputs::distinct(expand(&args.inputs)?);
+    if args.mode == KickMode::Weave {
+        return crate::cmd::margin_weave::run(args, &logs);
+    }
     let mut inputs: Vec<&Path> = logs.iter().map(PathBuf::as_path).collect();
     if let Some(params) = &args.model {
         inputs.push(params);
@@ -311,7 +321,7 @@ pub fn figure(report: &Report, margin: Margin) -> MarginPlot {
 }
 
 /// `v` to two decimals, or `what` for none.
-fn speed_text(v: Option<f64>, what: &str) -> String {
+pub(crate) fn speed_text(v: Option<f64>, what: &str) -> String {
     v.map_or(what.into(), |v| format!("{v:.2} m/s"))
 }
 

@@ -12,6 +12,7 @@ pub mod info;
 pub mod logs;
 pub mod margin;
 pub mod margin_model;
+pub mod margin_weave;
 pub mod model;
 pub mod nmea;
 pub mod plot;

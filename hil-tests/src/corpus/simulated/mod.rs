@@ -33,6 +33,7 @@ pub mod campaign;
 pub mod catalog;
 pub mod road;
 pub mod sensors;
+pub mod weave;
 
 use nalgebra::DVector;
 

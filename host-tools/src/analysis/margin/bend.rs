@@ -86,6 +86,18 @@ impl BendPrior {
         sd_convex: BEND_SHAPE_SD_CONVEX,
         sd_concave: BEND_SHAPE_SD_CONCAVE,
     };
+    /// The weave's shape in the reciprocal speed ([`super::weave`]):
+    /// `beta` of the benchmark and BicycleParameters' six measured
+    /// bicycles is 0.3 and 9.3-14.4 (mean 9.1, SD 4.1,
+    /// `host-tools/tests/weave_bend.rs`); the prior's mean lies between
+    /// the benchmark's and the others', its SD wide enough that each is
+    /// within 1.3 SDs of it (the simulated campaigns of the seven:
+    /// `hil-tests/tests/weave_kicks.rs`).
+    pub const WEAVE: Self = Self {
+        mean: 7.0,
+        sd_convex: 6.0,
+        sd_concave: 6.0,
+    };
     /// No bend assumed or allowed for: a straight line.
     pub const NONE: Self = Self {
         mean: 0.0,

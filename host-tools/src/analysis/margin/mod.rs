@@ -43,6 +43,7 @@ pub mod fit;
 pub mod interval;
 #[cfg(test)]
 mod tests;
+pub mod weave;
 
 use serde::Serialize;
 

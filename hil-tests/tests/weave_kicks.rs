@@ -1,0 +1,125 @@
+//! Simulated weave kick campaigns on seven published bicycles
+//! (`hil-tests/src/corpus/simulated/weave.rs`): the host's weave kicks
+//! against every kick's true weave eigenvalue, and each campaign's
+//! predicted weave speed against the bicycle's.
+
+use std::sync::OnceLock;
+
+use wobble_hil::corpus::signal::WHEEL_CIRCUMFERENCE_M;
+use wobble_hil::corpus::simulated::weave::{self, Campaign, Plan, WeaveKickTruth, BICYCLES};
+use wobblog::analysis::margin::weave::predict_weave;
+use wobblog::analysis::margin::{KickPoint, Trend};
+use wobblog::analysis::{find_mode_kicks, Kick, KickMode, Run};
+
+/// Seeds of the campaigns: the stated SD was calibrated on 300-306 and
+/// 400-406 (`analysis::weave`), so these are others.
+const SEED: u64 = 700;
+
+/// One campaign per bicycle, written and read back, with the host's weave
+/// kicks of each pass.
+struct Loaded {
+    campaign: Campaign,
+    kicks: Vec<Vec<Kick>>,
+}
+
+fn loaded() -> &'static [Loaded] {
+    static L: OnceLock<Vec<Loaded>> = OnceLock::new();
+    L.get_or_init(|| {
+        let tmp = tempfile::tempdir().unwrap();
+        BICYCLES
+            .iter()
+            .zip(SEED..)
+            .map(|(b, seed)| {
+                let campaign = weave::simulate(b, &Plan::default(), seed).unwrap();
+                let kicks = campaign
+                    .write(&tmp.path().join(b))
+                    .unwrap()
+                    .iter()
+                    .map(|log| {
+                        let run = Run::load(log).unwrap();
+                        find_mode_kicks(&run, WHEEL_CIRCUMFERENCE_M, KickMode::Weave)
+                    })
+                    .collect();
+                Loaded { campaign, kicks }
+            })
+            .collect()
+    })
+}
+
+/// Every (truth, measured kick) pair; a missed kick pairs with `None`.
+fn pairs() -> Vec<(&'static WeaveKickTruth, Option<&'static Kick>)> {
+    let mut out = Vec::new();
+    for l in loaded() {
+        for (pass, kicks) in l.campaign.passes.iter().zip(&l.kicks) {
+            let log = format!("{}.wbl", pass.name);
+            for truth in l.campaign.kicks.iter().filter(|k| k.log == log) {
+                out.push((
+                    truth,
+                    kicks.iter().find(|k| (k.t_s - truth.t_s).abs() < 1.0),
+                ));
+            }
+        }
+    }
+    out
+}
+
+/// The issue's measure: frequency within 0.05 Hz and damping within 0.3
+/// 1/s of the truth for most kicks; 85 % found; no kick found where
+/// none was given; the stated SD honest (two thirds of the errors within
+/// one, 85 % within two).
+#[test]
+fn weave_kicks_meet_their_accuracy() {
+    let pairs = pairs();
+    let found: Vec<(&WeaveKickTruth, &Kick)> = pairs
+        .iter()
+        .filter_map(|(t, k)| k.map(|k| (*t, k)))
+        .collect();
+    let within = |t: &WeaveKickTruth, k: &Kick| {
+        (k.freq_hz - t.freq_hz).abs() <= 0.05 && (k.sigma_per_s - t.sigma_per_s).abs() <= 0.3
+    };
+    let good = found.iter().filter(|(t, k)| within(t, k)).count();
+    let z: Vec<f64> = found
+        .iter()
+        .map(|(t, k)| ((k.sigma_per_s - t.sigma_per_s) / k.sigma_sd_per_s).abs())
+        .collect();
+    let share = |limit: f64| z.iter().filter(|z| **z <= limit).count() as f64 / z.len() as f64;
+    let n = pairs.len();
+    eprintln!(
+        "{n} kicks, {} found, {good} within 0.05 Hz and 0.3 1/s; |error|/SD within 1: {:.2}, \
+         within 2: {:.2}",
+        found.len(),
+        share(1.0),
+        share(2.0)
+    );
+    assert!(found.len() * 20 >= n * 17, "{} of {n} found", found.len());
+    assert!(good * 10 >= n * 8, "{good} of {n} within");
+    assert!((0.58..0.78).contains(&share(1.0)), "{}", share(1.0));
+    assert!(share(2.0) >= 0.85, "{}", share(2.0));
+    let extra: usize = loaded()
+        .iter()
+        .flat_map(|l| &l.kicks)
+        .map(Vec::len)
+        .sum::<usize>()
+        - found.len();
+    assert_eq!(extra, 0, "kicks found where none was given");
+}
+
+/// Each campaign's 95 % interval holds the bicycle's weave speed, lies
+/// below its kicks, and is bounded; the estimates are within 0.3 m/s.
+#[test]
+fn each_campaign_brackets_its_weave_speed() {
+    for l in loaded() {
+        let points: Vec<KickPoint> = l.kicks.iter().flatten().map(KickPoint::from).collect();
+        let m = predict_weave(&points, Trend::Line);
+        let truth = l.campaign.weave_speed_mps;
+        let [lo, hi] = m.ci95_mps;
+        eprintln!(
+            "{}: truth {truth:.3}, predicted {:?} [{lo:?}, {hi:?}] from {} kicks",
+            l.campaign.bicycle, m.weave_speed_mps, m.kicks_used
+        );
+        let (lo, hi) = (lo.unwrap(), hi.unwrap());
+        let slowest = m.speed_range_mps.unwrap()[0];
+        assert!(lo <= truth && truth <= hi && hi < slowest, "{m:?}");
+        assert!((m.weave_speed_mps.unwrap() - truth).abs() < 0.3, "{m:?}");
+    }
+}

@@ -1,0 +1,162 @@
+//! `wobblog margin --mode weave`: a hand-made campaign whose answer is
+//! written down (roll-rate ring-downs at 0.8 Hz decaying at `sigma =
+//! 8 (1/u - 1/4)`, so the weave speed is 4 m/s and sigma is straight in
+//! `1/u`), its JSON and table forms and its refusals.
+
+mod analysis_support;
+
+use std::f64::consts::TAU;
+use std::path::Path;
+
+use analysis_support::{wobblog, Extras, Ride};
+use serde_json::Value;
+
+/// The campaign's weave speed, m/s.
+const WEAVE_MPS: f64 = 4.0;
+
+/// sigma of the weave at `u`, 1/s.
+fn sigma(u: f64) -> f64 {
+    8.0 * (1.0 / u - 1.0 / WEAVE_MPS)
+}
+
+/// A 15 s pass at `speed` with a kick at 4 s: the roll rate rings at
+/// 0.8 Hz from 15 deg/s, decaying at [`sigma`], plus small deterministic
+/// noise.
+fn pass(path: &Path, speed: f64, seed: u32) {
+    let mut ride = Ride::new(15.0, speed, 0.0, 0.0, 0.0);
+    let mut state = 0x9E37_79B9u32 ^ seed;
+    for (t, g) in ride.t_s.iter().zip(ride.gyro_dps.iter_mut()) {
+        state ^= state << 13;
+        state ^= state >> 17;
+        state ^= state << 5;
+        let noise = 0.3 * (f64::from(state) / f64::from(u32::MAX) - 0.5);
+        let tau = t - 4.0;
+        let ring = if tau >= 0.0 {
+            15.0 * (sigma(speed) * tau).exp() * (TAU * 0.8 * tau).sin()
+        } else {
+            0.0
+        };
+        g[0] += ring + noise;
+    }
+    analysis_support::write_log(path, &ride, &Extras::default());
+}
+
+/// Ten passes at 4.6-6.4 m/s in a new directory.
+fn campaign() -> tempfile::TempDir {
+    let dir = tempfile::tempdir().unwrap();
+    for i in 0..10 {
+        let u = 4.6 + 0.2 * f64::from(i);
+        pass(&dir.path().join(format!("RUN{i:05}.WBL")), u, i as u32);
+    }
+    dir
+}
+
+#[test]
+fn json_gives_the_weave_speed_below_the_kicks() {
+    let dir = campaign();
+    let out = wobblog()
+        .args(["margin", "--mode", "weave", "--json"])
+        .arg(dir.path())
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["mode"], "weave");
+    let kicks = v["kicks"].as_array().unwrap();
+    assert_eq!(kicks.len(), 10, "{v}");
+    for k in kicks {
+        let u = k["speed_mps"].as_f64().unwrap();
+        assert!((k["freq_hz"].as_f64().unwrap() - 0.8).abs() < 0.02, "{k}");
+        let error = (k["sigma_per_s"].as_f64().unwrap() - sigma(u)).abs();
+        assert!(
+            error < 0.1 && error < 2.0 * k["sigma_sd_per_s"].as_f64().unwrap(),
+            "{k}"
+        );
+        // The roll angle's amplitude: 15 deg/s over 2 pi 0.8 rad/s, less
+        // what the ring decayed before the fit's start.
+        let roll = k["amp_deg"].as_f64().unwrap();
+        assert!(roll > 1.0 && roll < 15.0 / (TAU * 0.8) * 1.05, "{k}");
+        assert_eq!(k["used"], true);
+    }
+    let w = v["weave_speed_mps"].as_f64().unwrap();
+    let lo = v["ci95_mps"][0].as_f64().unwrap();
+    let hi = v["ci95_mps"][1].as_f64().unwrap();
+    assert!(lo < WEAVE_MPS && WEAVE_MPS < hi && hi < 4.6, "{v}");
+    assert!((w - WEAVE_MPS).abs() < 0.3, "{w}");
+    assert_eq!(v["kicks_used"], 10);
+}
+
+#[test]
+fn the_table_says_it_in_words() {
+    let dir = campaign();
+    let out = wobblog()
+        .args(["margin", "--mode", "weave"])
+        .arg(dir.path())
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert!(
+        text.starts_with("10 weave kicks in 10 logs: 10 used, 0 rejected\n"),
+        "{text}"
+    );
+    assert!(text.contains("predicted weave speed "), "{text}");
+    assert!(text.contains("(the weave is stable above it)"), "{text}");
+}
+
+#[test]
+fn options_of_the_wobble_alone_are_refused() {
+    let dir = campaign();
+    for extra in [
+        &["--plot", "x.png"][..],
+        &["--model", "m.toml"],
+        &["--kicks", "card"],
+    ] {
+        let out = wobblog()
+            .args(["margin", "--mode", "weave"])
+            .args(extra)
+            .arg(dir.path())
+            .output()
+            .unwrap();
+        assert_eq!(out.status.code(), Some(2), "{extra:?}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            err.contains(&format!("--mode weave does not take {}", extra[0])),
+            "{err}"
+        );
+    }
+}
+
+/// A wobble campaign's logs have no weave kicks: too few, no prediction.
+#[test]
+fn no_weave_kicks_no_prediction() {
+    let dir = tempfile::tempdir().unwrap();
+    for i in 0..3 {
+        let ride = analysis_support::kick_pass(3.0 + f64::from(i), 6.0, 6.5, i);
+        analysis_support::write_log(
+            &dir.path().join(format!("RUN{i:05}.WBL")),
+            &ride,
+            &Extras::default(),
+        );
+    }
+    let out = wobblog()
+        .args(["margin", "--mode", "weave", "--json"])
+        .arg(dir.path())
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    let v: Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["kicks"].as_array().unwrap().len(), 0, "{v}");
+    assert_eq!(v["weave_speed_mps"], Value::Null);
+    assert!(
+        v["warnings"][0]
+            .as_str()
+            .unwrap()
+            .starts_with("too few kicks"),
+        "{v}"
+    );
+}
