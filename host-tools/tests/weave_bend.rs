@@ -73,7 +73,10 @@ fn the_weaves_bend_in_reciprocal_speed_lies_within_the_prior() {
     // Each lies within 1.3 SDs of the prior's mean, which is within half
     // an SD of theirs (9.1).
     let p = BendPrior::WEAVE;
-    assert!(betas.iter().all(|b| (b - p.mean).abs() < 1.3 * p.sd_convex), "{betas:?}");
+    assert!(
+        betas.iter().all(|b| (b - p.mean).abs() < 1.3 * p.sd_convex),
+        "{betas:?}"
+    );
     let mean = betas.iter().sum::<f64>() / betas.len() as f64;
     assert!((mean - p.mean).abs() < 0.5 * p.sd_concave, "{mean}");
 }
