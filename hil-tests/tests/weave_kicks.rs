@@ -9,7 +9,7 @@ use wobble_hil::corpus::signal::WHEEL_CIRCUMFERENCE_M;
 use wobble_hil::corpus::simulated::weave::{self, Campaign, Plan, WeaveKickTruth, BICYCLES};
 use wobblog::analysis::margin::weave::predict_weave;
 use wobblog::analysis::margin::{KickPoint, Trend};
-use wobblog::analysis::{find_mode_kicks, Kick, KickMode, Run};
+use wobblog::analysis::{find_episodes, find_kicks, find_mode_kicks, Episode, Kick, KickMode, Run};
 
 /// Seeds of the campaigns: the stated SD was calibrated on 300-306 and
 /// 400-406 (`analysis::weave`), so these are others.
@@ -20,6 +20,9 @@ const SEED: u64 = 700;
 struct Loaded {
     campaign: Campaign,
     kicks: Vec<Vec<Kick>>,
+    /// What the wobble's analyses find in the same logs: kicks and
+    /// episodes, per pass.
+    wobble: Vec<(Vec<Kick>, Vec<Episode>)>,
 }
 
 fn loaded() -> &'static [Loaded] {
@@ -31,16 +34,25 @@ fn loaded() -> &'static [Loaded] {
             .zip(SEED..)
             .map(|(b, seed)| {
                 let campaign = weave::simulate(b, &Plan::default(), seed).unwrap();
-                let kicks = campaign
+                let runs: Vec<Run> = campaign
                     .write(&tmp.path().join(b))
                     .unwrap()
                     .iter()
-                    .map(|log| {
-                        let run = Run::load(log).unwrap();
-                        find_mode_kicks(&run, WHEEL_CIRCUMFERENCE_M, KickMode::Weave)
-                    })
+                    .map(|log| Run::load(log).unwrap())
                     .collect();
-                Loaded { campaign, kicks }
+                let kicks = runs
+                    .iter()
+                    .map(|run| find_mode_kicks(run, WHEEL_CIRCUMFERENCE_M, KickMode::Weave))
+                    .collect();
+                let wobble = runs
+                    .iter()
+                    .map(|run| (find_kicks(run, WHEEL_CIRCUMFERENCE_M), find_episodes(run)))
+                    .collect();
+                Loaded {
+                    campaign,
+                    kicks,
+                    wobble,
+                }
             })
             .collect()
     })
@@ -121,5 +133,17 @@ fn each_campaign_brackets_its_weave_speed() {
         let slowest = m.speed_range_mps.unwrap()[0];
         assert!(lo <= truth && truth <= hi && hi < slowest, "{m:?}");
         assert!((m.weave_speed_mps.unwrap() - truth).abs() < 0.3, "{m:?}");
+    }
+}
+
+/// No weave ring-down is called a wobble: the wobble's kick search and
+/// episode search find nothing in the weave campaigns' logs.
+#[test]
+fn no_weave_ring_down_is_called_wobble() {
+    for l in loaded() {
+        for (pass, (kicks, episodes)) in l.campaign.passes.iter().zip(&l.wobble) {
+            assert!(kicks.is_empty(), "{}: {kicks:?}", pass.name);
+            assert!(episodes.is_empty(), "{}: {episodes:?}", pass.name);
+        }
     }
 }

@@ -25,7 +25,12 @@
 //!    [`ONSET_AMP_DEG`]: the wobble's start "from nothing", independent of
 //!    where the noise floor happens to be. A stable episode starts where it
 //!    was struck.
-//! 5. Each stretch between gaps is analysed alone, so no fit reaches across
+//! 5. An oscillation whose frequency lies outside [`WOBBLE_BAND_HZ`] is
+//!    not a wobble, however strongly it shows through the band-pass's
+//!    skirts: a weave of several degrees at 1-2.5 Hz, pedalling, a
+//!    rider's shimmy of the bar. It is no episode (the weave's kicks are
+//!    measured in their own band: [`super::weave`]).
+//! 6. Each stretch between gaps is analysed alone, so no fit reaches across
 //!    a gap. An episode that reaches a lost block, a dropout, a time jump or
 //!    an end of the data is **censored** (see [`super::censor`]): its onset
 //!    is not placed before the cut, its peak and end are only what was seen,
@@ -39,7 +44,7 @@ use serde::Serialize;
 
 use super::campaign_kicks::{Source, MATCH_S};
 use super::censor::{Cut, Edge};
-use super::filter::{wobble_band, wobble_band_causal, Biquad, Pass};
+use super::filter::{wobble_band, wobble_band_causal, Biquad, Pass, WOBBLE_BAND_HZ};
 use super::kicks::Kick;
 use super::run::Run;
 use super::search::EpisodeSearch;
@@ -98,6 +103,7 @@ const TONE_LOOKBACK_S: f64 = 4.0;
 const TONE_SEARCH_HZ: f64 = 1.5;
 /// Speed at onset is the mean over onset ± this, s.
 const SPEED_HALF_WIDTH_S: f64 = 0.25;
+
 /// Spans shorter than this (between gaps in the data) are not analysed, s.
 pub(super) const MIN_SPAN_S: f64 = 2.0;
 
@@ -497,6 +503,9 @@ impl<'a> Span<'a> {
                 kick.fit_s,
             ),
         };
+        if !(WOBBLE_BAND_HZ.0..=WOBBLE_BAND_HZ.1).contains(&freq_hz) {
+            return None;
+        }
         // An onset before the stretch began would be extrapolated across
         // the cut: the first frame after it is all the data say.
         let start = if starts_at_cut {

@@ -83,8 +83,12 @@ impl Biquad {
 /// band's edges barely touch a wobble.
 #[must_use]
 pub fn wobble_band(x: &[f64], fs_hz: f64) -> Vec<f64> {
-    band_pass(x, (4.0, 12.0), fs_hz)
+    band_pass(x, WOBBLE_BAND_HZ, fs_hz)
 }
+
+/// The wobble band's corners, Hz: what every wobble analysis passes, and
+/// where the frequencies it reports lie.
+pub const WOBBLE_BAND_HZ: (f64, f64) = (4.0, 12.0);
 
 /// Zero-phase band-pass of `x` between `(low, high)` Hz: a Butterworth
 /// high-pass and low-pass section, each run forwards and backwards.
@@ -105,8 +109,8 @@ pub fn band_pass(x: &[f64], (low_hz, high_hz): (f64, f64), fs_hz: f64) -> Vec<f6
 #[must_use]
 pub fn wobble_band_causal(x: &[f64], fs_hz: f64) -> Vec<f64> {
     let mut y = x.to_vec();
-    let high = Biquad::butterworth(Pass::High, 4.0, fs_hz);
-    let low = Biquad::butterworth(Pass::Low, 12.0, fs_hz);
+    let high = Biquad::butterworth(Pass::High, WOBBLE_BAND_HZ.0, fs_hz);
+    let low = Biquad::butterworth(Pass::Low, WOBBLE_BAND_HZ.1, fs_hz);
     for section in [high, high, low, low] {
         section.forward(&mut y);
     }

@@ -54,7 +54,7 @@ use std::f64::consts::TAU;
 
 use serde::Serialize;
 
-use super::filter::{band_pass, follows};
+use super::filter::{band_pass, follows, WOBBLE_BAND_HZ};
 use super::run::Run;
 use super::sinefit::fit_mode;
 
@@ -136,7 +136,7 @@ pub struct Band {
 
 /// The wobble's kicks, in the steering angle (degrees).
 pub const WOBBLE: Band = Band {
-    pass_hz: (4.0, 12.0),
+    pass_hz: WOBBLE_BAND_HZ,
     envelope_window_s: ENVELOPE_WINDOW_S,
     kick_min: KICK_MIN_DEG,
     kick_over_background: KICK_OVER_BACKGROUND,
@@ -147,7 +147,7 @@ pub const WOBBLE: Band = Band {
     max_fit_s: MAX_FIT_S,
     min_fit_s: MIN_FIT_S,
     head_s: 1.0,
-    freq_band_hz: FREQ_BAND_HZ,
+    freq_band_hz: WOBBLE_BAND_HZ,
     wheel_tones: true,
     rate_signal: false,
     se_factor: SE_FACTOR,
@@ -216,8 +216,6 @@ const MAX_RESIDUAL_REL: f64 = 0.6;
 /// A wheel harmonic within this of the ring's frequency is fitted beside
 /// it, Hz.
 const TONE_SEARCH_HZ: f64 = 1.0;
-/// Fits are trusted for frequencies in this band, Hz.
-const FREQ_BAND_HZ: (f64, f64) = (4.0, 12.0);
 
 /// The fit's standard error of sigma is scaled by this...
 pub const SE_FACTOR: f64 = 1.6;
