@@ -282,6 +282,11 @@ fn runs_columns() -> Vec<Column<RunsRow>> {
 fn episodes_columns() -> Vec<Column<EpisodesRow>> {
     let mut columns = identity!(EpisodesRow).to_vec();
     columns.extend([
+        Column::<EpisodesRow> {
+            name: "mode",
+            kind: Kind::Label,
+            value: |r| Value::Label(Some(r.episode.mode.as_str())),
+        },
         number!(EpisodesRow, "onset_s", r => Some(r.episode.onset_s)),
         number!(EpisodesRow, "end_s", r => Some(r.episode.end_s)),
         number!(EpisodesRow, "peak_s", r => Some(r.episode.peak_s)),
@@ -400,7 +405,7 @@ pub fn write_dataset(
             Err(e) => return Err(e),
         };
         progress(entry, Outcome::Written(&ride));
-        episodes.extend(ride.episodes.iter().cloned().map(|episode| EpisodesRow {
+        episodes.extend(ride.all_episodes().into_iter().map(|episode| EpisodesRow {
             entry: entry.clone(),
             episode,
         }));

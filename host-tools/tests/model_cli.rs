@@ -266,9 +266,10 @@ fn compare_prints_residuals_and_fit_writes_the_fitted_file() {
         .lines()
         .find(|l| l.starts_with("wobble_fig6.WBL"))
         .expect(&text);
+    assert_eq!(row.split_whitespace().nth(1), Some("wobble"), "{row}");
     let cols: Vec<f64> = row
         .split_whitespace()
-        .skip(1)
+        .skip(2)
         .take(8)
         .map(|c| c.parse().unwrap())
         .collect();

@@ -196,15 +196,16 @@ fn a_kick_has_margins_sigma_in_every_command() {
     assert_eq!(rows.len(), 2, "{text}");
     let kick_row = rows
         .iter()
-        .find(|r| r[1] == format!("{:.2}", own_kick.onset_s))
+        .find(|r| r[2] == format!("{:.2}", own_kick.onset_s))
         .expect(&text);
-    assert_eq!(kick_row[3], format!("{:.2}", margin.freq_hz), "{text}");
-    assert_eq!(kick_row[6], format!("{:.2}", margin.sigma_per_s), "{text}");
-    assert_ne!(kick_row[6], format!("{:.2}", own_kick.sigma_per_s));
-    assert_eq!(kick_row[9], "host", "{text}");
-    let wobble_row = rows.iter().find(|r| r[9] == "episode").expect(&text);
+    assert_eq!(kick_row[1], "wobble", "{text}");
+    assert_eq!(kick_row[4], format!("{:.2}", margin.freq_hz), "{text}");
+    assert_eq!(kick_row[7], format!("{:.2}", margin.sigma_per_s), "{text}");
+    assert_ne!(kick_row[7], format!("{:.2}", own_kick.sigma_per_s));
+    assert_eq!(kick_row[10], "host", "{text}");
+    let wobble_row = rows.iter().find(|r| r[10] == "episode").expect(&text);
     assert_eq!(
-        wobble_row[6],
+        wobble_row[7],
         format!("{:.2}", own_wobble.sigma_per_s),
         "{text}"
     );

@@ -110,6 +110,7 @@ fn ride(frames: usize) -> Ride {
         distance_m: 0.0,
         max_speed_mps: 0.0,
         host_kicks: None,
+        weave_kicks: Vec::new(),
     }
 }
 

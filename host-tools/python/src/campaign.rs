@@ -65,6 +65,7 @@ pub fn margin<'py>(
         kicks: prefer(kicks)?,
         trend: choice::<Trend>("trend", trend)?,
         ride_margin: ride_margin_pct,
+        mode: wobblog::analysis::KickMode::Wobble,
     };
     let logs = detached(py, "margin", || {
         Ok(wobblog::inputs::distinct(expand(&args.inputs)?))

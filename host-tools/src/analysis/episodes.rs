@@ -45,7 +45,7 @@ use serde::Serialize;
 use super::campaign_kicks::{Source, MATCH_S};
 use super::censor::{Cut, Edge};
 use super::filter::{wobble_band, wobble_band_causal, Biquad, Pass, WOBBLE_BAND_HZ};
-use super::kicks::Kick;
+use super::kicks::{Kick, KickMode};
 use super::run::Run;
 use super::search::EpisodeSearch;
 use super::sinefit::{fit_mode, Grid, SineFit};
@@ -148,9 +148,13 @@ impl Serialize for Measured {
     }
 }
 
-/// One wobble episode.
+/// One episode: a wobble's, or a weave's ring-down after a kick
+/// ([`Episode::of_weave_kick`]).
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Episode {
+    /// The mode: `wobble` (in the steering angle) or `weave` (a kick's
+    /// ring-down in the roll rate).
+    pub mode: KickMode,
     /// Start, s since boot (see the module notes).
     pub onset_s: f64,
     /// Envelope back below [`QUIET_AMP_DEG`], s since boot.
@@ -167,7 +171,8 @@ pub struct Episode {
     pub sigma_sd_per_s: Option<f64>,
     /// Where `freq_hz`, `sigma_per_s` and `sigma_sd_per_s` come from.
     pub source: Measured,
-    /// Largest envelope (zero to peak), degrees.
+    /// Largest envelope (zero to peak), degrees: of the steering angle for
+    /// the wobble, of the roll angle at the fit's start for the weave.
     pub peak_amp_deg: f64,
     /// Wheel speed at onset, m/s.
     pub speed_at_onset_mps: f64,
@@ -185,6 +190,35 @@ pub struct Episode {
 }
 
 impl Episode {
+    /// The weave's ring-down after `kick` (found in the roll rate,
+    /// [`super::weave`]) as an episode: it starts where the kick rose, ends
+    /// with its fit, peaks at the fit's start with the roll angle's
+    /// amplitude; stable if it decays.
+    #[must_use]
+    pub fn of_weave_kick(kick: &Kick) -> Self {
+        Self {
+            mode: KickMode::Weave,
+            onset_s: kick.t_s,
+            end_s: kick.fit_s[1],
+            peak_s: kick.fit_s[0],
+            freq_hz: kick.freq_hz,
+            sigma_per_s: kick.sigma_per_s,
+            sigma_sd_per_s: Some(kick.sigma_sd_per_s),
+            source: Measured::Kick(Source::Host),
+            peak_amp_deg: kick.amp_deg,
+            speed_at_onset_mps: kick.speed_mps,
+            stability: if kick.sigma_per_s < 0.0 {
+                Stability::Stable
+            } else {
+                Stability::Unstable
+            },
+            fit_s: kick.fit_s,
+            censored: false,
+            cut_at_start: None,
+            cut_at_end: None,
+        }
+    }
+
     /// What cuts the episode, in words (`start: lost_blocks, end:
     /// data_end`); empty when the data show it whole.
     #[must_use]
@@ -203,13 +237,18 @@ impl Episode {
     }
 }
 
-/// The wobble speed: the lowest speed at onset of an unstable episode
-/// whose onset the data show (not cut at its start), m/s.
+/// The wobble speed: the lowest speed at onset of an unstable wobble
+/// episode whose onset the data show (not cut at its start), m/s (a
+/// weave's is no wobble's).
 #[must_use]
 pub fn wobble_speed_mps(episodes: &[Episode]) -> Option<f64> {
     episodes
         .iter()
-        .filter(|e| e.stability == Stability::Unstable && e.cut_at_start.is_none())
+        .filter(|e| {
+            e.mode == KickMode::Wobble
+                && e.stability == Stability::Unstable
+                && e.cut_at_start.is_none()
+        })
         .map(|e| e.speed_at_onset_mps)
         .min_by(f64::total_cmp)
 }
@@ -516,6 +555,7 @@ impl<'a> Span<'a> {
         let onset_s = onset_s.max(self.place.first_s);
         let end = region.end.min(self.t_s.len() - 1);
         let episode = Episode {
+            mode: KickMode::Wobble,
             onset_s,
             end_s: self.t_s[end],
             peak_s: t[top],

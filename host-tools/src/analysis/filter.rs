@@ -108,9 +108,15 @@ pub fn band_pass(x: &[f64], (low_hz, high_hz): (f64, f64), fs_hz: f64) -> Vec<f6
 /// only follows it.
 #[must_use]
 pub fn wobble_band_causal(x: &[f64], fs_hz: f64) -> Vec<f64> {
+    band_pass_causal(x, WOBBLE_BAND_HZ, fs_hz)
+}
+
+/// [`band_pass`] filtered forwards only, each section twice: causal.
+#[must_use]
+pub fn band_pass_causal(x: &[f64], (low_hz, high_hz): (f64, f64), fs_hz: f64) -> Vec<f64> {
     let mut y = x.to_vec();
-    let high = Biquad::butterworth(Pass::High, WOBBLE_BAND_HZ.0, fs_hz);
-    let low = Biquad::butterworth(Pass::Low, WOBBLE_BAND_HZ.1, fs_hz);
+    let high = Biquad::butterworth(Pass::High, low_hz, fs_hz);
+    let low = Biquad::butterworth(Pass::Low, high_hz, fs_hz);
     for section in [high, high, low, low] {
         section.forward(&mut y);
     }

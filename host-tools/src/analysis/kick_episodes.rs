@@ -71,6 +71,7 @@ mod tests {
     /// 7 Hz) starts at `fit_from_s`.
     fn episode(stability: Stability, onset_s: f64, fit_from_s: f64, end_s: f64) -> Episode {
         Episode {
+            mode: crate::analysis::KickMode::Wobble,
             onset_s,
             end_s,
             peak_s: fit_from_s,

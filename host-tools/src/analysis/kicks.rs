@@ -54,9 +54,9 @@ use std::f64::consts::TAU;
 
 use serde::Serialize;
 
-use super::filter::{band_pass, follows, WOBBLE_BAND_HZ};
+use super::filter::{band_pass, band_pass_causal, follows, WOBBLE_BAND_HZ};
 use super::run::Run;
-use super::sinefit::fit_mode;
+use super::sinefit::{fit_mode, fit_mode_on_trend};
 
 /// The mode a kick is searched for and measured in.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, clap::ValueEnum)]
@@ -100,6 +100,11 @@ pub struct Band {
     pub pass_hz: (f64, f64),
     /// Moving-RMS window of the envelope, s.
     pub envelope_window_s: f64,
+    /// Whether the envelope is taken of the signal band-passed causally
+    /// (forwards only) rather than with zero phase: a slow band's
+    /// zero-phase filter answers a kick seconds before it, so the kick
+    /// would seem to rise slowly, and be placed early.
+    pub causal_envelope: bool,
     /// Envelope a kick's ring must reach, in the signal's unit...
     pub kick_min: f64,
     /// ... and this many times the stretch's background.
@@ -114,6 +119,10 @@ pub struct Band {
     /// The fit ends where the envelope is back at this many times the
     /// background...
     pub fit_end_over_background: f64,
+    /// ... or at this share of its value where the fit starts (what is
+    /// left of a ring that has decayed this far is mostly not the ring:
+    /// a slow drift's share through the band-pass)...
+    pub fit_end_of_start: f64,
     /// ... and lasts no longer than this, s.
     pub max_fit_s: f64,
     /// A fit spans at least this long, s.
@@ -125,6 +134,9 @@ pub struct Band {
     pub freq_band_hz: (f64, f64),
     /// Whether a wheel harmonic near the ring is fitted as a tone.
     pub wheel_tones: bool,
+    /// Whether a straight trend is fitted beside the ring instead (see
+    /// [`super::sinefit::fit_mode_on_trend`]).
+    pub fit_trend: bool,
     /// Whether the signal is a rate (deg/s): a kick's amplitude is then
     /// that of its integral (degrees), the rate's over the frequency.
     pub rate_signal: bool,
@@ -138,17 +150,20 @@ pub struct Band {
 pub const WOBBLE: Band = Band {
     pass_hz: WOBBLE_BAND_HZ,
     envelope_window_s: ENVELOPE_WINDOW_S,
+    causal_envelope: false,
     kick_min: KICK_MIN_DEG,
     kick_over_background: KICK_OVER_BACKGROUND,
     quiet_before_s: QUIET_BEFORE_S,
     max_rise_s: MAX_RISE_S,
     skip_after_peak_s: SKIP_AFTER_PEAK_S,
     fit_end_over_background: FIT_END_OVER_BACKGROUND,
+    fit_end_of_start: 0.0,
     max_fit_s: MAX_FIT_S,
     min_fit_s: MIN_FIT_S,
     head_s: 1.0,
     freq_band_hz: WOBBLE_BAND_HZ,
     wheel_tones: true,
+    fit_trend: false,
     rate_signal: false,
     se_factor: SE_FACTOR,
     sd_floor_per_s: SD_FLOOR_PER_S,
@@ -252,7 +267,8 @@ pub struct Kick {
     pub sigma_sd_per_s: f64,
     /// The fit's own standard error of `sigma_per_s`, 1/s.
     pub sigma_se_fit_per_s: f64,
-    /// Amplitude at the fit's start, degrees.
+    /// Amplitude at the fit's start, degrees: the steering angle's (wobble),
+    /// the roll angle's (weave: the roll rate's over the angular frequency).
     pub amp_deg: f64,
     /// The stretch fitted, s since boot.
     pub fit_s: [f64; 2],
@@ -479,7 +495,12 @@ impl Stretch<'_> {
             return Vec::new();
         }
         let band = band_pass(self.signal, b.pass_hz, self.fs);
-        let env = envelope(&band, self.samples(b.envelope_window_s).max(3));
+        let window = self.samples(b.envelope_window_s).max(3);
+        let env = if b.causal_envelope {
+            envelope(&band_pass_causal(self.signal, b.pass_hz, self.fs), window)
+        } else {
+            envelope(&band, window)
+        };
         let background = quantile(env.clone(), BACKGROUND_QUANTILE);
         let threshold = b.kick_min.max(b.kick_over_background * background);
         let mut kicks = Vec::new();
@@ -530,7 +551,8 @@ impl Stretch<'_> {
     ) -> Option<Kick> {
         let b = self.band;
         let start = peak + self.samples(b.skip_after_peak_s);
-        let floor = b.fit_end_over_background * background;
+        let floor = (b.fit_end_over_background * background)
+            .max(b.fit_end_of_start * env.get(start).copied().unwrap_or(0.0));
         let last = (start + self.samples(b.max_fit_s)).min(next.saturating_sub(1));
         let stop = (start..last).find(|&k| env[k] <= floor).unwrap_or(last);
         if stop < start + self.samples(b.min_fit_s) {
@@ -561,7 +583,11 @@ impl Stretch<'_> {
             })
             .min_by(|a, b| (a - freq0).abs().total_cmp(&(b - freq0).abs()))
             .filter(|_| b.wheel_tones && wheel_hz > 0.0);
-        let fit = fit_mode(t, x, sigma0, TAU * freq0, tone.map(|f| TAU * f))?;
+        let fit = if b.fit_trend {
+            fit_mode_on_trend(t, x, sigma0, TAU * freq0)?
+        } else {
+            fit_mode(t, x, sigma0, TAU * freq0, tone.map(|f| TAU * f))?
+        };
         let freq = fit.omega_rad_s / TAU;
         let plausible = fit.residual_rel <= MAX_RESIDUAL_REL
             && (b.freq_band_hz.0..b.freq_band_hz.1).contains(&freq)

@@ -1,7 +1,8 @@
 //! What the commands over many logs (`wobble`, `summary`, the model fits
 //! and the data set) take from each: its summary, wobble episodes (a kick's
-//! with the kick's values, as `margin` has them), distance and top speed,
-//! found in one pass over the log in bounded memory.
+//! with the kick's values, as `margin` has them), the weave's kicks,
+//! distance and top speed, found in one pass over the log in bounded
+//! memory.
 //!
 //! The kick search runs ahead of the episode search: a frame reaches the
 //! episodes only once every kick that could have struck an episode up to
@@ -16,7 +17,7 @@ use std::path::{Path, PathBuf};
 use super::campaign_kicks::MATCH_S;
 use super::filter::follows;
 use super::kick_episodes::give_kick_values;
-use super::kicks::{Kick, KickSearch};
+use super::kicks::{Kick, KickMode, KickSearch};
 use super::run::{log_name, stream_rows};
 use super::search::EpisodeSearch;
 use super::{Episode, Run};
@@ -43,6 +44,9 @@ pub struct Ride {
     /// The kicks the host measured, as `wobblog margin` finds them
     /// (`None` when the log's config gives no wheel).
     pub host_kicks: Option<Vec<Kick>>,
+    /// The weave's kicks, found in the roll rate as `wobblog margin --mode
+    /// weave` finds them, in time order.
+    pub weave_kicks: Vec<Kick>,
 }
 
 impl Ride {
@@ -50,7 +54,7 @@ impl Ride {
     pub fn load(path: &Path) -> Result<Self, CliError> {
         let make = |told: &SummaryBuilder| Analyser::new(told.frame_rate_hz(), told.config());
         let (summary, analyser) = stream_rows(path, make, |a, row| {
-            a.push(row.t_s, row.steer_deg, row.speed_mps);
+            a.push(row.t_s, row.steer_deg, row.speed_mps, row.gyro_dps[0]);
         })?;
         Ok(analyser.finish(path, summary))
     }
@@ -60,9 +64,24 @@ impl Ride {
     pub fn of(run: &Run) -> Self {
         let mut a = Analyser::new(run.sample_rate_hz(), &run.summary.config);
         for i in 0..run.len() {
-            a.push(run.t_s[i], run.steer_deg[i], run.speed_mps[i]);
+            a.push(
+                run.t_s[i],
+                run.steer_deg[i],
+                run.speed_mps[i],
+                run.gyro_dps[i][0],
+            );
         }
         a.finish(&run.path, run.summary.clone())
+    }
+
+    /// Every episode, the weave's kicks as episodes among the wobble's, in
+    /// time order: what `wobblog wobble` and the data set list.
+    #[must_use]
+    pub fn all_episodes(&self) -> Vec<Episode> {
+        let mut all = self.episodes.clone();
+        all.extend(self.weave_kicks.iter().map(Episode::of_weave_kick));
+        all.sort_by(|a, b| a.onset_s.total_cmp(&b.onset_s));
+        all
     }
 
     /// The run's name for reports: the file name.
@@ -81,6 +100,8 @@ struct Analyser {
     kicks: Option<KickSearch>,
     /// How many of the kicks found the episode search has been given.
     kicks_given: usize,
+    /// The weave's kicks, in the roll rate.
+    weave: KickSearch,
     /// Frames (time, steering, speed) the kick search has seen and the
     /// episode search not yet.
     waiting: VecDeque<(f64, f64, f64)>,
@@ -102,6 +123,8 @@ impl Analyser {
                 .filter(|_| fs_hz.is_finite() && fs_hz > 0.0)
                 .map(|wheel_m| KickSearch::new(fs_hz, wheel_m)),
             kicks_given: 0,
+            // The weave's fit takes no wheel tone: any circumference does.
+            weave: KickSearch::for_mode(KickMode::Weave, fs_hz, 1.0),
             waiting: VecDeque::new(),
             distance_m: 0.0,
             max_speed_mps: 0.0,
@@ -109,7 +132,8 @@ impl Analyser {
         }
     }
 
-    fn push(&mut self, t_s: f64, steer_deg: f64, speed_mps: f64) {
+    fn push(&mut self, t_s: f64, steer_deg: f64, speed_mps: f64, roll_rate_dps: f64) {
+        self.weave.push(t_s, roll_rate_dps, speed_mps);
         if let Some((t0, v0)) = self.last.filter(|&(t0, _)| follows(t0, t_s, self.period_s)) {
             self.distance_m += 0.5 * (speed_mps + v0) * (t_s - t0);
         }
@@ -155,6 +179,7 @@ impl Analyser {
             distance_m: self.distance_m,
             max_speed_mps: self.max_speed_mps,
             host_kicks: kicks,
+            weave_kicks: self.weave.finish(),
         }
     }
 }

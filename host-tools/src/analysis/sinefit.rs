@@ -6,7 +6,10 @@
 //!
 //! Optionally a steady tone `c sin(w_h tau) + d cos(w_h tau)` is fitted
 //! alongside: a wheel harmonic a fraction of a hertz from the wobble beats
-//! with it and would otherwise bend the fitted growth.
+//! with it and would otherwise bend the fitted growth. Or a straight trend
+//! `c + d tau` ([`fit_mode_on_trend`]): a slow mode's drift under a slow
+//! ring (the weave's, under which the capsize drifts and the band-pass's
+//! answer to the kick dies out at a rate like the ring's own).
 
 /// A fitted mode.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -37,8 +40,11 @@ const ITERATIONS: usize = 60;
 /// their standard error (a cost change of `s^2 k^2` moves them about `k`
 /// standard errors).
 const CONVERGED: f64 = 1e-4;
-/// Parameters: a, b, sigma, w, then c, d, w_h with a tone.
+/// Parameters: a, b, sigma, w, then c, d, w_h with a tone, or c, d with a
+/// trend.
 const MAX_PARAMS: usize = 7;
+/// Parameters with a trend.
+const TREND_PARAMS: usize = 6;
 
 type Vector = [f64; MAX_PARAMS];
 type Matrix = [[f64; MAX_PARAMS]; MAX_PARAMS];
@@ -54,7 +60,24 @@ pub fn fit_mode(
     omega0: f64,
     tone_omega0: Option<f64>,
 ) -> Option<SineFit> {
-    fit_mode_until(t, x, sigma0, omega0, tone_omega0, CONVERGED)
+    let beside = tone_omega0.map_or(Beside::Nothing, Beside::Tone);
+    fit_mode_until(t, x, sigma0, omega0, beside, CONVERGED)
+}
+
+/// [`fit_mode`] with a straight trend `c + d tau` fitted beside the mode
+/// instead of a tone.
+#[must_use]
+pub fn fit_mode_on_trend(t: &[f64], x: &[f64], sigma0: f64, omega0: f64) -> Option<SineFit> {
+    fit_mode_until(t, x, sigma0, omega0, Beside::Trend, CONVERGED)
+}
+
+/// What is fitted beside the mode.
+#[derive(Clone, Copy)]
+enum Beside {
+    Nothing,
+    /// A steady tone starting at this angular frequency, rad/s.
+    Tone(f64),
+    Trend,
 }
 
 /// [`fit_mode`], ending the search where a step lowers the cost by less
@@ -64,7 +87,7 @@ fn fit_mode_until(
     x: &[f64],
     sigma0: f64,
     omega0: f64,
-    tone_omega0: Option<f64>,
+    beside: Beside,
     converged: f64,
 ) -> Option<SineFit> {
     let t0_s = *t.first()?;
@@ -72,9 +95,13 @@ fn fit_mode_until(
         return None;
     }
     let (a, b) = linear_part(t, x, t0_s, sigma0, omega0)?;
-    let n = if tone_omega0.is_some() { 7 } else { 4 };
+    let (n, tone_omega0) = match beside {
+        Beside::Nothing => (4, 0.0),
+        Beside::Tone(w) => (MAX_PARAMS, w),
+        Beside::Trend => (TREND_PARAMS, 0.0),
+    };
     let grid = Grid::of(t);
-    let mut p: Vector = [a, b, sigma0, omega0, 0.0, 0.0, tone_omega0.unwrap_or(0.0)];
+    let mut p: Vector = [a, b, sigma0, omega0, 0.0, 0.0, tone_omega0];
     // Each trial's normal equations come with its cost (one pass over the
     // samples): an accepted trial's are the next iteration's.
     let mut at_p = normal_equations(&grid, t, x, &p, n);
@@ -275,6 +302,10 @@ fn model_of(tau: f64, ph: &Phasors, p: &Vector, n: usize) -> (f64, Vector) {
     let mode = e * (p[0] * s + p[1] * c);
     let mut j = [0.0; MAX_PARAMS];
     j[..4].copy_from_slice(&[e * s, e * c, tau * mode, tau * e * (p[0] * c - p[1] * s)]);
+    if n == TREND_PARAMS {
+        j[4..TREND_PARAMS].copy_from_slice(&[1.0, tau]);
+        return (mode + p[4] + p[5] * tau, j);
+    }
     if n < MAX_PARAMS {
         return (mode, j);
     }
@@ -315,10 +346,10 @@ fn normal_equations(
 ) -> (Matrix, Vector, f64) {
     // The count as a constant lets the compiler unroll the per-sample
     // products: most of a fit's time is here.
-    if n == MAX_PARAMS {
-        normal_equations_of::<MAX_PARAMS>(grid, t, x, p)
-    } else {
-        normal_equations_of::<4>(grid, t, x, p)
+    match n {
+        MAX_PARAMS => normal_equations_of::<MAX_PARAMS>(grid, t, x, p),
+        TREND_PARAMS => normal_equations_of::<TREND_PARAMS>(grid, t, x, p),
+        _ => normal_equations_of::<4>(grid, t, x, p),
     }
 }
 
@@ -557,7 +588,8 @@ mod tests {
                 .map(|(a, b)| a + b + noise_deg * noise(&mut state))
                 .collect();
             let guess = (0.7 * sigma, TAU * (f_hz + 0.1), Some(TAU * (f_hz + 0.45)));
-            let at = |converged| fit_mode_until(&t, &x, guess.0, guess.1, guess.2, converged);
+            let beside = guess.2.map_or(Beside::Nothing, Beside::Tone);
+            let at = |converged| fit_mode_until(&t, &x, guess.0, guess.1, beside, converged);
             let (fit, tight) = (at(CONVERGED).unwrap(), at(1e-12).unwrap());
             prop_assert!(
                 (fit.sigma_per_s - tight.sigma_per_s).abs() <= 0.02 * tight.sigma_se_per_s,

@@ -1,11 +1,12 @@
-//! `wobblog wobble`: every wobble episode of one or more runs, the wobble
-//! speed of each, and optionally the seed paper's Figure 8 across them.
+//! `wobblog wobble`: every wobble episode of one or more runs and the
+//! weave's kick ring-downs (`mode`), the wobble speed of each, and
+//! optionally the seed paper's Figure 8 across them.
 
 use std::path::{Path, PathBuf};
 
 use serde::Serialize;
 
-use crate::analysis::{wobble_speed_mps, Episode, Ride, Stability};
+use crate::analysis::{wobble_speed_mps, Episode, KickMode, Ride, Stability};
 use crate::cmd::logs::{expand, for_each_log, print, warn_losses};
 use crate::output::Output;
 use crate::plot::modes::ModePlot;
@@ -97,7 +98,15 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         let runs = names
             .into_iter()
             .zip(reports)
-            .map(|(name, r)| (name, r.episodes.into_iter().map(|e| e.episode).collect()))
+            .map(|(name, r)| {
+                // Figure 8 is the wobble's: the weave's ring-downs are laid
+                // over the model's weave by `wobblog model compare`.
+                let wobble = r.episodes.into_iter().map(|e| e.episode);
+                (
+                    name,
+                    wobble.filter(|e| e.mode == KickMode::Wobble).collect(),
+                )
+            })
             .collect();
         render(&ModePlot::new(runs), out)?;
     }
@@ -111,7 +120,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
 /// A UTC bound of `window` in a log without UTC.
 pub fn episodes_of(ride: &Ride, window: &TimeWindow) -> Result<RunEpisodes, CliError> {
     let (from, to) = window.boot_s(&ride.summary.utc_syncs, &ride.path)?;
-    let mut episodes = ride.episodes.clone();
+    let mut episodes = ride.all_episodes();
     episodes.retain(|e| from.is_none_or(|a| e.onset_s >= a) && to.is_none_or(|b| e.onset_s <= b));
     let pairs = &ride.summary.utc_syncs;
     Ok(RunEpisodes {
@@ -145,7 +154,7 @@ fn render_text(r: &RunEpisodes) -> String {
     if !r.episodes.is_empty() {
         let _ = writeln!(
             o,
-            "  onset_s  onset_utc                   end_s  freq_hz  sigma_per_s  peak_amp_deg  speed_at_onset_mps  stability  source     censored"
+            "  mode    onset_s  onset_utc                   end_s  freq_hz  sigma_per_s  peak_amp_deg  speed_at_onset_mps  stability  source     censored"
         );
     }
     for EpisodeUtc {
@@ -158,7 +167,8 @@ fn render_text(r: &RunEpisodes) -> String {
             Stability::Unstable => "unstable",
         };
         let line = format!(
-            "  {:7.2}  {:<24}  {:7.2}  {:7.2}  {:11.2}  {:12.2}  {:18.2}  {stability:<9}  {:<9}  {}",
+            "  {:<6}  {:7.2}  {:<24}  {:7.2}  {:7.2}  {:11.2}  {:12.2}  {:18.2}  {stability:<9}  {:<9}  {}",
+            e.mode.as_str(),
             e.onset_s,
             onset_utc.as_deref().unwrap_or("-"),
             e.end_s,

@@ -182,6 +182,30 @@ fn stepper(model: &Model, speed_mps: f64) -> Result<(Discrete, [f64; 2]), String
     Ok((Discrete::new(&a, &b, 1.0 / FS_HZ), [m[(0, 0)], m[(1, 1)]]))
 }
 
+/// The roll rate (deg/s, 15 s at the frame rate) of `model` at
+/// `speed_mps` kicked at 3 s by a roll torque giving `kick_dps`, without
+/// noise.
+///
+/// # Errors
+/// The model is not a Whipple model.
+pub fn ring_down(model: &Model, speed_mps: f64, kick_dps: f64) -> Result<Vec<f64>, String> {
+    let (step, [roll_inertia, _]) = stepper(model, speed_mps)?;
+    let kick_nm = kick_dps.to_radians() * roll_inertia / KICK_S;
+    let mut x = DVector::<f64>::zeros(4);
+    let mut out = Vec::new();
+    for i in 0..(PASS_S * FS_HZ) as usize {
+        let t = i as f64 / FS_HZ;
+        let torque = if (3.0..3.0 + KICK_S).contains(&t) {
+            kick_nm
+        } else {
+            0.0
+        };
+        out.push(x[2].to_degrees());
+        x = step.step(&x, &DVector::from_vec(vec![torque, 0.0]));
+    }
+    Ok(out)
+}
+
 /// Simulates `plan` on `bicycle` from `seed`.
 ///
 /// # Errors

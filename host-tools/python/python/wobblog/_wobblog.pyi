@@ -70,8 +70,9 @@ class Log:
     def episodes(
         self, start: Optional[_Time] = None, end: Optional[_Time] = None
     ) -> dict[str, Any]:
-        """Wobble episodes with onset in the window, as ``wobblog wobble --json``:
-        ``wobble_speed_mps`` (m/s) and ``episodes`` (``freq_hz``, ``sigma_per_s`` 1/s,
+        """Wobble episodes and the weave's kick ring-downs with onset in the window,
+        as ``wobblog wobble --json``: ``wobble_speed_mps`` (m/s) and ``episodes``
+        (``mode`` ``wobble`` or ``weave``, ``freq_hz``, ``sigma_per_s`` 1/s,
         ``speed_at_onset_mps`` m/s, ...)."""
     def kicks(self, kicks: str = "best") -> list[dict[str, Any]]:
         """Kick ring-downs as the rows of ``wobblog margin --json`` (``speed_mps``

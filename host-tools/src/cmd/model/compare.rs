@@ -1,5 +1,6 @@
 //! `wobblog model compare`: the seed paper's Figure 8, the model's wobble
-//! mode against speed with every measured episode laid over it, and the
+//! mode against speed with every measured episode laid over it (and its
+//! weave with the weave's ring-downs, when the logs hold any), and the
 //! residuals (measured minus model) printed.
 
 use std::fmt::Write as _;
@@ -49,11 +50,36 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         .transpose()?;
     let stdout = Output::stdout(&inputs)?;
     let (found, loaded) = episodes::load(&logs);
-    let speeds: Vec<f64> = found.iter().map(|e| e.episode.speed_at_onset_mps).collect();
-    let wobble = mode_at(&model, Mode::Wobble, &speeds)
-        .map_err(|e| CliError::file(&args.params, e))?
-        .ok_or_else(|| CliError::file(&args.params, "the model has no wobble mode"))?;
-    let text = residual_table(&found, &wobble);
+    let mut at_model = vec![None; found.len()];
+    let mut missing = String::new();
+    for mode in [Mode::Wobble, Mode::Weave] {
+        let of_mode: Vec<usize> = (0..found.len())
+            .filter(|&i| found[i].mode() == mode)
+            .collect();
+        if of_mode.is_empty() {
+            continue;
+        }
+        let speeds: Vec<f64> = of_mode
+            .iter()
+            .map(|&i| found[i].episode.speed_at_onset_mps)
+            .collect();
+        let values = mode_at(&model, mode, &speeds).map_err(|e| CliError::file(&args.params, e))?;
+        let Some(values) = values else {
+            // A Whipple bicycle has a weave and no wobble: its episodes of
+            // a mode the model lacks are said, not compared.
+            let _ = writeln!(
+                missing,
+                "the model has no {} mode: {} not compared",
+                mode.name(),
+                crate::words::plural(of_mode.len(), "episode")
+            );
+            continue;
+        };
+        for (&i, v) in of_mode.iter().zip(values) {
+            at_model[i] = Some(v);
+        }
+    }
+    let text = residual_table(&found, &at_model) + &missing;
     print(stdout, &text)?;
     // A log that could not be read fails the command: the figure is not
     // committed then, and an old one stays as it was.
@@ -73,24 +99,39 @@ pub fn figure(
     params: &Path,
     found: &[LoggedEpisode],
 ) -> Result<EigenFigure, CliError> {
+    let weave = found.iter().any(|e| e.mode() == Mode::Weave);
     Ok(EigenFigure {
-        title: format!("{name}: wobble mode and measured episodes"),
+        title: if weave {
+            format!("{name}: wobble and weave modes and measured episodes")
+        } else {
+            format!("{name}: wobble mode and measured episodes")
+        },
         layers: vec![Layer {
             label: "model".into(),
             sweep: sweep(model, speeds, params)?,
             line: Line::Thick,
         }],
-        modes: vec![Mode::Wobble],
+        modes: if weave {
+            vec![Mode::Wobble, Mode::Weave]
+        } else {
+            vec![Mode::Wobble]
+        },
         measured: found.iter().map(LoggedEpisode::measured).collect(),
     })
 }
 
-fn residual_table(found: &[LoggedEpisode], wobble: &[wobble_model::Complex<f64>]) -> String {
+/// Each episode of `found` against the model's value of its mode
+/// (`at_model`, in the same order).
+fn residual_table(
+    found: &[LoggedEpisode],
+    at_model: &[Option<wobble_model::Complex<f64>>],
+) -> String {
     let mut o = String::from(
-        "log            onset_s  speed_mps  freq_hz  model_hz  d_freq_hz  sigma_per_s  model_per_s  d_sigma_per_s  source     censored\n",
+        "log            mode    onset_s  speed_mps  freq_hz  model_hz  d_freq_hz  sigma_per_s  model_per_s  d_sigma_per_s  source     censored\n",
     );
     let (mut sf, mut ss, mut n) = (0.0, 0.0, 0usize);
-    for (e, w) in found.iter().zip(wobble) {
+    for (e, w) in found.iter().zip(at_model) {
+        let Some(w) = w else { continue };
         let model_hz = w.im / std::f64::consts::TAU;
         let (df, ds) = (e.episode.freq_hz - model_hz, e.episode.sigma_per_s - w.re);
         if !e.censored() {
@@ -100,8 +141,9 @@ fn residual_table(found: &[LoggedEpisode], wobble: &[wobble_model::Complex<f64>]
         }
         let _ = writeln!(
             o,
-            "{:<13} {:8.2}  {:9.2}  {:7.2}  {:8.2}  {:9.2}  {:11.2}  {:11.2}  {:13.2}  {:<9}  {}",
+            "{:<13}  {:<6} {:8.2}  {:9.2}  {:7.2}  {:8.2}  {:9.2}  {:11.2}  {:11.2}  {:13.2}  {:<9}  {}",
             e.log,
+            e.episode.mode.as_str(),
             e.episode.onset_s,
             e.episode.speed_at_onset_mps,
             e.episode.freq_hz,

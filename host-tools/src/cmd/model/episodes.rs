@@ -1,12 +1,14 @@
-//! Measured wobble episodes of card logs, from the `wobblog wobble`
-//! analysis, as points to compare with and fit the model to.
+//! Measured episodes of card logs, from the `wobblog wobble` analysis
+//! (the wobble's and the weave's ring-downs), as points to compare with and
+//! fit the model to.
 
 use std::path::{Path, PathBuf};
 
 use wobble_model::fit::Observation;
+use wobble_model::Mode;
 
 use super::figure::Measured;
-use crate::analysis::{Episode, Ride};
+use crate::analysis::{Episode, KickMode, Ride};
 use crate::cmd::logs::{for_each_log, warn_losses};
 use crate::CliError;
 
@@ -19,6 +21,15 @@ pub struct LoggedEpisode {
 }
 
 impl LoggedEpisode {
+    /// The model's mode it measures.
+    #[must_use]
+    pub fn mode(&self) -> Mode {
+        match self.episode.mode {
+            KickMode::Wobble => Mode::Wobble,
+            KickMode::Weave => Mode::Weave,
+        }
+    }
+
     /// Whether the episode may not be fitted: the analysis marks it
     /// censored when a gap or an end of the data cut it.
     #[must_use]
@@ -48,7 +59,7 @@ impl LoggedEpisode {
     }
 }
 
-/// Every episode of `logs`. A log that cannot be read is reported and
+/// Every episode of `logs`, the weave's among the wobble's. A log that cannot be read is reported and
 /// skipped; the error then says so after the others were used.
 pub fn load(logs: &[PathBuf]) -> (Vec<LoggedEpisode>, Result<(), CliError>) {
     let mut out = Vec::new();
@@ -56,10 +67,14 @@ pub fn load(logs: &[PathBuf]) -> (Vec<LoggedEpisode>, Result<(), CliError>) {
         let ride = Ride::load(log)?;
         warn_losses(log, &ride.summary);
         let name = ride.name();
-        out.extend(ride.episodes.into_iter().map(|episode| LoggedEpisode {
-            log: name.clone(),
-            episode,
-        }));
+        out.extend(
+            ride.all_episodes()
+                .into_iter()
+                .map(|episode| LoggedEpisode {
+                    log: name.clone(),
+                    episode,
+                }),
+        );
         Ok(())
     });
     (out, result)

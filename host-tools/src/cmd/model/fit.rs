@@ -8,6 +8,7 @@ use std::path::{Path, PathBuf};
 
 use wobble_model::fit::{fit, Weights};
 use wobble_model::params::to_toml;
+use wobble_model::Mode;
 
 use super::episodes;
 use super::{key_error, param_error};
@@ -55,9 +56,10 @@ pub fn run(args: &Args) -> Result<(), CliError> {
     let mut out = Output::create(&args.output, &inputs)?;
     let stdout = Output::stdout(&inputs)?;
     let (found, loaded) = episodes::load(&logs);
+    // The fit is the wobble's: the weave's ring-downs are not fitted.
     let obs: Vec<_> = found
         .iter()
-        .filter(|e| !e.censored())
+        .filter(|e| !e.censored() && e.mode() == Mode::Wobble)
         .map(episodes::LoggedEpisode::observation)
         .collect();
     let weights = Weights {

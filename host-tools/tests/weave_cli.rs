@@ -1,7 +1,9 @@
-//! `wobblog margin --mode weave`: a hand-made campaign whose answer is
+//! The weave in the commands, on a hand-made campaign whose answer is
 //! written down (roll-rate ring-downs at 0.8 Hz decaying at `sigma =
 //! 8 (1/u - 1/4)`, so the weave speed is 4 m/s and sigma is straight in
-//! `1/u`), its JSON and table forms and its refusals.
+//! `1/u`): `margin --mode weave` (its JSON and table forms and its
+//! refusals), `wobble`'s `mode`, the data set's episodes and `model
+//! compare`.
 
 mod analysis_support;
 
@@ -159,4 +161,140 @@ fn no_weave_kicks_no_prediction() {
             .starts_with("too few kicks"),
         "{v}"
     );
+}
+
+/// `wobble` lists each kick's weave ring-down with `mode` weave, beside the
+/// ride's wobble (`mode` wobble), and the wobble speed is the wobble's.
+#[test]
+fn wobble_lists_the_weave_ring_downs() {
+    let dir = campaign();
+    let out = wobblog()
+        .args(["wobble", "--json"])
+        .arg(dir.path().join("RUN00003.WBL"))
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: Value = serde_json::from_slice(&out.stdout).unwrap();
+    let episodes = v["episodes"].as_array().unwrap();
+    let weave: Vec<&Value> = episodes.iter().filter(|e| e["mode"] == "weave").collect();
+    let wobble: Vec<&Value> = episodes.iter().filter(|e| e["mode"] == "wobble").collect();
+    assert_eq!(weave.len(), 1, "{v}");
+    assert_eq!(wobble.len() + weave.len(), episodes.len(), "{v}");
+    let e = weave[0];
+    assert!((e["freq_hz"].as_f64().unwrap() - 0.8).abs() < 0.02, "{e}");
+    assert_eq!(e["stability"], "stable");
+    assert_eq!(e["source"], "host");
+    assert!((e["onset_s"].as_f64().unwrap() - 4.0).abs() < 1.0, "{e}");
+    // The ride's 7 Hz wobble (`analysis_support::wobble`) is unstable and
+    // gives the wobble speed; the weave's ring-down does not count.
+    assert!(
+        wobble.iter().all(|w| w["freq_hz"].as_f64().unwrap() > 4.0),
+        "{v}"
+    );
+    let speed = v["wobble_speed_mps"].as_f64().unwrap();
+    assert!((speed - 5.2).abs() < 1e-9, "{v}");
+    let text = stdout_text(&["wobble"], &dir.path().join("RUN00003.WBL"));
+    assert!(text.contains("\n  mode    onset_s"), "{text}");
+    assert!(
+        text.lines().any(|l| l.trim_start().starts_with("weave ")),
+        "{text}"
+    );
+}
+
+/// The data set's episodes table has a `mode` column with the weave's rows.
+#[test]
+fn the_data_sets_episodes_hold_the_weave() {
+    let dir = campaign();
+    let out_dir = tempfile::tempdir().unwrap();
+    let dataset = out_dir.path().join("set");
+    let out = wobblog()
+        .arg("export")
+        .arg(dir.path())
+        .arg("-o")
+        .arg(&dataset)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let file = std::fs::File::open(dataset.join("episodes/part-0.parquet")).unwrap();
+    let reader = parquet::file::reader::SerializedFileReader::new(file).unwrap();
+    use parquet::file::reader::FileReader;
+    let modes: Vec<String> = reader
+        .get_row_iter(None)
+        .unwrap()
+        .map(|r| {
+            let row = r.unwrap();
+            row.get_column_iter()
+                .find(|(n, _)| n.as_str() == "mode")
+                .map(|(_, f)| f.to_string().trim_matches('"').to_owned())
+                .unwrap()
+        })
+        .collect();
+    assert_eq!(
+        modes.iter().filter(|m| *m == "weave").count(),
+        10,
+        "{modes:?}"
+    );
+    assert!(
+        modes.iter().all(|m| m == "weave" || m == "wobble"),
+        "{modes:?}"
+    );
+}
+
+/// `model compare` puts each weave ring-down against the model's weave
+/// at its speed; the benchmark (a Whipple bicycle) has no wobble mode, so
+/// the rides' wobbles are said and not compared.
+#[test]
+fn compare_sets_the_weave_against_the_models_weave() {
+    let dir = campaign();
+    let params = Path::new(env!("CARGO_MANIFEST_DIR")).join("bicycle-model/params/benchmark.toml");
+    let fig = tempfile::tempdir().unwrap();
+    let out = wobblog()
+        .args(["model", "compare"])
+        .arg(&params)
+        .arg(dir.path())
+        .arg("-o")
+        .arg(fig.path().join("fig8.svg"))
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8(out.stdout).unwrap();
+    let weave: Vec<Vec<&str>> = text
+        .lines()
+        .map(|l| l.split_whitespace().collect::<Vec<_>>())
+        .filter(|c| c.get(1) == Some(&"weave"))
+        .collect();
+    assert_eq!(weave.len(), 10, "{text}");
+    for c in &weave {
+        // The benchmark's weave above its weave speed: 0.5-1.1 Hz, decaying.
+        let model_hz: f64 = c[5].parse().unwrap();
+        let model_sigma: f64 = c[8].parse().unwrap();
+        assert!(
+            (0.5..1.1).contains(&model_hz) && model_sigma < 0.0,
+            "{text}"
+        );
+    }
+    assert!(
+        text.contains("the model has no wobble mode: 10 episodes not compared"),
+        "{text}"
+    );
+    let svg = std::fs::read_to_string(fig.path().join("fig8.svg")).unwrap();
+    assert!(svg.contains("wobble and weave modes"), "title");
+}
+
+fn stdout_text(args: &[&str], log: &Path) -> String {
+    let out = wobblog().args(args).arg(log).output().unwrap();
+    assert!(out.status.success());
+    String::from_utf8(out.stdout).unwrap()
 }
