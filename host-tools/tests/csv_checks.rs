@@ -1,5 +1,6 @@
 //! CSV input that is not what it claims is refused with the file, line and
-//! column, never stored clamped, zeroed or at the wrong rate.
+//! column, never stored clamped (unless `--clip` asks, and then said),
+//! zeroed or at the wrong rate.
 
 use assert_cmd::Command;
 use std::path::Path;
@@ -322,4 +323,111 @@ fn a_time_jump_the_encoder_cannot_hold_names_its_line() {
     assert_eq!(out.status.code(), Some(1));
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("jump.csv: line 5: "), "{err}");
+}
+
+/// With `--clip`, a foreign CSV's out-of-range numbers (a GPS speed of
+/// -0.01 m/s, a speed beyond the log's range) are clamped, each column's
+/// count and largest change said on stderr, and the decoded log holds the
+/// clamped values; NaN and text are still refused.
+#[test]
+fn clip_clamps_out_of_range_numbers_and_says_so() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut text =
+        String::from("t_s,steer_deg,speed_mps,gps_lat_deg,gps_lon_deg,gps_speed_mps,gps_fix\n");
+    for i in 0..20 {
+        let t = f64::from(i) / 100.0;
+        let (speed, gps_speed) = match i {
+            5 => ("70", "-0.01"),
+            6 => ("4.0", "-0.004"),
+            _ => ("4.0", "1.0"),
+        };
+        text.push_str(&format!("{t},0.5,{speed},52.0,4.3,{gps_speed},3d\n"));
+    }
+    let csv = dir.path().join("foreign.csv");
+    std::fs::write(&csv, &text).unwrap();
+    let log = dir.path().join("RUN00001.WBL");
+    let encode = |extra: &[&str]| {
+        wobblog()
+            .args(["encode", "--csv"])
+            .arg(&csv)
+            .arg("-o")
+            .arg(&log)
+            .args(extra)
+            .output()
+            .unwrap()
+    };
+    let refused = encode(&[]);
+    assert_eq!(refused.status.code(), Some(1));
+    assert!(!log.exists());
+    let out = encode(&["--clip"]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    assert!(
+        stderr.contains("foreign.csv: --clip: 1 cell of `speed_mps` outside what the log stores, clamped (by 4.465 at most)"),
+        "{stderr}"
+    );
+    assert!(
+        stderr.contains("--clip: 2 cells of `gps_speed_mps` outside what the log stores, clamped (by 0.01 at most)"),
+        "{stderr}"
+    );
+    let decoded = dir.path().join("out.csv");
+    let out = wobblog()
+        .arg("decode")
+        .arg(&log)
+        .arg("-o")
+        .arg(&decoded)
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    let text = std::fs::read_to_string(&decoded).unwrap();
+    let header: Vec<&str> = text.lines().next().unwrap().split(',').collect();
+    let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
+    let row: Vec<&str> = text.lines().nth(6).unwrap().split(',').collect();
+    assert_eq!(
+        row[col("speed_mps")].parse::<f64>().unwrap(),
+        65.535,
+        "{text}"
+    );
+    assert_eq!(
+        row[col("gps_speed_mps")].parse::<f64>().unwrap(),
+        0.0,
+        "{text}"
+    );
+    // NaN is no number to clamp.
+    std::fs::remove_file(&log).unwrap();
+    std::fs::write(&csv, text_with_nan()).unwrap();
+    let out = encode(&["--clip"]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("`steer_deg` is NaN"));
+    assert!(!log.exists());
+}
+
+fn text_with_nan() -> String {
+    let mut r = rows(20, 100.0);
+    r[5] = "0.05,NaN,4.0".into();
+    csv_text(&r)
+}
+
+/// `--run` states the run number in the log's header.
+#[test]
+fn run_sets_the_headers_run_number() {
+    let dir = tempfile::tempdir().unwrap();
+    let csv = dir.path().join("in.csv");
+    std::fs::write(&csv, csv_text(&rows(50, 100.0))).unwrap();
+    let log = dir.path().join("RUN00042.WBL");
+    let out = wobblog()
+        .args(["encode", "--run", "42", "--csv"])
+        .arg(&csv)
+        .arg("-o")
+        .arg(&log)
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    let out = wobblog()
+        .args(["info", "--json"])
+        .arg(&log)
+        .output()
+        .unwrap();
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["run"], 42, "{v}");
 }

@@ -46,6 +46,16 @@ pub struct Args {
     /// the header, as the board's does. A gap restarts the detector.
     #[arg(long)]
     pub detect: bool,
+    /// The run number the log's header states (as the board numbers its
+    /// `RUNnnnnn.WBL` files; `info`, `export` and the data set show it).
+    #[arg(long, default_value_t = 0)]
+    pub run: u32,
+    /// Clamp a number outside what the log can store (a GPS speed of
+    /// -0.01 m/s from another logger, a gyro rate beyond the range) to the
+    /// nearest it can, and say how many cells of which column were clamped
+    /// and by how much at most. NaN, infinities and text are still refused.
+    #[arg(long)]
+    pub clip: bool,
 }
 
 /// How `encode` builds the log.
@@ -56,6 +66,10 @@ pub struct Options {
     pub resample: bool,
     /// Run the on-board detector and store its alert and kick records.
     pub detect: bool,
+    /// The run number in the header.
+    pub run: u32,
+    /// Clamp numbers outside what the log stores instead of refusing them.
+    pub clip: bool,
 }
 
 /// The frame rate of the logs `encode` writes, as the firmware's.
@@ -73,8 +87,13 @@ pub fn run(args: &Args) -> Result<(), CliError> {
     let options = Options {
         resample: args.resample,
         detect: args.detect,
+        run: args.run,
+        clip: args.clip,
     };
-    encode_with(input, &args.csv, &mut output, &args.output, options)?;
+    let clipped = encode_with(input, &args.csv, &mut output, &args.output, options)?;
+    for line in clipped.lines(&args.csv) {
+        eprintln!("wobblog: {line}");
+    }
     output.commit()
 }
 
@@ -183,9 +202,9 @@ pub fn encode(
 ) -> Result<(), CliError> {
     let options = Options {
         resample,
-        detect: false,
+        ..Options::default()
     };
-    encode_with(input, in_name, output, out_name, options)
+    encode_with(input, in_name, output, out_name, options).map(|_| ())
 }
 
 /// [`encode`] with every option.
@@ -195,7 +214,7 @@ pub fn encode_with(
     output: impl Write,
     out_name: &Path,
     options: Options,
-) -> Result<(), CliError> {
+) -> Result<Clipped, CliError> {
     let resample = options.resample;
     let mut reader = csv::ReaderBuilder::new()
         .trim(csv::Trim::All)
@@ -223,6 +242,7 @@ pub fn encode_with(
         frames: 0,
         line: 0,
         detector: options.detect.then(OnBoard::new).transpose()?,
+        run: options.run,
     };
     let mut record = csv::StringRecord::new();
     let mut steps = if resample {
@@ -231,12 +251,13 @@ pub fn encode_with(
         TimeSteps::new(f64::from(SAMPLE_RATE_HZ))
     };
     let mut resampler = Resampler::new(1_000_000 / u64::from(SAMPLE_RATE_HZ));
+    let mut clip = options.clip.then(Clipped::default);
     while reader
         .read_record(&mut record)
         .map_err(|e| CliError::file(in_name, e))?
     {
         let line = record.position().map_or(0, |p| p.line());
-        let row = parse_row(&columns, &record, in_name, line)?;
+        let row = parse_row(&columns, &record, (in_name, line), &mut clip)?;
         let t_col = columns.0[0].unwrap_or(0);
         steps.step(row.frame.t_us as f64 / 1e6, line).map_err(|e| {
             let cell = Cell {
@@ -254,7 +275,43 @@ pub fn encode_with(
         }
     }
     resampler.finish(&mut |r: &CsvRow| log.store(r))?;
-    log.finish()
+    log.finish()?;
+    Ok(clip.unwrap_or_default())
+}
+
+/// The cells `--clip` clamped, per column: how many and the largest
+/// change.
+#[derive(Debug, Default, PartialEq)]
+pub struct Clipped(Vec<(&'static str, usize, f64)>);
+
+impl Clipped {
+    fn add(&mut self, column: &'static str, by: f64) {
+        match self.0.iter_mut().find(|c| c.0 == column) {
+            Some(c) => {
+                c.1 += 1;
+                c.2 = c.2.max(by);
+            }
+            None => self.0.push((column, 1, by)),
+        }
+    }
+
+    /// What was clamped, a line per column, about the CSV `path`.
+    #[must_use]
+    pub fn lines(&self, path: &Path) -> Vec<String> {
+        self.0
+            .iter()
+            .map(|(column, n, by)| {
+                format!(
+                    "{}: --clip: {} of `{column}` outside what the log stores, clamped \
+                     (by {} at most)",
+                    crate::text::shown(path),
+                    crate::words::plural(*n, "cell"),
+                    // Six decimals: the CSV's own, not the subtraction's.
+                    (by * 1e6).round() / 1e6
+                )
+            })
+            .collect()
+    }
 }
 
 /// Writes frames, GPS fixes and sync pairs into a log.
@@ -271,6 +328,8 @@ struct LogWriter<'a, W> {
     line: u64,
     /// The on-board detector, with `--detect`.
     detector: Option<OnBoard>,
+    /// The run number the header states.
+    run: u32,
 }
 
 /// The on-board detector as the board's sampler runs it on the frames.
@@ -349,7 +408,7 @@ impl<W: Write> LogWriter<'_, W> {
                 firmware: concat!("wobblog-encode ", env!("CARGO_PKG_VERSION")),
                 device_id: [0; 12],
                 sample_rate_hz: SAMPLE_RATE_HZ,
-                run: 0,
+                run: self.run,
             };
             let lines = self.detector.as_ref().map(OnBoard::header_lines);
             let lines = lines.iter().flatten().map(String::as_str);
@@ -405,12 +464,15 @@ fn write_block(
     })
 }
 
+/// One CSV row as a frame; with `clip`, numbers outside what the log
+/// stores are clamped and counted there.
 fn parse_row(
     columns: &Columns,
     record: &csv::StringRecord,
-    path: &Path,
-    line: u64,
+    (path, line): (&Path, u64),
+    clip: &mut Option<Clipped>,
 ) -> Result<CsvRow, CliError> {
+    let clip = std::cell::RefCell::new(clip);
     let cell = |i: usize, c: usize| Cell {
         line,
         column: c + 1,
@@ -434,7 +496,20 @@ fn parse_row(
                 "is empty: give a value, or leave the column out (then it is zero)",
             )),
             (Some(c), Some((_, text))) => {
-                number_in(text, range, unit).map_err(|e| cell(i, c).error(path, e))
+                match (number_in(text, range, unit), &mut **clip.borrow_mut()) {
+                    (Err(e), Some(clipped)) => {
+                        // Out of range but a finite number: clamped, counted.
+                        match text.parse::<f64>().ok().filter(|v| v.is_finite()) {
+                            Some(v) => {
+                                let kept = v.clamp(range.0, range.1);
+                                clipped.add(CSV_COLUMNS[i], (v - kept).abs());
+                                Ok(kept)
+                            }
+                            None => Err(cell(i, c).error(path, e)),
+                        }
+                    }
+                    (result, _) => result.map_err(|e| cell(i, c).error(path, e)),
+                }
             }
         }
     };

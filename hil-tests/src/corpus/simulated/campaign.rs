@@ -496,6 +496,7 @@ impl Campaign {
             let options = wobblog::cmd::encode::Options {
                 resample: false,
                 detect: true,
+                ..Default::default()
             };
             wobblog::cmd::encode::encode_with(
                 pass.fixture.csv.as_bytes(),

@@ -284,6 +284,7 @@ impl Campaign {
             let options = wobblog::cmd::encode::Options {
                 resample: false,
                 detect: false,
+                ..Default::default()
             };
             wobblog::cmd::encode::encode_with(
                 pass.csv.as_bytes(),
