@@ -4,12 +4,19 @@
 //! well for a folder of cards, `NAME` percent-encoded as Hive readers
 //! decode it; the run number unpadded so readers type it
 //! as an integer), `runs/part-0.parquet` (one row per run, as `wobblog
-//! summary`) and `episodes/part-0.parquet` (one row per wobble episode, as
-//! `wobblog wobble`). Every file carries its columns' units as key-value
-//! metadata (`unit.NAME`).
+//! summary`), `episodes/part-0.parquet` (one row per episode, the wobble's
+//! and the weave's, as `wobblog wobble`) and `kicks/part-0.parquet` (one
+//! row per kick, as `wobblog margin` and `margin --mode weave` take them,
+//! with `used`: whether the campaign's prediction gave it weight). Every
+//! file carries its columns' units as key-value metadata (`unit.NAME`).
 
 use std::path::{Path, PathBuf};
 
+use crate::analysis::campaign_kicks::{ride_campaign_kicks, CampaignKick, Prefer, SpeedsAfter};
+use crate::analysis::kicks::{Kick, KickMode};
+use crate::analysis::margin::weave::predict_weave;
+use crate::analysis::margin::{predict, KickPoint, Trend};
+use crate::analysis::run::read_rows;
 use crate::analysis::{Cut, Episode, Ride, Stability};
 use crate::cmd::summary::{logs_in, RunRow};
 use crate::export::columns::{Column, Kind, Value};
@@ -23,6 +30,8 @@ pub const FRAMES: &str = "frames";
 pub const RUNS: &str = "runs";
 /// See [`FRAMES`].
 pub const EPISODES: &str = "episodes";
+/// See [`FRAMES`].
+pub const KICKS: &str = "kicks";
 
 /// One log of the campaign and where it goes.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -198,6 +207,55 @@ pub struct EpisodesRow {
     episode: Episode,
 }
 
+/// One kick's row of `kicks.parquet`.
+pub struct KicksRow {
+    entry: LogEntry,
+    mode: KickMode,
+    kick: CampaignKick,
+    used: bool,
+}
+
+impl KicksRow {
+    /// A weave kick (the host's alone: the board records wobble kicks).
+    fn weave(entry: &LogEntry, k: Kick) -> Self {
+        Self {
+            entry: entry.clone(),
+            mode: KickMode::Weave,
+            kick: CampaignKick {
+                source: crate::analysis::campaign_kicks::Source::Host,
+                t_s: k.t_s,
+                speed_mps: k.speed_mps,
+                freq_hz: k.freq_hz,
+                sigma_per_s: k.sigma_per_s,
+                sigma_sd_per_s: k.sigma_sd_per_s,
+                amp_deg: k.amp_deg,
+                host: Some(k),
+                card: None,
+            },
+            used: false,
+        }
+    }
+}
+
+/// Marks each kick of `rows` the campaign's prediction of its mode gave
+/// weight (`wobblog margin`'s defaults; `--mode weave`'s for the weave).
+fn mark_used(rows: &mut [KicksRow]) {
+    for mode in [KickMode::Wobble, KickMode::Weave] {
+        let of_mode: Vec<usize> = (0..rows.len()).filter(|&i| rows[i].mode == mode).collect();
+        let points: Vec<KickPoint> = of_mode
+            .iter()
+            .map(|&i| KickPoint::from(&rows[i].kick))
+            .collect();
+        let weights = match mode {
+            KickMode::Wobble => predict(&points).weights,
+            KickMode::Weave => predict_weave(&points, Trend::Line).fit.weights,
+        };
+        for (&i, w) in of_mode.iter().zip(weights) {
+            rows[i].used = w > 0.0;
+        }
+    }
+}
+
 /// The identifying columns every table starts with.
 macro_rules! identity {
     ($t:ty) => {
@@ -273,6 +331,36 @@ fn runs_columns() -> Vec<Column<RunsRow>> {
             name: "firmware",
             kind: Kind::Text,
             value: |r| Value::Text(r.firmware.clone()),
+        },
+    ]);
+    columns
+}
+
+/// The columns of `kicks.parquet`: `wobblog margin`'s kick fields, the
+/// mode, and whether the prediction used the kick.
+fn kicks_columns() -> Vec<Column<KicksRow>> {
+    let mut columns = identity!(KicksRow).to_vec();
+    columns.extend([
+        Column::<KicksRow> {
+            name: "mode",
+            kind: Kind::Label,
+            value: |r| Value::Label(Some(r.mode.as_str())),
+        },
+        Column {
+            name: "source",
+            kind: Kind::Label,
+            value: |r| Value::Label(Some(r.kick.source.as_str())),
+        },
+        number!(KicksRow, "t_s", r => Some(r.kick.t_s)),
+        number!(KicksRow, "speed_mps", r => Some(r.kick.speed_mps)),
+        number!(KicksRow, "freq_hz", r => Some(r.kick.freq_hz)),
+        number!(KicksRow, "sigma_per_s", r => Some(r.kick.sigma_per_s)),
+        number!(KicksRow, "sigma_sd_per_s", r => Some(r.kick.sigma_sd_per_s)),
+        number!(KicksRow, "amp_deg", r => Some(r.kick.amp_deg)),
+        Column {
+            name: "used",
+            kind: Kind::Bool,
+            value: |r| Value::Bool(Some(r.used)),
         },
     ]);
     columns
@@ -356,6 +444,39 @@ pub enum Outcome<'a> {
     Skipped(&'a CliError),
 }
 
+/// The kicks of `ride` (read from `entry`) as `wobblog margin` takes them
+/// (`--kicks best`), the weave's after them. A card record without a speed
+/// takes the frames' speed after it: a second reading of the log, made
+/// only when there is such a record.
+fn kicks_of(entry: &LogEntry, ride: &Ride) -> Result<Vec<KicksRow>, CliError> {
+    let mut speeds = SpeedsAfter::for_records(&ride.summary.kick_records);
+    if !speeds.is_empty() {
+        read_rows(
+            &entry.path,
+            |_| {},
+            |row| speeds.push(row.t_s, row.speed_mps),
+        )?;
+    }
+    // A config the host refuses gives no wobble kicks, as in `margin`.
+    let wobble = ride_campaign_kicks(ride, Prefer::Best, &speeds).unwrap_or_default();
+    let mut rows: Vec<KicksRow> = wobble
+        .into_iter()
+        .map(|kick| KicksRow {
+            entry: entry.clone(),
+            mode: KickMode::Wobble,
+            kick,
+            used: false,
+        })
+        .collect();
+    rows.extend(
+        ride.weave_kicks
+            .iter()
+            .cloned()
+            .map(|k| KicksRow::weave(entry, k)),
+    );
+    Ok(rows)
+}
+
 /// Writes one log's frame file and analysis; nothing of it stays on failure.
 fn write_log(entry: &LogEntry, dir: &Path) -> Result<Ride, CliError> {
     // Analysed first: a log that cannot be read fails before a file is made.
@@ -390,6 +511,7 @@ pub fn write_dataset(
 ) -> Result<usize, CliError> {
     let mut runs = Vec::new();
     let mut episodes = Vec::new();
+    let mut kicks = Vec::new();
     let mut skipped = 0;
     for entry in entries {
         let ride = match write_log(entry, dir) {
@@ -405,6 +527,7 @@ pub fn write_dataset(
             Err(e) => return Err(e),
         };
         progress(entry, Outcome::Written(&ride));
+        kicks.extend(kicks_of(entry, &ride)?);
         episodes.extend(ride.all_episodes().into_iter().map(|episode| EpisodesRow {
             entry: entry.clone(),
             episode,
@@ -424,6 +547,8 @@ pub fn write_dataset(
     }
     write_table(&dir.join(RUNS), &runs_columns(), &runs)?;
     write_table(&dir.join(EPISODES), &episodes_columns(), &episodes)?;
+    mark_used(&mut kicks);
+    write_table(&dir.join(KICKS), &kicks_columns(), &kicks)?;
     Ok(skipped)
 }
 

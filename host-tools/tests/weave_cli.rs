@@ -205,7 +205,8 @@ fn wobble_lists_the_weave_ring_downs() {
     );
 }
 
-/// The data set's episodes table has a `mode` column with the weave's rows.
+/// The data set's episodes table has a `mode` column with the weave's rows,
+/// and its kicks table the weave's kicks, each used by the prediction.
 #[test]
 fn the_data_sets_episodes_hold_the_weave() {
     let dir = campaign();
@@ -246,6 +247,26 @@ fn the_data_sets_episodes_hold_the_weave() {
         modes.iter().all(|m| m == "weave" || m == "wobble"),
         "{modes:?}"
     );
+    // The kicks table: each weave kick, used by the weave's prediction.
+    let file = std::fs::File::open(dataset.join("kicks/part-0.parquet")).unwrap();
+    let reader = parquet::file::reader::SerializedFileReader::new(file).unwrap();
+    let kicks: Vec<(String, String)> = reader
+        .get_row_iter(None)
+        .unwrap()
+        .map(|r| {
+            let row = r.unwrap();
+            let text = |name: &str| {
+                row.get_column_iter()
+                    .find(|(n, _)| n.as_str() == name)
+                    .map(|(_, f)| f.to_string().trim_matches('"').to_owned())
+                    .unwrap()
+            };
+            (text("mode"), text("used"))
+        })
+        .collect();
+    let weave: Vec<&(String, String)> = kicks.iter().filter(|k| k.0 == "weave").collect();
+    assert_eq!(weave.len(), 10, "{kicks:?}");
+    assert!(weave.iter().all(|k| k.1 == "true"), "{kicks:?}");
 }
 
 /// `model compare` puts each weave ring-down against the model's weave
