@@ -12,7 +12,9 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::analysis::campaign_kicks::{ride_campaign_kicks, CampaignKick, Prefer, SpeedsAfter};
+use crate::analysis::campaign_kicks::{
+    ride_campaign_kicks, CampaignKick, Prefer, Source, SpeedsAfter,
+};
 use crate::analysis::kicks::{Kick, KickMode};
 use crate::analysis::margin::weave::predict_weave;
 use crate::analysis::margin::{predict, KickPoint, Trend};
@@ -207,31 +209,40 @@ pub struct EpisodesRow {
     episode: Episode,
 }
 
-/// One kick's row of `kicks.parquet`.
+/// One kick's row of `kicks.parquet`: the values alone (a campaign of
+/// card records holds many).
 pub struct KicksRow {
     entry: LogEntry,
     mode: KickMode,
-    kick: CampaignKick,
+    source: Source,
+    t_s: f64,
+    amp_deg: f64,
+    point: KickPoint,
     used: bool,
 }
 
 impl KicksRow {
+    fn of(entry: &LogEntry, mode: KickMode, k: &CampaignKick) -> Self {
+        Self {
+            entry: entry.clone(),
+            mode,
+            source: k.source,
+            t_s: k.t_s,
+            amp_deg: k.amp_deg,
+            point: KickPoint::from(k),
+            used: false,
+        }
+    }
+
     /// A weave kick (the host's alone: the board records wobble kicks).
-    fn weave(entry: &LogEntry, k: Kick) -> Self {
+    fn weave(entry: &LogEntry, k: &Kick) -> Self {
         Self {
             entry: entry.clone(),
             mode: KickMode::Weave,
-            kick: CampaignKick {
-                source: crate::analysis::campaign_kicks::Source::Host,
-                t_s: k.t_s,
-                speed_mps: k.speed_mps,
-                freq_hz: k.freq_hz,
-                sigma_per_s: k.sigma_per_s,
-                sigma_sd_per_s: k.sigma_sd_per_s,
-                amp_deg: k.amp_deg,
-                host: Some(k),
-                card: None,
-            },
+            source: Source::Host,
+            t_s: k.t_s,
+            amp_deg: k.amp_deg,
+            point: KickPoint::from(k),
             used: false,
         }
     }
@@ -242,10 +253,7 @@ impl KicksRow {
 fn mark_used(rows: &mut [KicksRow]) {
     for mode in [KickMode::Wobble, KickMode::Weave] {
         let of_mode: Vec<usize> = (0..rows.len()).filter(|&i| rows[i].mode == mode).collect();
-        let points: Vec<KickPoint> = of_mode
-            .iter()
-            .map(|&i| KickPoint::from(&rows[i].kick))
-            .collect();
+        let points: Vec<KickPoint> = of_mode.iter().map(|&i| rows[i].point.clone()).collect();
         let weights = match mode {
             KickMode::Wobble => predict(&points).weights,
             KickMode::Weave => predict_weave(&points, Trend::Line).fit.weights,
@@ -349,14 +357,14 @@ fn kicks_columns() -> Vec<Column<KicksRow>> {
         Column {
             name: "source",
             kind: Kind::Label,
-            value: |r| Value::Label(Some(r.kick.source.as_str())),
+            value: |r| Value::Label(Some(r.source.as_str())),
         },
-        number!(KicksRow, "t_s", r => Some(r.kick.t_s)),
-        number!(KicksRow, "speed_mps", r => Some(r.kick.speed_mps)),
-        number!(KicksRow, "freq_hz", r => Some(r.kick.freq_hz)),
-        number!(KicksRow, "sigma_per_s", r => Some(r.kick.sigma_per_s)),
-        number!(KicksRow, "sigma_sd_per_s", r => Some(r.kick.sigma_sd_per_s)),
-        number!(KicksRow, "amp_deg", r => Some(r.kick.amp_deg)),
+        number!(KicksRow, "t_s", r => Some(r.t_s)),
+        number!(KicksRow, "speed_mps", r => Some(r.point.speed_mps)),
+        number!(KicksRow, "freq_hz", r => Some(r.point.freq_hz)),
+        number!(KicksRow, "sigma_per_s", r => Some(r.point.sigma_per_s)),
+        number!(KicksRow, "sigma_sd_per_s", r => Some(r.point.sigma_sd_per_s)),
+        number!(KicksRow, "amp_deg", r => Some(r.amp_deg)),
         Column {
             name: "used",
             kind: Kind::Bool,
@@ -460,20 +468,10 @@ fn kicks_of(entry: &LogEntry, ride: &Ride) -> Result<Vec<KicksRow>, CliError> {
     // A config the host refuses gives no wobble kicks, as in `margin`.
     let wobble = ride_campaign_kicks(ride, Prefer::Best, &speeds).unwrap_or_default();
     let mut rows: Vec<KicksRow> = wobble
-        .into_iter()
-        .map(|kick| KicksRow {
-            entry: entry.clone(),
-            mode: KickMode::Wobble,
-            kick,
-            used: false,
-        })
+        .iter()
+        .map(|k| KicksRow::of(entry, KickMode::Wobble, k))
         .collect();
-    rows.extend(
-        ride.weave_kicks
-            .iter()
-            .cloned()
-            .map(|k| KicksRow::weave(entry, k)),
-    );
+    rows.extend(ride.weave_kicks.iter().map(|k| KicksRow::weave(entry, k)));
     Ok(rows)
 }
 

@@ -140,6 +140,8 @@ pub struct Band {
     /// Whether the signal is a rate (deg/s): a kick's amplitude is then
     /// that of its integral (degrees), the rate's over the frequency.
     pub rate_signal: bool,
+    /// Frames searched at once, at most ([`PIECE_FRAMES`] for the wobble).
+    pub piece_frames: usize,
     /// The fit's standard error of sigma is scaled by this...
     pub se_factor: f64,
     /// ... and an error this large (1/s) is added in quadrature.
@@ -165,6 +167,7 @@ pub const WOBBLE: Band = Band {
     wheel_tones: true,
     fit_trend: false,
     rate_signal: false,
+    piece_frames: PIECE_FRAMES,
     se_factor: SE_FACTOR,
     sd_floor_per_s: SD_FLOOR_PER_S,
 };
@@ -337,7 +340,8 @@ impl KickSearch {
     /// [`KickMode::signal`].
     #[must_use]
     pub fn for_mode(mode: KickMode, fs_hz: f64, wheel_circumference_m: f64) -> Self {
-        Self::with_piece(Band::of(mode), fs_hz, wheel_circumference_m, PIECE_FRAMES)
+        let band = Band::of(mode);
+        Self::with_piece(band, fs_hz, wheel_circumference_m, band.piece_frames)
     }
 
     /// A search of `band` in pieces of `piece` frames (at least twice the

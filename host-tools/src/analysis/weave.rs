@@ -68,6 +68,10 @@ pub const WEAVE: Band = Band {
     wheel_tones: false,
     fit_trend: true,
     rate_signal: true,
+    // A quarter of the wobble's pieces (10.9 min): every command that
+    // analyses a ride runs this search beside the wobble's, and its
+    // 20 s overlap is small against it.
+    piece_frames: super::kicks::PIECE_FRAMES / 4,
     se_factor: 2.5,
     sd_floor_per_s: 0.025,
 };
