@@ -290,10 +290,74 @@ fn compare_prints_residuals_and_fit_writes_the_fitted_file() {
     );
     let written = wobble_model::ParamSet::load(&fitted).unwrap();
     let q = written.quantity("steer_head.damping").unwrap();
-    assert_eq!(q.source, "fitted to measured wobble episodes");
-    assert!(String::from_utf8(out.stdout)
+    let stdout = String::from_utf8(out.stdout).unwrap();
+    assert!(stdout.contains(&format!("steer_head.damping = {:.6}", q.value)));
+    // The fitted file keeps its evidence: the value's interval (as printed)
+    // and what it came from, a name of its own, and each episode's
+    // residual against the fitted model.
+    let ci = stdout
+        .lines()
+        .find(|l| l.contains("steer_head.damping ="))
+        .and_then(|l| l.split("+/- ").nth(1))
+        .and_then(|r| r.split_whitespace().next())
+        .and_then(|v| v.parse::<f64>().ok())
+        .expect(&stdout);
+    assert!(
+        q.source.starts_with("fitted by wobblog model fit: "),
+        "{}",
+        q.source
+    );
+    let stated: f64 = q
+        .source
+        .split("+/- ")
+        .nth(1)
         .unwrap()
-        .contains(&format!("steer_head.damping = {:.6}", q.value)));
+        .split_whitespace()
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert!((stated - ci).abs() <= 1e-6, "{} vs {ci}", q.source);
+    assert!(
+        q.source
+            .contains("(95 %), to 1 wobble episode of 1 log (wobble_fig6.WBL); rms residuals"),
+        "{}",
+        q.source
+    );
+    assert!(
+        written.name.ends_with(", fitted to 1 wobble episode"),
+        "{}",
+        written.name
+    );
+    let text = std::fs::read_to_string(&fitted).unwrap();
+    let residual = text
+        .lines()
+        .find(|l| l.starts_with("# wobble_fig6.WBL, "))
+        .expect(&text);
+    let cols: Vec<f64> = residual[2..]
+        .split(", ")
+        .skip(1)
+        .map(|c| c.parse().unwrap())
+        .collect();
+    assert_eq!(cols.len(), 6, "{residual}");
+    // With one episode its residuals are the fit's RMS residuals, as
+    // printed (worked out again here from the fitted file's model).
+    let rms: Vec<f64> = stdout
+        .lines()
+        .find(|l| l.starts_with("rms residuals: "))
+        .expect(&stdout)
+        .trim_start_matches("rms residuals: ")
+        .split(", ")
+        .map(|p| p.split_whitespace().next().unwrap().parse().unwrap())
+        .collect();
+    assert!(
+        (cols[3].abs() - rms[0]).abs() <= 0.002,
+        "{residual} vs {rms:?}"
+    );
+    assert!(
+        (cols[5].abs() - rms[1]).abs() <= 0.002,
+        "{residual} vs {rms:?}"
+    );
 }
 
 #[test]

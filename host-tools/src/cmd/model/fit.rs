@@ -1,6 +1,8 @@
 //! `wobblog model fit`: least-squares fit of chosen parameters to the
 //! measured wobble frequencies and growth rates (censored episodes left
-//! out), with 95 % confidence intervals, and the fitted parameter file.
+//! out), with 95 % confidence intervals, and the fitted parameter file,
+//! which keeps its evidence: each fitted value's interval, the logs and
+//! episodes it came from, and every episode's residual.
 
 use std::fmt::Write as _;
 use std::io::Write as _;
@@ -57,11 +59,11 @@ pub fn run(args: &Args) -> Result<(), CliError> {
     let stdout = Output::stdout(&inputs)?;
     let (found, loaded) = episodes::load(&logs);
     // The fit is the wobble's: the weave's ring-downs are not fitted.
-    let obs: Vec<_> = found
+    let used: Vec<&episodes::LoggedEpisode> = found
         .iter()
         .filter(|e| !e.censored() && e.mode() == Mode::Wobble)
-        .map(episodes::LoggedEpisode::observation)
         .collect();
+    let obs: Vec<_> = used.iter().map(|e| e.observation()).collect();
     let weights = Weights {
         freq_sd_hz: args.freq_sd,
         sigma_sd_per_s: args.sigma_sd,
@@ -86,11 +88,97 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         "rms residuals: {:.3} Hz, {:.3} 1/s",
         result.rms_freq_hz, result.rms_sigma_per_s
     );
-    let mut fitted = result.set;
-    fitted.source = format!("{} (fitted by wobblog model fit)", fitted.source);
-    out.write_all(to_toml(&fitted).as_bytes())
+    let mut fitted = result.set.clone();
+    let evidence = Evidence::of(&used, &result);
+    fitted.name = format!("{}, fitted to {}", fitted.name, evidence.episodes);
+    fitted.source = format!(
+        "{}; fitted by wobblog model fit to {}",
+        fitted.source, evidence.what
+    );
+    for e in &result.estimates {
+        fitted
+            .set_value(&e.key, e.value, &evidence.source_of(e))
+            .map_err(|err| param_error(&err))?;
+    }
+    let residuals = residual_lines(&fitted, &used).map_err(|e| CliError::file(&args.params, e))?;
+    out.write_all((to_toml(&fitted) + &residuals).as_bytes())
         .map_err(|e| out.error(e))?;
     out.commit()?;
     print(stdout, &text)?;
     loaded
+}
+
+/// What a fit was made from, in words for the fitted file.
+struct Evidence {
+    /// `12 wobble episodes`.
+    episodes: String,
+    /// `12 wobble episodes of 3 logs (RUN00001.WBL, ...); rms residuals ...`.
+    what: String,
+}
+
+/// Logs named in the fitted file at most; more are counted.
+const LOGS_NAMED: usize = 8;
+
+impl Evidence {
+    fn of(used: &[&episodes::LoggedEpisode], result: &wobble_model::fit::FitResult) -> Self {
+        let mut logs: Vec<&str> = used.iter().map(|e| e.log.as_str()).collect();
+        logs.dedup();
+        let mut named = logs
+            .iter()
+            .take(LOGS_NAMED)
+            .copied()
+            .collect::<Vec<_>>()
+            .join(", ");
+        if logs.len() > LOGS_NAMED {
+            let _ = write!(named, " and {} more", logs.len() - LOGS_NAMED);
+        }
+        let episodes = crate::words::plural(used.len(), "wobble episode");
+        let what = format!(
+            "{episodes} of {} ({named}); rms residuals {:.3} Hz, {:.3} 1/s",
+            crate::words::plural(logs.len(), "log"),
+            result.rms_freq_hz,
+            result.rms_sigma_per_s
+        );
+        Self { episodes, what }
+    }
+
+    /// The source of a fitted value: its interval and what it came from.
+    fn source_of(&self, e: &wobble_model::fit::Estimate) -> String {
+        format!(
+            "fitted by wobblog model fit: {} +/- {} {} (95 %), to {}",
+            e.value, e.ci95, e.unit, self.what
+        )
+    }
+}
+
+/// Every episode fitted, measured against the fitted model's wobble at
+/// its speed, as TOML comments (the file still loads as it did).
+fn residual_lines(
+    fitted: &wobble_model::ParamSet,
+    used: &[&episodes::LoggedEpisode],
+) -> Result<String, String> {
+    let model = wobble_model::Model::from_set(fitted).map_err(|e| e.to_string())?;
+    let speeds: Vec<f64> = used.iter().map(|e| e.episode.speed_at_onset_mps).collect();
+    let at = wobble_model::sweep::mode_at(&model, Mode::Wobble, &speeds)
+        .map_err(|e| e.to_string())?
+        .unwrap_or_default();
+    let mut o = String::from(
+        "\n# The episodes fitted, measured minus the fitted model's wobble at the same speed:\n\
+         # log, onset_s, speed_mps, freq_hz, d_freq_hz, sigma_per_s, d_sigma_per_s\n",
+    );
+    for (e, w) in used.iter().zip(at) {
+        let ep = &e.episode;
+        let _ = writeln!(
+            o,
+            "# {}, {:.2}, {:.3}, {:.3}, {:.3}, {:.3}, {:.3}",
+            crate::text::escape_controls(&e.log),
+            ep.onset_s,
+            ep.speed_at_onset_mps,
+            ep.freq_hz,
+            ep.freq_hz - w.im / std::f64::consts::TAU,
+            ep.sigma_per_s,
+            ep.sigma_per_s - w.re
+        );
+    }
+    Ok(o)
 }
