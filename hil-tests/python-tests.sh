@@ -8,9 +8,11 @@ cd "$(dirname "$0")/.."
 
 TARGET_DIR="${CARGO_TARGET_DIR:-$PWD/target}"
 VENV="$TARGET_DIR/python-venv"
-# The test dependencies: the build backend, the runner, and the libraries
-# the package's Arrow tables are read with.
-PY_PACKAGES=(maturin pytest polars pyarrow pandas duckdb)
+# The test dependencies: the build backend, the runner, the libraries the
+# package's Arrow tables are read with, and the MCAP reader with its ROS 2
+# decoder (the CLI's MCAP files are read with them): `name` or
+# `name:module` where the module is named otherwise.
+PY_PACKAGES=(maturin pytest polars pyarrow pandas duckdb mcap mcap-ros2-support:mcap_ros2)
 
 if [ ! -x "$VENV/bin/python" ]; then
     # Debian's Python has no venv module (ensurepip) without python3-venv.
@@ -24,8 +26,8 @@ if [ ! -x "$VENV/bin/python" ]; then
     python3 -m venv "$VENV"
 fi
 missing=()
-for pkg in "${PY_PACKAGES[@]}"; do
-    "$VENV/bin/python" -c "import $pkg" 2>/dev/null || missing+=("$pkg")
+for entry in "${PY_PACKAGES[@]}"; do
+    "$VENV/bin/python" -c "import ${entry#*:}" 2>/dev/null || missing+=("${entry%%:*}")
 done
 if ((${#missing[@]})); then
     "$VENV/bin/python" -m pip install --quiet "${missing[@]}"

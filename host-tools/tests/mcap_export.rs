@@ -1,7 +1,11 @@
 //! `wobblog decode --format mcap`, read back with the `mcap` crate as
-//! Foxglove reads it: zstd chunks, one CDR message per frame on `/sensors`
-//! with its ROS 2 message definition, the GPS as `foxglove.LocationFix`, the
-//! events as `foxglove.Log`, log times in UTC nanoseconds, the metadata.
+//! Foxglove reads it: zstd chunks, every channel CDR with its ROS 2 message
+//! definition (one CDR message per frame on `/sensors`, the GPS as
+//! `foxglove_msgs/msg/LocationFix`, the events as `foxglove_msgs/msg/Log`),
+//! log times in UTC nanoseconds, the metadata. The CDR is read back here by
+//! a reader written from the specification (each field aligned to its size
+//! after the 4-byte header); `python/tests` reads it with the Python
+//! `mcap-ros2-support` decoder.
 
 mod analysis_support;
 
@@ -20,10 +24,80 @@ struct Message {
     data: Vec<u8>,
 }
 
+/// Plain little-endian CDR read field by field.
+struct CdrReader<'a> {
+    data: &'a [u8],
+    at: usize,
+}
+
+impl CdrReader<'_> {
+    fn take(&mut self, size: usize, align: usize) -> &[u8] {
+        while !self.at.is_multiple_of(align) {
+            self.at += 1;
+        }
+        let field = &self.data[self.at..self.at + size];
+        self.at += size;
+        field
+    }
+    fn u8(&mut self) -> u8 {
+        self.take(1, 1)[0]
+    }
+    fn u32(&mut self) -> u32 {
+        u32::from_le_bytes(self.take(4, 4).try_into().unwrap())
+    }
+    fn i32(&mut self) -> i32 {
+        i32::from_le_bytes(self.take(4, 4).try_into().unwrap())
+    }
+    fn f64(&mut self) -> f64 {
+        f64::from_le_bytes(self.take(8, 8).try_into().unwrap())
+    }
+    fn string(&mut self) -> String {
+        let len = self.u32() as usize;
+        let bytes = self.take(len, 1);
+        assert_eq!(bytes[len - 1], 0, "NUL-terminated");
+        String::from_utf8(bytes[..len - 1].to_vec()).unwrap()
+    }
+    fn time(&mut self) -> serde_json::Value {
+        serde_json::json!({"sec": self.i32(), "nanosec": self.u32()})
+    }
+}
+
 impl Message {
+    /// A `foxglove_msgs` message decoded by its schema's fields.
     fn json(&self) -> serde_json::Value {
-        assert_eq!(self.encoding, "json");
-        serde_json::from_slice(&self.data).unwrap()
+        assert_eq!(self.encoding, "cdr");
+        assert_eq!(self.data[..4], [0, 1, 0, 0], "plain CDR, little-endian");
+        let mut r = CdrReader {
+            data: &self.data[4..],
+            at: 0,
+        };
+        let v = if self.schema.contains("LocationFix") {
+            serde_json::json!({
+                "timestamp": r.time(),
+                "frame_id": r.string(),
+                "latitude": r.f64(),
+                "longitude": r.f64(),
+                "altitude": r.f64(),
+                "position_covariance": (0..9).map(|_| r.f64()).collect::<Vec<_>>(),
+                "position_covariance_type": r.u8(),
+            })
+        } else {
+            assert!(
+                self.schema.contains("foxglove_msgs/msg/Log"),
+                "{}",
+                self.schema
+            );
+            serde_json::json!({
+                "timestamp": r.time(),
+                "level": r.u8(),
+                "message": r.string(),
+                "name": r.string(),
+                "file": r.string(),
+                "line": r.u32(),
+            })
+        };
+        assert_eq!(r.at, self.data.len() - 4, "every byte read");
+        v
     }
 
     /// The float64 fields of a CDR message, after its encapsulation header.
@@ -139,7 +213,9 @@ fn mcap_is_compressed_in_utc_with_every_frame_fix_and_event_on_its_channel() {
         .collect();
     let gps = &by_topic["/gps"];
     assert_eq!(gps.len(), fixes.len());
-    assert!(gps[0].schema.starts_with("jsonschema foxglove.LocationFix"));
+    assert!(gps[0]
+        .schema
+        .starts_with("ros2msg foxglove_msgs/msg/LocationFix"));
     for (message, fix) in gps.iter().zip(&fixes) {
         let body = message.json();
         // Latitude and longitude each their own value.
@@ -150,7 +226,7 @@ fn mcap_is_compressed_in_utc_with_every_frame_fix_and_event_on_its_channel() {
         let t = fix.t_us as f64 / 1e6;
         assert_eq!(message.log_time, utc_ns(t));
         let stamp = body["timestamp"]["sec"].as_u64().unwrap() * 1_000_000_000
-            + body["timestamp"]["nsec"].as_u64().unwrap();
+            + body["timestamp"]["nanosec"].as_u64().unwrap();
         assert_eq!(stamp, message.log_time);
     }
     let first = gps[0].json();
@@ -159,13 +235,15 @@ fn mcap_is_compressed_in_utc_with_every_frame_fix_and_event_on_its_channel() {
 
     // The events in Foxglove's Log panel: alerts warn.
     let events = &by_topic["/events"];
-    assert!(events[0].schema.starts_with("jsonschema foxglove.Log"));
+    assert!(events[0]
+        .schema
+        .starts_with("ros2msg foxglove_msgs/msg/Log"));
     let logged: Vec<(String, u64)> = events
         .iter()
         .map(|m| {
             let body = m.json();
             let stamp = body["timestamp"]["sec"].as_u64().unwrap() * 1_000_000_000
-                + body["timestamp"]["nsec"].as_u64().unwrap();
+                + body["timestamp"]["nanosec"].as_u64().unwrap();
             assert_eq!(stamp, m.log_time);
             assert_eq!(body["file"], "RUN00003.WBL");
             (

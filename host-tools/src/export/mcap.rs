@@ -1,10 +1,13 @@
 //! Rows, GPS fixes and events as an MCAP file for Foxglove and other
-//! robotics viewers: zstd-compressed chunks; the sensors of a frame as one
-//! message on `/sensors`, a ROS 2 message definition in CDR (binary, and one
-//! message per frame rather than one per sensor group: a 64 MiB log is 2.6 M
-//! messages, and the writer's cost is per message); the GPS as
-//! `foxglove.LocationFix` (the map panel) and the events as `foxglove.Log`
-//! (the Log panel), both JSON; the log's metadata as an MCAP metadata record.
+//! robotics viewers: zstd-compressed chunks; every channel a ROS 2 message
+//! definition in CDR, one encoding, so a reader with a ROS 2 decoder (the
+//! Python `mcap-ros2-support`, Foxglove) decodes every topic without a
+//! decoder of its own: the sensors of a frame as one message on `/sensors`
+//! (binary, and one message per frame rather than one per sensor group: a
+//! 64 MiB log is 2.6 M messages, and the writer's cost is per message); the
+//! GPS as `foxglove_msgs/msg/LocationFix` (the map panel) and the events as
+//! `foxglove_msgs/msg/Log` (the Log panel); the log's metadata as an MCAP
+//! metadata record.
 //!
 //! Message log times are UTC, nanoseconds since 1970, when the log has a
 //! GPS sync pair (frames before the first pair are placed through it), so
@@ -14,7 +17,6 @@
 use std::collections::BTreeMap;
 use std::io::Write;
 
-use serde::Serialize;
 use wobble_core::format::GpsFix;
 
 use super::columns::{Column, Value};
@@ -35,11 +37,34 @@ fn numbers_schema(fields: &[Column]) -> String {
 /// The CDR encapsulation header: plain CDR, little-endian.
 const CDR_LE: [u8; 4] = [0, 1, 0, 0];
 
-/// Foxglove's `foxglove.LocationFix`, as its JSON Schema.
-const LOCATION_FIX_SCHEMA: &str = r#"{"title":"foxglove.LocationFix","type":"object","properties":{"timestamp":{"type":"object","properties":{"sec":{"type":"integer"},"nsec":{"type":"integer"}}},"frame_id":{"type":"string"},"latitude":{"type":"number"},"longitude":{"type":"number"},"altitude":{"type":"number"},"position_covariance":{"type":"array","items":{"type":"number"},"minItems":9,"maxItems":9},"position_covariance_type":{"type":"integer"}}}"#;
+/// The definition a ROS 2 schema that uses a time appends for it.
+const TIME_DEFINITION: &str =
+    "================================================================================\n\
+MSG: builtin_interfaces/Time\n\
+int32 sec\n\
+uint32 nanosec\n";
 
-/// Foxglove's `foxglove.Log`, as its JSON Schema.
-const LOG_SCHEMA: &str = r#"{"title":"foxglove.Log","type":"object","properties":{"timestamp":{"type":"object","properties":{"sec":{"type":"integer"},"nsec":{"type":"integer"}}},"level":{"type":"integer","description":"1 debug, 2 info, 3 warning, 4 error, 5 fatal"},"message":{"type":"string"},"name":{"type":"string"},"file":{"type":"string"},"line":{"type":"integer"}}}"#;
+/// Foxglove's `foxglove_msgs/msg/LocationFix`, its ROS 2 definition.
+const LOCATION_FIX_SCHEMA_NAME: &str = "foxglove_msgs/msg/LocationFix";
+/// See [`LOCATION_FIX_SCHEMA_NAME`].
+const LOCATION_FIX_FIELDS: &str = "builtin_interfaces/Time timestamp\n\
+string frame_id\n\
+float64 latitude\n\
+float64 longitude\n\
+float64 altitude\n\
+float64[9] position_covariance\n\
+uint8 position_covariance_type\n";
+
+/// Foxglove's `foxglove_msgs/msg/Log`, its ROS 2 definition (`level`: 1
+/// debug, 2 info, 3 warning, 4 error, 5 fatal).
+const LOG_SCHEMA_NAME: &str = "foxglove_msgs/msg/Log";
+/// See [`LOG_SCHEMA_NAME`].
+const LOG_FIELDS: &str = "builtin_interfaces/Time timestamp\n\
+uint8 level\n\
+string message\n\
+string name\n\
+string file\n\
+uint32 line\n";
 
 /// Every sensor field of a frame, one message per frame.
 pub const SENSORS_TOPIC: &str = "/sensors";
@@ -95,31 +120,55 @@ pub struct McapWriter<W: Write> {
     utc_offset_ns: Option<i64>,
 }
 
-#[derive(Serialize)]
-struct Time {
-    sec: u64,
-    nsec: u32,
-}
+/// A CDR message body (plain CDR, little-endian) written field by
+/// field: each field aligned to its size, counted from the end of the
+/// encapsulation header. Written here: the ROS 2 types used are four plain
+/// structs, and a serialisation crate would bring a message model of its
+/// own for them.
+struct Cdr<'a>(&'a mut Vec<u8>);
 
-/// Foxglove's `foxglove.Log`.
-#[derive(Serialize)]
-struct Log<'a> {
-    timestamp: Time,
-    /// 2 info, 3 warning, 4 error.
-    level: u8,
-    message: String,
-    /// The event kind (`alert_on`, `fault`, ...), to filter on.
-    name: &'static str,
-    file: &'a str,
-    line: u32,
-}
+impl<'a> Cdr<'a> {
+    /// A body in `buf` (cleared), its header written.
+    fn start(buf: &'a mut Vec<u8>) -> Self {
+        buf.clear();
+        buf.extend_from_slice(&CDR_LE);
+        Self(buf)
+    }
 
-impl Time {
-    fn of_ns(ns: u64) -> Self {
-        Self {
-            sec: ns / 1_000_000_000,
-            nsec: (ns % 1_000_000_000) as u32,
+    fn align(&mut self, size: usize) {
+        while !(self.0.len() - CDR_LE.len()).is_multiple_of(size) {
+            self.0.push(0);
         }
+    }
+
+    fn u8(&mut self, v: u8) {
+        self.0.push(v);
+    }
+
+    fn u32(&mut self, v: u32) {
+        self.align(4);
+        self.0.extend_from_slice(&v.to_le_bytes());
+    }
+
+    fn f64(&mut self, v: f64) {
+        self.align(8);
+        self.0.extend_from_slice(&v.to_le_bytes());
+    }
+
+    /// A string: its length with the terminating NUL, its bytes, the NUL.
+    fn string(&mut self, text: &str) {
+        self.u32(u32::try_from(text.len() + 1).unwrap_or(u32::MAX));
+        self.0.extend_from_slice(text.as_bytes());
+        self.0.push(0);
+    }
+
+    /// A `builtin_interfaces/Time` of `ns` nanoseconds since 1970 (or since
+    /// boot): seconds as an `int32`, which holds them until 2038.
+    fn time(&mut self, ns: u64) {
+        let sec = i32::try_from(ns / 1_000_000_000).unwrap_or(i32::MAX);
+        self.align(4);
+        self.0.extend_from_slice(&sec.to_le_bytes());
+        self.u32((ns % 1_000_000_000) as u32);
     }
 }
 
@@ -133,18 +182,6 @@ fn level(kind: &EventKind) -> u8 {
     }
 }
 
-#[derive(Serialize)]
-struct LocationFix {
-    timestamp: Time,
-    frame_id: &'static str,
-    latitude: f64,
-    longitude: f64,
-    altitude: f64,
-    position_covariance: [f64; 9],
-    /// 0: unknown (no covariance is logged).
-    position_covariance_type: u8,
-}
-
 impl<W: Write> McapWriter<W> {
     /// A writer of `columns` on `out`; the header and channel definitions
     /// go out at once. `/sensors` carries the chosen sensor columns, in the
@@ -155,14 +192,9 @@ impl<W: Write> McapWriter<W> {
     /// When `out` fails.
     pub fn new(out: W, columns: &[Column]) -> std::io::Result<Self> {
         let mut file = McapFile::new(out, concat!("wobblog ", env!("CARGO_PKG_VERSION")))?;
-        let mut channel = |topic: &str, schema_name: &str, schema: &str, json: bool| {
-            let (schema_encoding, message_encoding) = if json {
-                ("jsonschema", "json")
-            } else {
-                ("ros2msg", "cdr")
-            };
-            let id = file.add_schema(schema_name, schema_encoding, schema.as_bytes())?;
-            file.add_channel(id, topic, message_encoding)
+        let mut channel = |topic: &str, schema_name: &str, schema: &str| {
+            let id = file.add_schema(schema_name, "ros2msg", schema.as_bytes())?;
+            file.add_channel(id, topic, "cdr")
         };
         let chosen: Vec<Column> = columns
             .iter()
@@ -174,21 +206,21 @@ impl<W: Write> McapWriter<W> {
         } else {
             let schema = numbers_schema(&chosen);
             Some(SensorChannel {
-                id: channel(SENSORS_TOPIC, SENSORS_SCHEMA_NAME, &schema, false)?,
+                id: channel(SENSORS_TOPIC, SENSORS_SCHEMA_NAME, &schema)?,
                 columns: chosen,
             })
         };
         let gps = if columns.iter().any(|c| c.name.starts_with("gps_")) {
-            Some(channel(
-                GPS_TOPIC,
-                "foxglove.LocationFix",
-                LOCATION_FIX_SCHEMA,
-                true,
-            )?)
+            let schema = format!("{LOCATION_FIX_FIELDS}{TIME_DEFINITION}");
+            Some(channel(GPS_TOPIC, LOCATION_FIX_SCHEMA_NAME, &schema)?)
         } else {
             None
         };
-        let events = channel(EVENTS_TOPIC, "foxglove.Log", LOG_SCHEMA, true)?;
+        let events = channel(
+            EVENTS_TOPIC,
+            LOG_SCHEMA_NAME,
+            &format!("{LOG_FIELDS}{TIME_DEFINITION}"),
+        )?;
         Ok(Self {
             file,
             sensors,
@@ -220,10 +252,16 @@ impl<W: Write> McapWriter<W> {
             .unwrap_or(boot_ns)
     }
 
-    fn message(&mut self, channel_id: u16, t_s: f64, body: &impl Serialize) -> std::io::Result<()> {
+    /// Writes the CDR body `fill` makes as a message of `channel_id` at
+    /// `t_s` since boot.
+    fn message(
+        &mut self,
+        channel_id: u16,
+        t_s: f64,
+        fill: impl FnOnce(&mut Cdr<'_>),
+    ) -> std::io::Result<()> {
         let mut data = std::mem::take(&mut self.body);
-        data.clear();
-        serde_json::to_writer(&mut data, body).map_err(std::io::Error::other)?;
+        fill(&mut Cdr::start(&mut data));
         let written = self.message_data(channel_id, t_s, &data);
         self.body = data;
         written
@@ -272,16 +310,19 @@ impl<W: Write> McapWriter<W> {
         let ns = fix
             .utc
             .map_or_else(|| self.log_time(boot_ns(t_s)), |u| u.unix_ms() * 1_000_000);
-        let location = LocationFix {
-            timestamp: Time::of_ns(ns),
-            frame_id: "gps",
-            latitude: pos.lat_deg,
-            longitude: pos.lon_deg,
-            altitude: fix.alt_cm.map_or(0.0, |cm| f64::from(cm) / 100.0),
-            position_covariance: [0.0; 9],
-            position_covariance_type: 0,
-        };
-        self.message(gps, t_s, &location)
+        let altitude_m = fix.alt_cm.map_or(0.0, |cm| f64::from(cm) / 100.0);
+        self.message(gps, t_s, |m| {
+            m.time(ns);
+            m.string("gps");
+            m.f64(pos.lat_deg);
+            m.f64(pos.lon_deg);
+            m.f64(altitude_m);
+            // No covariance is logged: zeros, type 0 (unknown).
+            for _ in 0..9 {
+                m.f64(0.0);
+            }
+            m.u8(0);
+        })
     }
 
     /// Writes one event.
@@ -291,19 +332,22 @@ impl<W: Write> McapWriter<W> {
     pub fn event(&mut self, event: &LogEvent, log_name: &str) -> std::io::Result<()> {
         let details = event.kind.describe();
         let name = event.kind.name();
-        let log = Log {
-            timestamp: Time::of_ns(self.log_time(boot_ns(event.t_s))),
-            level: level(&event.kind),
-            message: if details.is_empty() {
-                format!("{name} at {:.3} s", event.t_s)
-            } else {
-                format!("{name} at {:.3} s: {details}", event.t_s)
-            },
-            name,
-            file: log_name,
-            line: 0,
+        let message = if details.is_empty() {
+            format!("{name} at {:.3} s", event.t_s)
+        } else {
+            format!("{name} at {:.3} s: {details}", event.t_s)
         };
-        self.message(self.events, event.t_s, &log)
+        let stamp = self.log_time(boot_ns(event.t_s));
+        let level = level(&event.kind);
+        self.message(self.events, event.t_s, |m| {
+            m.time(stamp);
+            m.u8(level);
+            m.string(&message);
+            // The event kind (`alert_on`, `fault`, ...), to filter on.
+            m.string(name);
+            m.string(log_name);
+            m.u32(0);
+        })
     }
 
     /// Writes the log's metadata and the summary; the file is complete
