@@ -1,6 +1,7 @@
 //! One row per 100 Hz frame, with the GPS fix in force at that frame: the
 //! shape of `wobblog decode` output and of every analysis.
 
+use crate::export::derived::Derived;
 use std::collections::VecDeque;
 
 use wobble_core::format::{
@@ -46,7 +47,7 @@ impl GpsColumns {
 }
 
 /// One decoded 100 Hz frame in physical units.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Row {
     /// Seconds since boot.
     pub t_s: f64,
@@ -67,6 +68,9 @@ pub struct Row {
     /// UTC, µs since 1970, from the latest GPS sync pair at or before the
     /// frame (`None` before the first).
     pub utc_us: Option<i64>,
+    /// Signals derived from the frames around it, when asked for
+    /// ([`crate::export::derived`]).
+    pub derived: Derived,
 }
 
 impl Row {
@@ -84,6 +88,7 @@ impl Row {
             status: frame.status,
             gps,
             utc_us: sync.and_then(|s| utc_us_at(s, frame.t_us)),
+            derived: Derived::default(),
         }
     }
 }

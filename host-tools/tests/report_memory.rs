@@ -83,6 +83,7 @@ fn row(i: usize) -> Row {
             fix: FixMode::Fix3d,
         }),
         utc_us: None,
+        derived: Default::default(),
     }
 }
 

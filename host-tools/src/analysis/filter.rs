@@ -11,6 +11,26 @@ pub struct Biquad {
     a: [f64; 2],
 }
 
+/// A [`Biquad`] filtering a stream one sample at a time.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Streaming {
+    section: Biquad,
+    z1: f64,
+    z2: f64,
+}
+
+impl Streaming {
+    /// The output for the next input `x`.
+    pub fn next(&mut self, x: f64) -> f64 {
+        let [b0, b1, b2] = self.section.b;
+        let [a1, a2] = self.section.a;
+        let y = b0 * x + self.z1;
+        self.z1 = b1 * x - a1 * y + self.z2;
+        self.z2 = b2 * x - a2 * y;
+        y
+    }
+}
+
 /// Which side of the corner frequency a section passes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Pass {
@@ -43,25 +63,29 @@ impl Biquad {
     /// constant input equal to the first sample would have settled to, so a
     /// signal offset does not ring at the edges.
     fn run(&self, x: &mut [f64], forward: bool) {
-        let [b0, b1, b2] = self.b;
-        let [a1, a2] = self.a;
         let first = if forward { x.first() } else { x.last() };
         let Some(&x0) = first else { return };
-        let dc_gain = (b0 + b1 + b2) / (1.0 + a1 + a2);
-        let y0 = dc_gain * x0;
-        let mut z2 = b2 * x0 - a2 * y0;
-        let mut z1 = b1 * x0 - a1 * y0 + z2;
-        let mut step = |v: &mut f64| {
-            let input = *v;
-            let y = b0 * input + z1;
-            z1 = b1 * input - a1 * y + z2;
-            z2 = b2 * input - a2 * y;
-            *v = y;
-        };
+        let mut section = self.stream(x0);
+        let mut step = |v: &mut f64| *v = section.next(*v);
         if forward {
             x.iter_mut().for_each(&mut step);
         } else {
             x.iter_mut().rev().for_each(&mut step);
+        }
+    }
+
+    /// The section filtering one sample at a time, started from the state
+    /// a constant input `x0` would have settled to (as [`Self::forward`]).
+    #[must_use]
+    pub fn stream(self, x0: f64) -> Streaming {
+        let [b0, b1, b2] = self.b;
+        let [a1, a2] = self.a;
+        let y0 = (b0 + b1 + b2) / (1.0 + a1 + a2) * x0;
+        let z2 = b2 * x0 - a2 * y0;
+        Streaming {
+            section: self,
+            z1: b1 * x0 - a1 * y0 + z2,
+            z2,
         }
     }
 

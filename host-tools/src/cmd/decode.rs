@@ -5,6 +5,7 @@ use std::path::{Path, PathBuf};
 
 use crate::events::{EventConverter, LogEvent};
 use crate::export::columns::{self, Column};
+use crate::export::derived::Deriver;
 use crate::export::{Format, LogMetadata, RowWriter};
 use crate::losses::Losses;
 use crate::output::Output;
@@ -209,6 +210,16 @@ pub fn decode_to(
     let log_name = log
         .file_name()
         .map_or_else(String::new, |n| n.to_string_lossy().into_owned());
+    let names: Vec<&str> = export.columns.iter().map(|c| c.name).collect();
+    // Made at the first frame, when the header has given the frame rate.
+    let mut deriver: Option<Option<Deriver>> = None;
+    let mut rows_out = |row: &Row, meta: &LogMetadata, sink: &mut WindowedSink<_>| {
+        let fs_hz = f64::from(meta.sample_rate_hz.unwrap_or(100).max(1));
+        match deriver.get_or_insert_with(|| Deriver::for_columns(&names, fs_hz)) {
+            Some(d) => d.push(row, &mut |r: &Row| sink.row(r)),
+            None => sink.row(row),
+        }
+    };
     read_log(log, |event| {
         losses.observe(&event);
         meta.observe(&event);
@@ -227,10 +238,13 @@ pub fn decode_to(
                 _ => {}
             }
             sink.has_utc |= matches!(record, Record::UtcSync(_));
-            rows.push(&record, &mut |row: &Row| sink.row(row));
+            rows.push(&record, &mut |row: &Row| rows_out(row, &meta, &mut sink));
         }
     })?;
-    rows.finish(&mut |row: &Row| sink.row(row));
+    rows.finish(&mut |row: &Row| rows_out(row, &meta, &mut sink));
+    if let Some(Some(d)) = &mut deriver {
+        d.finish(&mut |r: &Row| sink.row(r));
+    }
     if sink.rows_kept == 0 && !export.window.is_all() {
         // Nothing is written: an empty file would pass for a result.
         return Err(export

@@ -382,6 +382,7 @@ mod tests {
             status: FrameStatus::default(),
             gps: None,
             utc_us: None,
+            derived: Default::default(),
         };
         let fix = GpsColumns {
             lat_deg: 52.0,

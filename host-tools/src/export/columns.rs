@@ -109,8 +109,27 @@ pub const COLUMNS: [Column; 14] = [
     },
 ];
 
+/// A derived column: given only when named ([`super::derived`]).
+macro_rules! derived {
+    ($name:literal, $row:ident => $value:expr) => {
+        Column {
+            name: $name,
+            kind: Kind::OptNumber,
+            value: |$row| Value::Number($value),
+        }
+    };
+}
+
+/// The columns derived from the frames around a row
+/// ([`super::derived`]), chosen by name only.
+pub const DERIVED_COLUMNS: [Column; 3] = [
+    derived!("roll_deg", r => r.derived.roll_deg),
+    derived!("steer_bp_deg", r => r.derived.steer_bp_deg),
+    derived!("wobble_env_deg", r => r.derived.wobble_env_deg),
+];
+
 /// The columns named in `list` (comma-separated, in the order given), or
-/// every column for `None`.
+/// every column but the derived ones for `None`.
 ///
 /// # Errors
 /// An unknown or repeated name, with the known ones.
@@ -120,8 +139,13 @@ pub fn select(list: Option<&str>) -> Result<Vec<Column>, String> {
     };
     let mut chosen: Vec<Column> = Vec::new();
     for name in list.split(',').map(str::trim).filter(|n| !n.is_empty()) {
-        let column = COLUMNS.iter().find(|c| c.name == name).ok_or_else(|| {
-            let known: Vec<&str> = COLUMNS.iter().map(|c| c.name).collect();
+        let mut all = COLUMNS.iter().chain(&DERIVED_COLUMNS);
+        let column = all.find(|c| c.name == name).ok_or_else(|| {
+            let known: Vec<&str> = COLUMNS
+                .iter()
+                .chain(&DERIVED_COLUMNS)
+                .map(|c| c.name)
+                .collect();
             format!("no column {name:?}; the columns are {}", known.join(","))
         })?;
         if chosen.iter().any(|c| c.name == name) {

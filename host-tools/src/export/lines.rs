@@ -187,6 +187,7 @@ mod tests {
             status: wobble_core::format::FrameStatus(0),
             gps: None,
             utc_us: None,
+            derived: Default::default(),
         };
         (0..n)
             .map(|i| Row {

@@ -3,6 +3,7 @@
 
 pub mod columnar;
 pub mod columns;
+pub mod derived;
 mod lines;
 pub mod mcap;
 mod mcap_file;

@@ -268,6 +268,7 @@ mod tests {
                         },
                     ),
                     utc_us,
+                    derived: Default::default(),
                 },
             )
     }
