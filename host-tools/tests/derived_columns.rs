@@ -20,9 +20,16 @@ fn derived_columns_are_the_analyses_signals() {
     let out = decode_to(
         &log,
         &csv,
-        &["--columns", "t_s,steer_deg,roll_deg,steer_bp_deg,wobble_env_deg"],
+        &[
+            "--columns",
+            "t_s,steer_deg,roll_deg,steer_bp_deg,wobble_env_deg",
+        ],
     );
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let text = std::fs::read_to_string(&csv).unwrap();
     let mut lines = text.lines();
     assert_eq!(
@@ -60,7 +67,10 @@ fn derived_columns_are_the_analyses_signals() {
         .iter()
         .enumerate()
         .fold((0, 0.0f64), |m, (i, &e)| if e > m.1 { (i, e) } else { m });
-    assert!((max - wobble::PEAK_DEG).abs() < 0.35 * wobble::PEAK_DEG, "{max}");
+    assert!(
+        (max - wobble::PEAK_DEG).abs() < 0.35 * wobble::PEAK_DEG,
+        "{max}"
+    );
     let late = t[i_max] - wobble::peak_s();
     assert!(
         late > 0.0 && late < GROUP_DELAY_7HZ_S + ENVELOPE_WINDOW_S,

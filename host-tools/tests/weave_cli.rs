@@ -56,17 +56,11 @@ fn campaign() -> tempfile::TempDir {
 #[test]
 fn json_gives_the_weave_speed_below_the_kicks() {
     let dir = campaign();
-    let out = wobblog()
-        .args(["margin", "--mode", "weave", "--json"])
-        .arg(dir.path())
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let v: Value = serde_json::from_slice(&out.stdout).unwrap();
+    let v: Value = serde_json::from_str(&run_ok(
+        &["margin", "--mode", "weave", "--json"],
+        dir.path(),
+    ))
+    .unwrap();
     assert_eq!(v["mode"], "weave");
     let kicks = v["kicks"].as_array().unwrap();
     assert_eq!(kicks.len(), 10, "{v}");
@@ -95,13 +89,7 @@ fn json_gives_the_weave_speed_below_the_kicks() {
 #[test]
 fn the_table_says_it_in_words() {
     let dir = campaign();
-    let out = wobblog()
-        .args(["margin", "--mode", "weave"])
-        .arg(dir.path())
-        .output()
-        .unwrap();
-    assert!(out.status.success());
-    let text = String::from_utf8(out.stdout).unwrap();
+    let text = run_ok(&["margin", "--mode", "weave"], dir.path());
     assert!(
         text.starts_with("10 weave kicks in 10 logs: 10 used, 0 rejected\n"),
         "{text}"
@@ -145,13 +133,11 @@ fn no_weave_kicks_no_prediction() {
             &Extras::default(),
         );
     }
-    let out = wobblog()
-        .args(["margin", "--mode", "weave", "--json"])
-        .arg(dir.path())
-        .output()
-        .unwrap();
-    assert!(out.status.success());
-    let v: Value = serde_json::from_slice(&out.stdout).unwrap();
+    let v: Value = serde_json::from_str(&run_ok(
+        &["margin", "--mode", "weave", "--json"],
+        dir.path(),
+    ))
+    .unwrap();
     assert_eq!(v["kicks"].as_array().unwrap().len(), 0, "{v}");
     assert_eq!(v["weave_speed_mps"], Value::Null);
     assert!(
@@ -168,17 +154,8 @@ fn no_weave_kicks_no_prediction() {
 #[test]
 fn wobble_lists_the_weave_ring_downs() {
     let dir = campaign();
-    let out = wobblog()
-        .args(["wobble", "--json"])
-        .arg(dir.path().join("RUN00003.WBL"))
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let v: Value = serde_json::from_slice(&out.stdout).unwrap();
+    let log = dir.path().join("RUN00003.WBL");
+    let v: Value = serde_json::from_str(&run_ok(&["wobble", "--json"], &log)).unwrap();
     let episodes = v["episodes"].as_array().unwrap();
     let weave: Vec<&Value> = episodes.iter().filter(|e| e["mode"] == "weave").collect();
     let wobble: Vec<&Value> = episodes.iter().filter(|e| e["mode"] == "wobble").collect();
@@ -197,7 +174,7 @@ fn wobble_lists_the_weave_ring_downs() {
     );
     let speed = v["wobble_speed_mps"].as_f64().unwrap();
     assert!((speed - 5.2).abs() < 1e-9, "{v}");
-    let text = stdout_text(&["wobble"], &dir.path().join("RUN00003.WBL"));
+    let text = run_ok(&["wobble"], &log);
     assert!(text.contains("\n  mode    onset_s"), "{text}");
     assert!(
         text.lines().any(|l| l.trim_start().starts_with("weave ")),
@@ -212,32 +189,8 @@ fn the_data_sets_episodes_hold_the_weave() {
     let dir = campaign();
     let out_dir = tempfile::tempdir().unwrap();
     let dataset = out_dir.path().join("set");
-    let out = wobblog()
-        .arg("export")
-        .arg(dir.path())
-        .arg("-o")
-        .arg(&dataset)
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let file = std::fs::File::open(dataset.join("episodes/part-0.parquet")).unwrap();
-    let reader = parquet::file::reader::SerializedFileReader::new(file).unwrap();
-    use parquet::file::reader::FileReader;
-    let modes: Vec<String> = reader
-        .get_row_iter(None)
-        .unwrap()
-        .map(|r| {
-            let row = r.unwrap();
-            row.get_column_iter()
-                .find(|(n, _)| n.as_str() == "mode")
-                .map(|(_, f)| f.to_string().trim_matches('"').to_owned())
-                .unwrap()
-        })
-        .collect();
+    run_ok(&["export", "-o", dataset.to_str().unwrap()], dir.path());
+    let modes = texts(&dataset.join("episodes/part-0.parquet"), "mode");
     assert_eq!(
         modes.iter().filter(|m| *m == "weave").count(),
         10,
@@ -248,21 +201,10 @@ fn the_data_sets_episodes_hold_the_weave() {
         "{modes:?}"
     );
     // The kicks table: each weave kick, used by the weave's prediction.
-    let file = std::fs::File::open(dataset.join("kicks/part-0.parquet")).unwrap();
-    let reader = parquet::file::reader::SerializedFileReader::new(file).unwrap();
-    let kicks: Vec<(String, String)> = reader
-        .get_row_iter(None)
-        .unwrap()
-        .map(|r| {
-            let row = r.unwrap();
-            let text = |name: &str| {
-                row.get_column_iter()
-                    .find(|(n, _)| n.as_str() == name)
-                    .map(|(_, f)| f.to_string().trim_matches('"').to_owned())
-                    .unwrap()
-            };
-            (text("mode"), text("used"))
-        })
+    let table = dataset.join("kicks/part-0.parquet");
+    let kicks: Vec<(String, String)> = texts(&table, "mode")
+        .into_iter()
+        .zip(texts(&table, "used"))
         .collect();
     let weave: Vec<&(String, String)> = kicks.iter().filter(|k| k.0 == "weave").collect();
     assert_eq!(weave.len(), 10, "{kicks:?}");
@@ -277,20 +219,17 @@ fn compare_sets_the_weave_against_the_models_weave() {
     let dir = campaign();
     let params = Path::new(env!("CARGO_MANIFEST_DIR")).join("bicycle-model/params/benchmark.toml");
     let fig = tempfile::tempdir().unwrap();
-    let out = wobblog()
-        .args(["model", "compare"])
-        .arg(&params)
-        .arg(dir.path())
-        .arg("-o")
-        .arg(fig.path().join("fig8.svg"))
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
+    let svg = fig.path().join("fig8.svg");
+    let text = run_ok(
+        &[
+            "model",
+            "compare",
+            params.to_str().unwrap(),
+            "-o",
+            svg.to_str().unwrap(),
+        ],
+        dir.path(),
     );
-    let text = String::from_utf8(out.stdout).unwrap();
     let weave: Vec<Vec<&str>> = text
         .lines()
         .map(|l| l.split_whitespace().collect::<Vec<_>>())
@@ -310,12 +249,36 @@ fn compare_sets_the_weave_against_the_models_weave() {
         text.contains("the model has no wobble mode: 10 episodes not compared"),
         "{text}"
     );
-    let svg = std::fs::read_to_string(fig.path().join("fig8.svg")).unwrap();
+    let svg = std::fs::read_to_string(svg).unwrap();
     assert!(svg.contains("wobble and weave modes"), "title");
 }
 
-fn stdout_text(args: &[&str], log: &Path) -> String {
-    let out = wobblog().args(args).arg(log).output().unwrap();
-    assert!(out.status.success());
+/// The standard output of `wobblog ARGS... PATH`, which must succeed.
+fn run_ok(args: &[&str], path: &Path) -> String {
+    let out = wobblog().args(args).arg(path).output().unwrap();
+    assert!(
+        out.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     String::from_utf8(out.stdout).unwrap()
+}
+
+/// Column `name` of the Parquet file at `path`, each cell as text.
+fn texts(path: &Path, name: &str) -> Vec<String> {
+    use parquet::file::reader::FileReader;
+    let reader =
+        parquet::file::reader::SerializedFileReader::new(std::fs::File::open(path).unwrap())
+            .unwrap();
+    reader
+        .get_row_iter(None)
+        .unwrap()
+        .map(|r| {
+            let row = r.unwrap();
+            row.get_column_iter()
+                .find(|(n, _)| n.as_str() == name)
+                .map(|(_, f)| f.to_string().trim_matches('"').to_owned())
+                .unwrap()
+        })
+        .collect()
 }
