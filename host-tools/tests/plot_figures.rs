@@ -9,7 +9,10 @@ use analysis_support::{stdout_of, wobblog};
 use base64::Engine;
 use quick_xml::events::Event;
 use wobblog::plot::modes::ZERO_LINE_COLOUR;
-use wobblog::plot::timeplot::{ALERT_COLOUR, LINE_COLOUR, LOST_COLOUR, MARKER_COLOUR, PANELS};
+use wobblog::plot::timeplot::{
+    ALERT_COLOUR, EPISODE_COLOUR, KICK_COLOUR, LINE_COLOUR, LOST_COLOUR, MARKER_COLOUR,
+    MIN_SPAN_PX, PANELS,
+};
 use wobblog::plot::FONT;
 
 fn hex(c: plotters::style::RGBColor) -> String {
@@ -127,6 +130,9 @@ fn figure_6_has_four_panels_alerts_and_markers() {
     assert_eq!(count(&svg, "polyline", &hex(MARKER_COLOUR)), 8 + 1);
     assert!(labels.contains(&"wobble alert (on board)"), "{labels:?}");
     assert!(labels.contains(&"rider marker"), "{labels:?}");
+    // The host's wobble episode (the ride's one wobble), shaded and keyed.
+    assert_eq!(count(&svg, "rect", &hex(EPISODE_COLOUR)), 4 + 1);
+    assert!(labels.contains(&"wobble episode (host)"), "{labels:?}");
     assert!(
         !labels.contains(&"data lost (missing blocks)"),
         "{labels:?}"
@@ -463,4 +469,43 @@ fn a_log_of_one_frame_is_plotted() {
     // would draw nothing).
     let svg = std::fs::read_to_string(dir.path().join("one.svg")).unwrap();
     assert_eq!(svg.matches("<circle").count(), PANELS.len(), "{svg:.300}");
+}
+
+/// The widths of the `<rect>` elements of `svg` in `colour`, px.
+fn rect_widths(svg: &str, colour: &str) -> Vec<f64> {
+    svg.split('<')
+        .filter(|e| e.starts_with("rect") && e.to_uppercase().contains(colour))
+        .filter_map(|e| {
+            let at = e.find("width=\"")? + 7;
+            e[at..e[at..].find('"')? + at].parse().ok()
+        })
+        .collect()
+}
+
+/// A 10 ms alert on a 30 s figure is drawn at least [`MIN_SPAN_PX`] wide,
+/// not as a hairline; the board's kick records are ticked and keyed.
+#[test]
+fn short_spans_stay_visible_and_kick_records_are_ticked() {
+    let dir = tempfile::tempdir().unwrap();
+    let log = dir.path().join("RUN00004.WBL");
+    let ride = analysis_support::Ride::new(30.0, 5.0, 0.0, 0.0, 0.0);
+    let extras = analysis_support::Extras {
+        alerts_s: vec![(10.0, 10.01)],
+        records: vec![
+            analysis_support::kick_record(5.0, Some(4000)),
+            analysis_support::kick_record(20.0, None),
+        ],
+        ..Default::default()
+    };
+    analysis_support::write_log(&log, &ride, &extras);
+    let svg = plot_svg(&log, &dir.path().join("short.svg"), &[]);
+    let widths = rect_widths(&svg, &hex(ALERT_COLOUR));
+    // Four panels' spans, then the key's swatch (16 px).
+    assert_eq!(widths.len(), 5, "{widths:?}");
+    assert!(
+        widths[..4].iter().all(|w| *w >= MIN_SPAN_PX - 0.5),
+        "{widths:?}"
+    );
+    assert_eq!(count(&svg, "polyline", &hex(KICK_COLOUR)), 2 * 4 + 1);
+    assert!(texts(&svg).contains(&"kick record (board)"));
 }

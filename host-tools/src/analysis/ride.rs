@@ -52,7 +52,7 @@ pub struct Ride {
 impl Ride {
     /// Reads and analyses the log at `path`, streaming its frames.
     pub fn load(path: &Path) -> Result<Self, CliError> {
-        let make = |told: &SummaryBuilder| Analyser::new(told.frame_rate_hz(), told.config());
+        let make = |told: &SummaryBuilder| RideAnalysis::new(told.frame_rate_hz(), told.config());
         let (summary, analyser) = stream_rows(path, make, |a, row| {
             a.push(row.t_s, row.steer_deg, row.speed_mps, row.gyro_dps[0]);
         })?;
@@ -62,7 +62,7 @@ impl Ride {
     /// Analyses a run held in memory: the same analysis as [`Self::load`].
     #[must_use]
     pub fn of(run: &Run) -> Self {
-        let mut a = Analyser::new(run.sample_rate_hz(), &run.summary.config);
+        let mut a = RideAnalysis::new(run.sample_rate_hz(), &run.summary.config);
         for i in 0..run.len() {
             a.push(
                 run.t_s[i],
@@ -91,8 +91,10 @@ impl Ride {
     }
 }
 
-/// The analysis of a stream of frames.
-struct Analyser {
+/// The analysis of a stream of frames: what [`Ride::load`] runs, for a
+/// command that reads the frames itself (the plot draws them in the same
+/// pass).
+pub struct RideAnalysis {
     period_s: f64,
     search: EpisodeSearch,
     /// The kicks, as `wobblog margin` finds them (`None` when the log's
@@ -111,10 +113,11 @@ struct Analyser {
     last: Option<(f64, f64)>,
 }
 
-impl Analyser {
+impl RideAnalysis {
     /// An analysis of frames `fs_hz` apart, from a log whose header has
     /// `config` lines.
-    fn new(fs_hz: f64, config: &[String]) -> Self {
+    #[must_use]
+    pub fn new(fs_hz: f64, config: &[String]) -> Self {
         Self {
             period_s: 1.0 / fs_hz,
             search: EpisodeSearch::new(fs_hz),
@@ -132,7 +135,9 @@ impl Analyser {
         }
     }
 
-    fn push(&mut self, t_s: f64, steer_deg: f64, speed_mps: f64, roll_rate_dps: f64) {
+    /// Takes the next frame in file order: time, steering angle, speed,
+    /// roll rate.
+    pub fn push(&mut self, t_s: f64, steer_deg: f64, speed_mps: f64, roll_rate_dps: f64) {
         self.weave.push(t_s, roll_rate_dps, speed_mps);
         if let Some((t0, v0)) = self.last.filter(|&(t0, _)| follows(t0, t_s, self.period_s)) {
             self.distance_m += 0.5 * (speed_mps + v0) * (t_s - t0);
@@ -159,7 +164,9 @@ impl Analyser {
         }
     }
 
-    fn finish(mut self, path: &Path, summary: Summary) -> Ride {
+    /// The ride of the log at `path`, which `summary` describes.
+    #[must_use]
+    pub fn finish(mut self, path: &Path, summary: Summary) -> Ride {
         let kicks = self.kicks.map(|search| {
             let kicks = search.finish();
             self.search.add_kicks(&kicks[self.kicks_given..]);

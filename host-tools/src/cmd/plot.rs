@@ -2,6 +2,7 @@
 
 use std::path::PathBuf;
 
+use crate::analysis::ride::RideAnalysis;
 use crate::analysis::run::{log_name, read_rows};
 use crate::cmd::info::summarise;
 use crate::cmd::logs::{one_log, warn_losses};
@@ -87,8 +88,18 @@ pub fn run(args: &Args) -> Result<(), CliError> {
     };
     let mut builder =
         TimePlotBuilder::new(&name, &summary, data_s, fs_hz, window_s).ok_or_else(no_frames)?;
-    read_rows(&args.log, |_| {}, |row| builder.push_row(row))?;
+    // The episodes drawn come from the same reading of the frames.
+    let mut analysis = RideAnalysis::new(fs_hz, &summary.config);
+    read_rows(
+        &args.log,
+        |_| {},
+        |row| {
+            builder.push_row(row);
+            analysis.push(row.t_s, row.steer_deg, row.speed_mps, row.gyro_dps[0]);
+        },
+    )?;
     let mut figure = builder.finish();
+    figure.set_episodes(&analysis.finish(&args.log, summary.clone()).all_episodes());
     if figure.is_empty() {
         return Err(no_frames());
     }

@@ -9,7 +9,7 @@ use plotters::prelude::*;
 use super::{padded_range, tick_label, titled_page, Decimator, Figure, FONT};
 use crate::analysis::filter::follows;
 use crate::analysis::roll::RollStream;
-use crate::analysis::Run;
+use crate::analysis::{Episode, KickMode, Run};
 use crate::rows::Row;
 use crate::summary::Summary;
 use crate::time::{iso8601_unix_ms, utc_ms_at, SyncPair};
@@ -31,6 +31,15 @@ pub const MARKER_COLOUR: RGBColor = RGBColor(0x20, 0x90, 0x30);
 pub const LOST_COLOUR: RGBColor = RGBColor(0x70, 0x70, 0x70);
 /// Colour of forward jumps of the logger's clock (drawn with transparency).
 pub const JUMP_COLOUR: RGBColor = RGBColor(0xe0, 0x90, 0x10);
+/// Colour of the wobble episodes the host measured (with transparency).
+pub const EPISODE_COLOUR: RGBColor = RGBColor(0x80, 0x30, 0xa0);
+/// Colour of the weave's kick ring-downs the host measured.
+pub const WEAVE_COLOUR: RGBColor = RGBColor(0x10, 0x90, 0xa0);
+/// Colour of the board's kick records.
+pub const KICK_COLOUR: RGBColor = RGBColor(0x90, 0x50, 0x10);
+/// A shaded span is drawn at least this wide, px: a 3 s alert on an
+/// hour's figure would otherwise be a hairline or nothing.
+pub const MIN_SPAN_PX: f64 = 4.0;
 /// Width of the y tick labels and axis title, px: room for `-1000.0`
 /// beside a two-line-free title in 14 px text.
 const Y_LABEL_AREA_PX: u32 = 84;
@@ -43,6 +52,12 @@ pub struct TimePlot {
     series: [Vec<Vec<(f64, f64)>>; 4],
     alerts_s: Vec<(f64, f64)>,
     markers_s: Vec<f64>,
+    /// The board's kick records, s.
+    kicks_s: Vec<f64>,
+    /// The wobble episodes the host measured (onset to end), s.
+    episodes_s: Vec<(f64, f64)>,
+    /// The weave's kick ring-downs the host measured, s.
+    weave_s: Vec<(f64, f64)>,
     /// Stretches lost from the file (missing blocks), s.
     lost_s: Vec<(f64, f64)>,
     /// Forward jumps of the frame times, s: no data, and no time passed
@@ -134,6 +149,17 @@ impl TimePlotBuilder {
             .copied()
             .filter(|t| window_s.contains(t))
             .collect();
+        // One tick per pixel column at most: a log of 100 000 kick records
+        // would otherwise draw each of them.
+        let column_s = (window_s.end - window_s.start) / f64::from(WIDTH_PX);
+        let mut kicks_s: Vec<f64> = summary
+            .kick_records
+            .iter()
+            .map(|k| k.t_us as f64 / 1e6)
+            .filter(|t| window_s.contains(t))
+            .collect();
+        kicks_s.sort_by(f64::total_cmp);
+        kicks_s.dedup_by(|b, a| *b - *a < column_s);
         let lost_s = summary
             .losses
             .lost_blocks
@@ -160,6 +186,9 @@ impl TimePlotBuilder {
                     series: Default::default(),
                     alerts_s,
                     markers_s,
+                    kicks_s,
+                    episodes_s: Vec::new(),
+                    weave_s: Vec::new(),
                     lost_s,
                     jumps_s,
                     utc: None,
@@ -270,6 +299,42 @@ impl TimePlot {
         clock_ticks(from, to, MAX_TIME_TICKS).1
     }
 
+    /// Draws `episodes` (the host's, as `wobblog wobble` lists them): the
+    /// wobble's and the weave's ring-downs each as a span of its own.
+    pub fn set_episodes(&mut self, episodes: &[Episode]) {
+        let window = &self.window_s;
+        let spans = |mode: KickMode| {
+            episodes
+                .iter()
+                .filter(|e| e.mode == mode && e.onset_s < window.end && e.end_s > window.start)
+                .map(|e| (e.onset_s.max(window.start), e.end_s.min(window.end)))
+                .collect()
+        };
+        self.episodes_s = spans(KickMode::Wobble);
+        self.weave_s = spans(KickMode::Weave);
+    }
+
+    /// The spans drawn for the host's wobble episodes, s.
+    #[must_use]
+    pub fn episodes_s(&self) -> &[(f64, f64)] {
+        &self.episodes_s
+    }
+
+    /// `span` widened about its middle to [`MIN_SPAN_PX`] when narrower,
+    /// within the window.
+    #[must_use]
+    pub fn visible(&self, (a, b): (f64, f64)) -> (f64, f64) {
+        let w = &self.window_s;
+        let plot_px = f64::from(WIDTH_PX - Y_LABEL_AREA_PX - 30);
+        let min_s = (w.end - w.start) * MIN_SPAN_PX / plot_px;
+        if b - a >= min_s {
+            return (a, b);
+        }
+        let mid = 0.5 * (a + b);
+        let a = (mid - 0.5 * min_s).max(w.start);
+        (a, (a + min_s).min(w.end))
+    }
+
     /// Stretches lost from the file drawn, s.
     #[must_use]
     pub fn lost_s(&self) -> &[(f64, f64)] {
@@ -356,7 +421,8 @@ impl Figure for TimePlot {
                 .light_line_style(WHITE.mix(0.0))
                 .draw()
                 .map_err(err)?;
-            let span = |&(a, b): &(f64, f64), colour: RGBAColor| {
+            let span = |&s: &(f64, f64), colour: RGBAColor| {
+                let (a, b) = self.visible(s);
                 Rectangle::new([(self.x(a), y.start), (self.x(b), y.end)], colour.filled())
             };
             // The shaded spans, each kind in the key of the top panel if present.
@@ -375,6 +441,16 @@ impl Figure for TimePlot {
                     &self.jumps_s,
                     JUMP_COLOUR.mix(0.3),
                     "time jump (logger clock)",
+                ),
+                (
+                    &self.episodes_s,
+                    EPISODE_COLOUR.mix(0.22),
+                    "wobble episode (host)",
+                ),
+                (
+                    &self.weave_s,
+                    WEAVE_COLOUR.mix(0.22),
+                    "weave ring-down (host)",
                 ),
             ];
             for (spans, colour, label) in shaded {
@@ -403,6 +479,24 @@ impl Figure for TimePlot {
                     )
                 });
             }
+            // The board's kick records: a tick along the top of each panel.
+            let tick = (y.end - y.start) * 0.15;
+            let kicks = chart
+                .draw_series(self.kicks_s.iter().map(|&t| {
+                    PathElement::new(
+                        vec![(self.x(t), y.end - tick), (self.x(t), y.end)],
+                        KICK_COLOUR.stroke_width(3),
+                    )
+                }))
+                .map_err(err)?;
+            if k == 0 && !self.kicks_s.is_empty() {
+                kicks.label("kick record (board)").legend(|(x, y)| {
+                    PathElement::new(
+                        vec![(x + 8, y - 7), (x + 8, y + 7)],
+                        KICK_COLOUR.stroke_width(3),
+                    )
+                });
+            }
             for points in series {
                 let line =
                     LineSeries::new(points.iter().map(|&(t, v)| (self.x(t), v)), LINE_COLOUR);
@@ -417,7 +511,10 @@ impl Figure for TimePlot {
             let keyed = !(self.alerts_s.is_empty()
                 && self.lost_s.is_empty()
                 && self.jumps_s.is_empty()
-                && self.markers_s.is_empty());
+                && self.markers_s.is_empty()
+                && self.kicks_s.is_empty()
+                && self.episodes_s.is_empty()
+                && self.weave_s.is_empty());
             if k == 0 && keyed {
                 chart
                     .configure_series_labels()
