@@ -453,7 +453,24 @@ fn eig_no_slip_has_the_eight_states_of_the_constrained_bicycle() {
         2,
         "{text}"
     );
-    // Said once: the camber relaxation lengths default.
+    // The shipped file states its camber relaxation lengths: no note.
+    let stderr = String::from_utf8(out.stderr).unwrap();
+    assert!(!stderr.contains("not given"), "{stderr}");
+    // A file that leaves them out is told so, once each.
+    let dir = tempfile::tempdir().unwrap();
+    let shipped = std::fs::read_to_string(params("test-bicycle.toml")).unwrap();
+    let without: String = shipped
+        .lines()
+        .filter(|l| !l.starts_with("camber_relaxation_length"))
+        .map(|l| format!("{l}\n"))
+        .collect();
+    let file = dir.path().join("without.toml");
+    std::fs::write(&file, without).unwrap();
+    let out = wobblog()
+        .args(["model", "eig", "--speeds", "4:4:1"])
+        .arg(&file)
+        .output()
+        .unwrap();
     let stderr = String::from_utf8(out.stderr).unwrap();
     assert_eq!(
         stderr.matches("camber_relaxation_length not given").count(),
