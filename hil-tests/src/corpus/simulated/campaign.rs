@@ -488,27 +488,14 @@ impl Campaign {
     /// # Errors
     /// A file cannot be written.
     pub fn write(&self, dir: &Path) -> Result<Vec<PathBuf>, String> {
-        std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
-        let mut logs = Vec::new();
-        for pass in &self.passes {
-            let log = dir.join(format!("{}.wbl", pass.fixture.truth.name));
-            let mut out = Vec::new();
-            let options = wobblog::cmd::encode::Options {
-                resample: false,
-                detect: true,
-                ..Default::default()
-            };
-            wobblog::cmd::encode::encode_with(
-                pass.fixture.csv.as_bytes(),
-                Path::new(&pass.fixture.truth.file),
-                &mut out,
-                &log,
-                options,
-            )
-            .map_err(|e| e.to_string())?;
-            std::fs::write(&log, out).map_err(|e| format!("{}: {e}", log.display()))?;
-            logs.push(log);
-        }
+        let logs = self
+            .passes
+            .iter()
+            .map(|pass| {
+                let fx = &pass.fixture;
+                super::write_log(dir, &fx.truth.name, &fx.csv, &fx.truth.file, true)
+            })
+            .collect::<Result<Vec<PathBuf>, String>>()?;
         let truth = TruthFile {
             generator: "hil-tests/src/corpus/simulated/campaign.rs",
             variant: &self.variant,

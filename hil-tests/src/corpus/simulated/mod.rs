@@ -493,3 +493,36 @@ pub fn manifest_json(fixtures: &[Fixture]) -> String {
     s.push('\n');
     s
 }
+
+/// Writes `csv` (the CSV `wobblog encode` takes, named `csv_name` in
+/// messages) as the card log `dir/NAME.wbl`, through the encoder the CLI
+/// uses; with `detect`, with the on-board detector's records as the board
+/// writes them. Returns the log's path.
+///
+/// # Errors
+/// The CSV is refused or the file cannot be written.
+pub fn write_log(
+    dir: &std::path::Path,
+    name: &str,
+    csv: &str,
+    csv_name: &str,
+    detect: bool,
+) -> Result<std::path::PathBuf, String> {
+    std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    let log = dir.join(format!("{name}.wbl"));
+    let mut out = Vec::new();
+    let options = wobblog::cmd::encode::Options {
+        detect,
+        ..Default::default()
+    };
+    wobblog::cmd::encode::encode_with(
+        csv.as_bytes(),
+        std::path::Path::new(csv_name),
+        &mut out,
+        &log,
+        options,
+    )
+    .map_err(|e| e.to_string())?;
+    std::fs::write(&log, out).map_err(|e| format!("{}: {e}", log.display()))?;
+    Ok(log)
+}

@@ -276,27 +276,9 @@ impl Campaign {
     /// # Errors
     /// A file cannot be written.
     pub fn write(&self, dir: &Path) -> Result<Vec<PathBuf>, String> {
-        std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
-        let mut logs = Vec::new();
-        for pass in &self.passes {
-            let log = dir.join(format!("{}.wbl", pass.name));
-            let mut out = Vec::new();
-            let options = wobblog::cmd::encode::Options {
-                resample: false,
-                detect: false,
-                ..Default::default()
-            };
-            wobblog::cmd::encode::encode_with(
-                pass.csv.as_bytes(),
-                Path::new(&format!("{}.csv", pass.name)),
-                &mut out,
-                &log,
-                options,
-            )
-            .map_err(|e| e.to_string())?;
-            std::fs::write(&log, out).map_err(|e| format!("{}: {e}", log.display()))?;
-            logs.push(log);
-        }
-        Ok(logs)
+        self.passes
+            .iter()
+            .map(|p| super::write_log(dir, &p.name, &p.csv, &format!("{}.csv", p.name), false))
+            .collect()
     }
 }
