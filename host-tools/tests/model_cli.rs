@@ -487,3 +487,32 @@ fn eig_no_slip_has_the_eight_states_of_the_constrained_bicycle() {
         "--whipple and --contacts conflict"
     );
 }
+
+/// `model plot` marks each critical speed on the real part's zero line,
+/// named with its speed: on the benchmark, the published weave and capsize
+/// speeds (4.292 and 6.024 m/s, Meijaard et al. 2007).
+#[test]
+fn plot_marks_the_critical_speeds() {
+    let dir = tempfile::tempdir().unwrap();
+    let svg = dir.path().join("fig4.svg");
+    let out = model("plot", "benchmark.toml")
+        .arg("-o")
+        .arg(&svg)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = std::fs::read_to_string(&svg).unwrap();
+    for mark in ["weave 4.29 m/s", "capsize 6.02 m/s"] {
+        assert!(text.contains(mark), "{mark}");
+    }
+    let marks = text
+        .split("<text")
+        .filter_map(|e| Some(e[e.find('>')? + 1..e.find("</text>")?].trim().to_owned()))
+        .filter(|t| t.ends_with(" m/s"))
+        .count();
+    assert_eq!(marks, 2, "two critical speeds");
+}

@@ -10,7 +10,7 @@ use wobble_model::sweep::mode_at;
 use wobble_model::Mode;
 
 use super::episodes::{self, LoggedEpisode};
-use super::figure::{EigenFigure, Layer, Line};
+use super::figure::{critical_marks, EigenFigure, Layer, Line};
 use super::{load, sweep, Speeds};
 use crate::cmd::logs::{expand, print};
 use crate::output::Output;
@@ -100,22 +100,25 @@ pub fn figure(
     found: &[LoggedEpisode],
 ) -> Result<EigenFigure, CliError> {
     let weave = found.iter().any(|e| e.mode() == Mode::Weave);
+    let own = sweep(model, speeds, params)?;
+    let modes = if weave {
+        vec![Mode::Wobble, Mode::Weave]
+    } else {
+        vec![Mode::Wobble]
+    };
     Ok(EigenFigure {
         title: if weave {
             format!("{name}: wobble and weave modes and measured episodes")
         } else {
             format!("{name}: wobble mode and measured episodes")
         },
+        critical: critical_marks(model, &own, &modes),
         layers: vec![Layer {
             label: "model".into(),
-            sweep: sweep(model, speeds, params)?,
+            sweep: own,
             line: Line::Thick,
         }],
-        modes: if weave {
-            vec![Mode::Wobble, Mode::Weave]
-        } else {
-            vec![Mode::Wobble]
-        },
+        modes,
         measured: found.iter().map(LoggedEpisode::measured).collect(),
     })
 }

@@ -7,6 +7,7 @@
 use plotters::coord::Shift;
 use plotters::element::DashedPathElement;
 use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
 use wobble_model::sweep::REAL_TOL;
 use wobble_model::{Mode, Sweep};
 
@@ -59,6 +60,24 @@ pub struct EigenFigure {
     pub modes: Vec<Mode>,
     /// Measured points.
     pub measured: Vec<Measured>,
+    /// Critical speeds marked on the real part's zero line: the mode and
+    /// the speed, m/s.
+    pub critical: Vec<(Mode, f64)>,
+}
+
+/// The critical speeds of `model` found on `sweep` whose mode is among
+/// `modes`, to mark on the figure.
+#[must_use]
+pub fn critical_marks(
+    model: &wobble_model::Model,
+    sweep: &Sweep,
+    modes: &[Mode],
+) -> Vec<(Mode, f64)> {
+    wobble_model::critical_speeds(model, sweep)
+        .into_iter()
+        .filter(|c| modes.contains(&c.mode))
+        .map(|c| (c.mode, c.speed_mps))
+        .collect()
 }
 
 fn colour(mode: Mode) -> RGBColor {
@@ -244,6 +263,30 @@ impl EigenFigure {
             };
             Circle::new(at, 4, style)
         };
+        if !frequency {
+            // Each critical speed: a mark on the zero line in its mode's
+            // colour, named with its speed above it.
+            for &(mode, v) in &self.critical {
+                let c = colour(mode);
+                chart
+                    .draw_series(std::iter::once(TriangleMarker::new(
+                        (v, 0.0),
+                        7,
+                        c.filled(),
+                    )))
+                    .map_err(err)?;
+                chart
+                    .draw_series(std::iter::once(Text::new(
+                        format!("{mode} {v:.2} m/s"),
+                        (v, 0.0),
+                        (FONT, 13)
+                            .into_font()
+                            .color(&c)
+                            .pos(Pos::new(HPos::Left, VPos::Bottom)),
+                    )))
+                    .map_err(err)?;
+            }
+        }
         if !self.measured.is_empty() {
             let s = chart
                 .draw_series(self.measured.iter().map(dot))

@@ -6,7 +6,7 @@ use std::path::PathBuf;
 
 use wobble_model::{Mode, Model};
 
-use super::figure::{EigenFigure, Layer, Line};
+use super::figure::{critical_marks, EigenFigure, Layer, Line};
 use super::{load, param_error, sweep, Speeds};
 use crate::output::Output;
 use crate::plot::{render, ImageKind};
@@ -58,20 +58,23 @@ pub fn run(args: &Args) -> Result<(), CliError> {
             line: Line::Thick,
         });
     }
-    layers.push(Layer {
-        label: label(&model),
-        sweep: sweep(&model, &args.speeds.0, &args.params)?,
-        line: if both { Line::Thin } else { Line::Thick },
-    });
+    let own = sweep(&model, &args.speeds.0, &args.params)?;
     let mut modes = NAMED_MODES.to_vec();
     if args.all_modes {
         modes.extend([Mode::Twist, Mode::Other]);
     }
+    let critical = critical_marks(&model, &own, &modes);
+    layers.push(Layer {
+        label: label(&model),
+        sweep: own,
+        line: if both { Line::Thin } else { Line::Thick },
+    });
     let figure = EigenFigure {
         title: set.name.clone(),
         layers,
         modes,
         measured: Vec::new(),
+        critical,
     };
     render(&figure, out)
 }

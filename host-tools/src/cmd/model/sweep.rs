@@ -100,6 +100,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
                 vec![Mode::Wobble, Mode::Weave]
             },
             measured: Vec::new(),
+            critical: Vec::new(),
         };
         render(&figure, out)?;
     }
