@@ -231,7 +231,7 @@ impl Log {
         start: Option<Bound<'_, PyAny>>,
         end: Option<Bound<'_, PyAny>>,
     ) -> PyResult<Table> {
-        let chosen = columns::select(columns.map(|c| c.join(",")).as_deref())
+        let chosen = columns::select_from(columns.map(|c| c.join(",")).as_deref(), &[])
             .map_err(|e| WobblogError::new_err(format!("{}: {e}", self.shown())))?;
         let window = window(start.as_ref(), end.as_ref())?;
         // Decoded on opening, where its losses were reported.

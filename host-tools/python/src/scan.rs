@@ -43,7 +43,7 @@ pub fn scan(
     end: Option<Bound<'_, PyAny>>,
 ) -> PyResult<Scan> {
     let shown = dir.display().to_string();
-    let chosen = columns::select(columns.map(|c| c.join(",")).as_deref())
+    let chosen = columns::select_from(columns.map(|c| c.join(",")).as_deref(), &[])
         .map_err(|e| WobblogError::new_err(format!("{shown}: {e}")))?;
     let window = window(start.as_ref(), end.as_ref())?;
     let entries = detached(py, &shown, || campaign_logs(&dir))?;

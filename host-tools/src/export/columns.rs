@@ -134,18 +134,23 @@ pub const DERIVED_COLUMNS: [Column; 3] = [
 /// # Errors
 /// An unknown or repeated name, with the known ones.
 pub fn select(list: Option<&str>) -> Result<Vec<Column>, String> {
+    select_from(list, &DERIVED_COLUMNS)
+}
+
+/// [`select`] among the stored columns and `derived` (none where the
+/// derived signals are not computed: the Python package's frames).
+///
+/// # Errors
+/// An unknown or repeated name, with the known ones.
+pub fn select_from(list: Option<&str>, derived: &[Column]) -> Result<Vec<Column>, String> {
     let Some(list) = list else {
         return Ok(COLUMNS.to_vec());
     };
     let mut chosen: Vec<Column> = Vec::new();
     for name in list.split(',').map(str::trim).filter(|n| !n.is_empty()) {
-        let mut all = COLUMNS.iter().chain(&DERIVED_COLUMNS);
+        let mut all = COLUMNS.iter().chain(derived);
         let column = all.find(|c| c.name == name).ok_or_else(|| {
-            let known: Vec<&str> = COLUMNS
-                .iter()
-                .chain(&DERIVED_COLUMNS)
-                .map(|c| c.name)
-                .collect();
+            let known: Vec<&str> = COLUMNS.iter().chain(derived).map(|c| c.name).collect();
             format!("no column {name:?}; the columns are {}", known.join(","))
         })?;
         if chosen.iter().any(|c| c.name == name) {
