@@ -219,6 +219,9 @@ fn cut_run(bundle: &qemu::Bundle, base: &Path, name: &str, scenario: Scenario) -
         sampled - on_card <= bound,
         "{name}: {on_card} of {sampled} frames kept"
     );
+    // Every check passed: the run's 40 MiB card image is not kept (a
+    // campaign of cuts would fill a disk); a failed run keeps its directory.
+    let _ = std::fs::remove_dir_all(&dir);
     Cut {
         sampled,
         frames,
