@@ -116,7 +116,11 @@ fn benches(c: &mut Criterion) {
         });
     }
     group.bench_function("events_one_hour", |b| {
-        b.iter(|| events::list(&log, false, std::io::sink()).unwrap().unwrap())
+        b.iter(|| {
+            events::list(&log, false, Vec::new(), std::io::sink())
+                .unwrap()
+                .unwrap()
+        })
     });
     for (name, path) in [("config_one_hour", &log), ("config_64_mib", &big)] {
         group.bench_function(name, |b| {

@@ -1,14 +1,17 @@
 //! A campaign as Parquet datasets, one folder per table, so Polars,
 //! pyarrow and DuckDB open each with their default options:
-//! `frames/run=N/part-0.parquet` (Hive-partitioned, under `card=NAME/` as
-//! well for a folder of cards, `NAME` percent-encoded as Hive readers
-//! decode it; the run number unpadded so readers type it
-//! as an integer), `runs/part-0.parquet` (one row per run, as `wobblog
+//! `frames/RUNnnnnnn.parquet` (one file per run, named as its log, whose
+//! first column `run` says the run in every row, so that a reader without
+//! partitions, `pyarrow.dataset` with its defaults, or the file alone keeps
+//! it; under `card=NAME/` for a folder of cards, a Hive partition with
+//! `NAME` percent-encoded as Hive readers decode it), `runs/part-0.parquet` (one row per run, as `wobblog
 //! summary`), `episodes/part-0.parquet` (one row per episode, the wobble's
 //! and the weave's, as `wobblog wobble`) and `kicks/part-0.parquet` (one
 //! row per kick, as `wobblog margin` and `margin --mode weave` take them,
-//! with `used`: whether the campaign's prediction gave it weight). Every
-//! file carries its columns' units as key-value metadata (`unit.NAME`).
+//! with `used`: whether the campaign's prediction gave it weight) and
+//! `events/part-0.parquet` (one row per event, as `wobblog events`: alerts,
+//! markers, kick records, faults, dropouts, losses). Every file carries its
+//! columns' units as key-value metadata (`unit.NAME`).
 
 use std::path::{Path, PathBuf};
 
@@ -21,6 +24,7 @@ use crate::analysis::margin::{predict, KickPoint, Trend};
 use crate::analysis::run::read_rows;
 use crate::analysis::{Cut, Episode, Ride, Stability};
 use crate::cmd::summary::{logs_in, RunRow};
+use crate::events::{EventKind, LogEvent};
 use crate::export::columns::{Column, Kind, Value};
 use crate::export::parquet::ParquetWriter;
 use crate::output::Output;
@@ -34,6 +38,8 @@ pub const RUNS: &str = "runs";
 pub const EPISODES: &str = "episodes";
 /// See [`FRAMES`].
 pub const KICKS: &str = "kicks";
+/// See [`FRAMES`].
+pub const EVENTS: &str = "events";
 
 /// One log of the campaign and where it goes.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -47,14 +53,16 @@ pub struct LogEntry {
 }
 
 impl LogEntry {
-    /// The frames' partition directory, relative to the dataset.
+    /// The run's frame file, relative to the dataset. No `run=N` folder:
+    /// a Hive partition beside the file's own `run` column is a conflict
+    /// pyarrow's `read_table` refuses.
     #[must_use]
-    pub fn partition(&self) -> PathBuf {
-        let run = PathBuf::from(format!("run={}", self.run));
+    pub fn frame_file(&self) -> PathBuf {
+        let file = format!("RUN{:05}.parquet", self.run);
         let frames = Path::new(FRAMES);
         match &self.card {
-            Some(card) => frames.join(format!("card={}", hive_value(card))).join(run),
-            None => frames.join(run),
+            Some(card) => frames.join(format!("card={}", hive_value(card))).join(file),
+            None => frames.join(file),
         }
     }
 }
@@ -103,7 +111,10 @@ pub fn campaign_logs(dir: &Path) -> Result<Vec<LogEntry>, CliError> {
                 run,
                 path,
             };
-            if let Some(twin) = entries.iter().find(|e| e.partition() == entry.partition()) {
+            if let Some(twin) = entries
+                .iter()
+                .find(|e| e.frame_file() == entry.frame_file())
+            {
                 return Err(CliError::file(
                     &entry.path,
                     format!("the same run number as {}", crate::text::shown(&twin.path)),
@@ -161,7 +172,7 @@ pub fn cards_in(dir: &Path) -> Result<Vec<Card>, CliError> {
 }
 
 /// `err` with a file of the temporary dataset `temp` named as it would be
-/// in `target` (`DATASET/frames/run=1/part-0.parquet: No space left on
+/// in `target` (`DATASET/frames/RUN00001.parquet: No space left on
 /// device`): the temporary name means nothing to the user and is gone.
 fn named_in(err: CliError, temp: &Path, target: &Path) -> CliError {
     match err {
@@ -426,19 +437,114 @@ fn episodes_columns() -> Vec<Column<EpisodesRow>> {
 }
 
 /// Writes `rows` as the one file of the table folder `dir`.
-fn write_table<R: 'static>(dir: &Path, columns: &[Column<R>], rows: &[R]) -> Result<(), CliError> {
+/// One event's row of `events.parquet`: what `wobblog events --json` lists.
+pub struct EventsRow {
+    entry: LogEntry,
+    event: LogEvent,
+    /// UTC, µs since 1970, where the log has it.
+    utc_us: Option<i64>,
+}
+
+impl EventsRow {
+    /// The event's numbers: frequency (Hz), growth rate (1/s), amplitude
+    /// (deg) and speed (m/s), where its kind has them.
+    fn numbers(&self) -> [Option<f64>; 4] {
+        match &self.event.kind {
+            EventKind::AlertOn { freq_hz, amp_deg } => [Some(*freq_hz), None, Some(*amp_deg), None],
+            EventKind::Kick {
+                speed_mps,
+                freq_hz,
+                sigma_per_s,
+                amp_deg,
+                ..
+            } => [
+                Some(*freq_hz),
+                Some(*sigma_per_s),
+                Some(*amp_deg),
+                *speed_mps,
+            ],
+            EventKind::MarginEstimate(m)
+            | EventKind::Approaching(m)
+            | EventKind::ApproachingOff(m) => [None, None, None, m.speed_mps],
+            _ => [None; 4],
+        }
+    }
+}
+
+/// The columns of `events.parquet`: the time, the kind, its numbers where
+/// it has them, and the details in words as `wobblog events` prints them.
+fn events_columns() -> Vec<Column<EventsRow>> {
+    let mut columns = identity!(EventsRow).to_vec();
+    columns.extend([
+        number!(EventsRow, "t_s", r => Some(r.event.t_s)),
+        Column::<EventsRow> {
+            name: "utc",
+            kind: Kind::Utc,
+            value: |r| Value::Utc(r.utc_us),
+        },
+        Column {
+            name: "event",
+            kind: Kind::Label,
+            value: |r| Value::Label(Some(r.event.kind.name())),
+        },
+        number!(EventsRow, "freq_hz", r => r.numbers()[0]),
+        number!(EventsRow, "sigma_per_s", r => r.numbers()[1]),
+        number!(EventsRow, "amp_deg", r => r.numbers()[2]),
+        number!(EventsRow, "speed_mps", r => r.numbers()[3]),
+        Column {
+            name: "details",
+            kind: Kind::Text,
+            value: |r| Value::Text(Some(r.event.kind.describe())),
+        },
+    ]);
+    columns
+}
+
+/// Writes the events of `entry`'s log, in time order, to `table` as they
+/// are read: a log of millions of records never sits in memory.
+fn write_events<W: std::io::Write + Send>(
+    entry: &LogEntry,
+    table: &mut ParquetWriter<W, EventsRow>,
+    table_path: &Path,
+) -> Result<(), CliError> {
+    crate::cmd::events::walk(&entry.path, |event, utc_us| {
+        table.write(&EventsRow {
+            entry: entry.clone(),
+            event,
+            utc_us,
+        })
+    })?
+    .map_err(|e| CliError::file(table_path, e))
+}
+
+/// The file of the table in folder `dir`, created (the folder too).
+fn table_file(dir: &Path) -> Result<(PathBuf, Output), CliError> {
     std::fs::create_dir_all(dir).map_err(|e| CliError::file(dir, e))?;
     let path = dir.join("part-0.parquet");
-    let mut out = Output::create(&path, &[])?;
-    let mut writer = ParquetWriter::new(&mut out, columns);
+    let out = Output::create(&path, &[])?;
+    Ok((path, out))
+}
+
+/// Finishes a table's file: the version and the columns' units as its
+/// metadata.
+fn finish_table<W: std::io::Write + Send, R: 'static>(
+    writer: &mut ParquetWriter<W, R>,
+    columns: &[Column<R>],
+) -> Result<(), parquet::errors::ParquetError> {
     let mut pairs = vec![(
         "wobblog.version".to_string(),
         env!("CARGO_PKG_VERSION").to_string(),
     )];
     pairs.extend(crate::export::metadata::units(columns));
+    writer.finish_with(pairs)
+}
+
+fn write_table<R: 'static>(dir: &Path, columns: &[Column<R>], rows: &[R]) -> Result<(), CliError> {
+    let (path, mut out) = table_file(dir)?;
+    let mut writer = ParquetWriter::new(&mut out, columns);
     rows.iter()
         .try_for_each(|r| writer.write(r))
-        .and_then(|()| writer.finish_with(pairs))
+        .and_then(|()| finish_table(&mut writer, columns))
         .map_err(|e| CliError::file(&path, e))?;
     drop(writer);
     out.commit()
@@ -479,17 +585,17 @@ fn kicks_of(entry: &LogEntry, ride: &Ride) -> Result<Vec<KicksRow>, CliError> {
 fn write_log(entry: &LogEntry, dir: &Path) -> Result<Ride, CliError> {
     // Analysed first: a log that cannot be read fails before a file is made.
     let ride = Ride::load(&entry.path)?;
-    let partition = dir.join(entry.partition());
-    std::fs::create_dir_all(&partition).map_err(|e| CliError::file(&partition, e))?;
-    let part = partition.join("part-0.parquet");
+    let part = dir.join(entry.frame_file());
+    let folder = part.parent().unwrap_or(dir);
+    std::fs::create_dir_all(folder).map_err(|e| CliError::file(folder, e))?;
     let written = Output::create(&part, &[&entry.path]).and_then(|mut out| {
-        let export = crate::cmd::decode::Export::all(crate::export::Format::Parquet);
+        let export = crate::cmd::decode::Export::dataset_frames(entry.run);
         crate::cmd::decode::decode_to(&entry.path, &export, &mut out, &part)?;
         out.commit()
     });
     if written.is_err() {
-        // Only the empty partition folder this call made; never data.
-        let _ = std::fs::remove_dir(&partition);
+        // The folder only if it is empty: never data.
+        let _ = std::fs::remove_dir(folder);
     }
     written.map(|()| ride)
 }
@@ -511,6 +617,10 @@ pub fn write_dataset(
     let mut episodes = Vec::new();
     let mut kicks = Vec::new();
     let mut skipped = 0;
+    // Events are written as each log is read.
+    let (events_path, mut events_out) = table_file(&dir.join(EVENTS))?;
+    let events_columns = events_columns();
+    let mut events = ParquetWriter::new(&mut events_out, &events_columns);
     for entry in entries {
         let ride = match write_log(entry, dir) {
             Ok(ride) => ride,
@@ -526,6 +636,7 @@ pub fn write_dataset(
         };
         progress(entry, Outcome::Written(&ride));
         kicks.extend(kicks_of(entry, &ride)?);
+        write_events(entry, &mut events, &events_path)?;
         episodes.extend(ride.all_episodes().into_iter().map(|episode| EpisodesRow {
             entry: entry.clone(),
             episode,
@@ -547,6 +658,9 @@ pub fn write_dataset(
     write_table(&dir.join(EPISODES), &episodes_columns(), &episodes)?;
     mark_used(&mut kicks);
     write_table(&dir.join(KICKS), &kicks_columns(), &kicks)?;
+    finish_table(&mut events, &events_columns).map_err(|e| CliError::file(&events_path, e))?;
+    drop(events);
+    events_out.commit()?;
     Ok(skipped)
 }
 
@@ -625,20 +739,20 @@ mod tests {
             run: 3,
             path: PathBuf::from("RUN00003.WBL"),
         }
-        .partition()
+        .frame_file()
     }
 
     #[test]
     fn a_write_error_names_the_file_in_the_dataset_not_the_temporary_one() {
         let temp = Path::new("cards/.season.a1b2c3.tmp");
         let err = CliError::file(
-            &temp.join("frames/run=1/part-0.parquet"),
+            &temp.join("frames/RUN00001.parquet"),
             "No space left on device",
         );
         let named = named_in(err, temp, Path::new("season"));
         assert_eq!(
             named.to_string(),
-            "season/frames/run=1/part-0.parquet: No space left on device"
+            "season/frames/RUN00001.parquet: No space left on device"
         );
         // A log's own error stays the log's.
         let log = CliError::file(Path::new("cards/RUN00001.WBL"), "bad");
@@ -649,7 +763,7 @@ mod tests {
     }
 
     #[test]
-    fn card_names_are_percent_encoded_in_partitions() {
+    fn card_names_are_percent_encoded_in_their_folders() {
         for (card, folder) in [
             ("anna", "card=anna"),
             ("rider=anna", "card=rider%3Danna"),
@@ -660,7 +774,7 @@ mod tests {
         ] {
             assert_eq!(
                 partition_of(card),
-                Path::new("frames").join(folder).join("run=3"),
+                Path::new("frames").join(folder).join("RUN00003.parquet"),
                 "{card:?}"
             );
         }

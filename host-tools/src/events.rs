@@ -121,6 +121,21 @@ pub enum EventKind {
         /// What it was and what became of it.
         what: String,
     },
+    /// A wobble episode or weave ring-down the host measured in the frames
+    /// (`wobblog events --episodes`; the time is its onset), as `wobblog
+    /// wobble` lists it.
+    Episode {
+        /// `wobble` or `weave`.
+        mode: &'static str,
+        /// Frequency, Hz.
+        freq_hz: f64,
+        /// Growth rate, 1/s (negative: decaying).
+        sigma_per_s: f64,
+        /// Speed at onset, m/s.
+        speed_mps: f64,
+        /// Where it ends, s since boot.
+        end_s: f64,
+    },
 }
 
 /// What a margin record says: the speed at the time and the wobble speed
@@ -180,6 +195,23 @@ impl Margin {
     }
 }
 
+impl LogEvent {
+    /// A wobble episode or weave ring-down the host measured.
+    #[must_use]
+    pub fn of_episode(e: &crate::analysis::Episode) -> Self {
+        Self {
+            t_s: e.onset_s,
+            kind: EventKind::Episode {
+                mode: e.mode.as_str(),
+                freq_hz: e.freq_hz,
+                sigma_per_s: e.sigma_per_s,
+                speed_mps: e.speed_at_onset_mps,
+                end_s: e.end_s,
+            },
+        }
+    }
+}
+
 impl EventKind {
     /// The kind's name, as in the JSON `event` field.
     #[must_use]
@@ -199,6 +231,7 @@ impl EventKind {
             Self::BadRecord { .. } => "bad_record",
             Self::TimeJump { .. } => "time_jump",
             Self::OutOfRange { .. } => "out_of_range",
+            Self::Episode { .. } => "episode",
         }
     }
 
@@ -247,6 +280,15 @@ impl EventKind {
             Self::BadRecord { block, error } => format!("block {block}: {error}"),
             Self::TimeJump { to_s } => format!("to {to_s:.6} s"),
             Self::OutOfRange { block, what } => format!("block {block}: {what}"),
+            Self::Episode {
+                mode,
+                freq_hz,
+                sigma_per_s,
+                speed_mps,
+                end_s,
+            } => format!(
+                "{mode} (host): {freq_hz:.2} Hz, sigma {sigma_per_s:.2} 1/s, {speed_mps:.2} m/s, to {end_s:.3} s"
+            ),
         }
     }
 }

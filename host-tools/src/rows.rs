@@ -71,6 +71,9 @@ pub struct Row {
     /// Signals derived from the frames around it, when asked for
     /// ([`crate::export::derived`]).
     pub derived: Derived,
+    /// The run it belongs to, where an output names it in every row (a
+    /// dataset's frame files); `None` from the decoder.
+    pub run: Option<u32>,
 }
 
 impl Row {
@@ -89,6 +92,7 @@ impl Row {
             gps,
             utc_us: sync.and_then(|s| utc_us_at(s, frame.t_us)),
             derived: Derived::default(),
+            run: None,
         }
     }
 }

@@ -197,8 +197,15 @@ const NO_UTC_FOR_WINDOW: &str =
 /// the first pair).
 #[must_use]
 pub fn utc_text_at(pairs: &[SyncPair], t_s: f64) -> Option<String> {
+    utc_us_after_pair(pairs, t_s).and_then(iso8601_unix_us)
+}
+
+/// UTC at `t_s` since boot, µs since 1970, through the latest pair at or
+/// before it (none before the first pair), as [`utc_text_at`] gives it.
+#[must_use]
+pub fn utc_us_after_pair(pairs: &[SyncPair], t_s: f64) -> Option<i64> {
     let earlier = pairs.partition_point(|p| p.0 <= t_s);
-    utc_us_at(&pairs[..earlier], t_s).and_then(iso8601_unix_us)
+    utc_us_at(&pairs[..earlier], t_s)
 }
 
 /// The `--from/--to` of a command.

@@ -5,7 +5,7 @@
 
 mod analysis_support;
 
-use analysis_support::{python, standard_log, wobblog, write_log, Ride};
+use analysis_support::{python, standard_log, stdout_of, wobblog, write_log, Ride};
 use serde_json::json;
 use std::path::Path;
 
@@ -63,6 +63,12 @@ out["polars_counts"] = frames.group_by("run").len().sort("run").collect().rows()
 out["polars_utc_type"] = str(frames.collect_schema()["utc"])
 table = pq.read_table(ds + "/frames")
 out["pyarrow_run_type"] = str(table.schema.field("run").type)
+import pyarrow.dataset
+out["pyarrow_dataset_runs"] = sorted(set(pyarrow.dataset.dataset(ds + "/frames").to_table().column("run").to_pylist()))
+out["first_column"] = pq.read_schema(f"{ds}/frames/RUN00001.parquet").names[0]
+events = pl.read_parquet(ds + "/events/")
+out["events_schema"] = {k: str(v) for k, v in events.schema.items()}
+out["events"] = events.select("run", "event").rows()
 out["pyarrow_rows"] = table.num_rows
 out["duckdb_counts"] = duckdb.sql(
     f"SELECT run, typeof(run), count(*) FROM '{ds}/frames/**/*.parquet' GROUP BY ALL ORDER BY run"
@@ -83,8 +89,8 @@ out["duckdb_runs"] = duckdb.sql(
     f"SELECT count(*), min(first_utc)::VARCHAR FROM '{ds}/runs/*.parquet'"
 ).fetchall()
 units = {}
-for table in ["frames/run=1", "runs", "episodes"]:
-    meta = pq.read_schema(f"{ds}/{table}/part-0.parquet").metadata
+for table in ["frames/RUN00001.parquet", "runs/part-0.parquet", "episodes/part-0.parquet", "events/part-0.parquet"]:
+    meta = pq.read_schema(f"{ds}/{table}").metadata
     units[table] = {k.decode()[5:]: v.decode() for k, v in meta.items() if k.startswith(b"unit.")}
 out["units"] = units
 print(json.dumps(out, default=str))
@@ -103,20 +109,41 @@ fn each_table_opens_as_a_dataset_in_polars_pyarrow_and_duckdb() {
         .assert()
         .success();
     for run in 1..=3 {
-        assert!(ds
-            .join(format!("frames/run={run}/part-0.parquet"))
-            .is_file());
+        assert!(ds.join(format!("frames/RUN{run:05}.parquet")).is_file());
     }
     let Some(seen) = python(READ_BACK, &[ds.as_os_str()]) else {
         return;
     };
-    // Typed partitions: an integer run number in every reader.
+    // The run in every file, an integer in every reader, also where
+    // partition folders are not read (pyarrow.dataset's defaults).
     assert_eq!(seen["polars_run_type"], "Int64");
-    // pyarrow dictionary-encodes partition values: of int32.
-    assert!(seen["pyarrow_run_type"]
-        .as_str()
-        .unwrap()
-        .contains("values=int32"));
+    assert_eq!(seen["pyarrow_run_type"], "int64");
+    assert_eq!(seen["pyarrow_dataset_runs"], json!([1, 2, 3]));
+    assert_eq!(seen["first_column"], "run");
+    // The events table: the alerts and markers of every run.
+    let events = &seen["events_schema"];
+    assert_eq!(events["run"], "Int64");
+    assert_eq!(events["utc"], "Datetime(time_unit='us', time_zone='UTC')");
+    assert_eq!(events["freq_hz"], "Float64");
+    assert_eq!(events["details"], "String");
+    // Each run's events are those `wobblog events` lists, in its order.
+    for run in 1..=3 {
+        let log = dir.path().join(format!("card/RUN{run:05}.WBL"));
+        let listed = stdout_of(wobblog().arg("events").arg(&log).arg("--json"));
+        let names: Vec<serde_json::Value> = listed
+            .lines()
+            .map(|l| serde_json::from_str::<serde_json::Value>(l).unwrap()["event"].clone())
+            .collect();
+        let in_table: Vec<serde_json::Value> = seen["events"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .filter(|r| r[0] == run)
+            .map(|r| r[1].clone())
+            .collect();
+        assert!(names.len() >= 4, "{names:?}");
+        assert_eq!(in_table, names, "run {run}");
+    }
     let counts: Vec<serde_json::Value> = frames
         .iter()
         .enumerate()
@@ -157,12 +184,13 @@ fn each_table_opens_as_a_dataset_in_polars_pyarrow_and_duckdb() {
     );
     // Units on every table.
     let units = &seen["units"];
-    assert_eq!(units["frames/run=1"]["gz_dps"], "deg/s");
-    assert_eq!(units["runs"]["distance_m"], "m");
-    assert_eq!(units["runs"]["first_utc"], "UTC");
-    assert_eq!(units["episodes"]["sigma_per_s"], "1/s");
-    assert_eq!(units["episodes"]["freq_hz"], "Hz");
-    assert_eq!(units["episodes"]["censored"], "");
+    assert_eq!(units["frames/RUN00001.parquet"]["gz_dps"], "deg/s");
+    assert_eq!(units["runs/part-0.parquet"]["distance_m"], "m");
+    assert_eq!(units["runs/part-0.parquet"]["first_utc"], "UTC");
+    assert_eq!(units["episodes/part-0.parquet"]["sigma_per_s"], "1/s");
+    assert_eq!(units["episodes/part-0.parquet"]["freq_hz"], "Hz");
+    assert_eq!(units["episodes/part-0.parquet"]["censored"], "");
+    assert_eq!(units["events/part-0.parquet"]["amp_deg"], "deg");
 }
 
 /// A folder of cards, one log each (different bytes: copies would be one
@@ -247,7 +275,7 @@ runs = pl.read_parquet(ds + "/runs/").get_column("run").to_list()
 frames = pl.scan_parquet(ds + "/frames/").select(pl.len()).collect().item()
 print(json.dumps({"runs": runs, "frames": frames}))
 "#;
-    assert!(!ds.join("frames/run=4").exists());
+    assert!(!ds.join("frames/RUN00004.parquet").exists());
     if let Some(seen) = python(script, &[ds.as_os_str()]) {
         assert_eq!(seen["runs"], json!([1, 2, 3]));
         assert_eq!(seen["frames"], frames.iter().sum::<usize>());
@@ -311,8 +339,8 @@ fn a_temporary_dataset_left_by_a_killed_run_is_removed_by_the_next() {
     let card_dir = dir.path().join("card");
     card(&card_dir);
     let left = dir.path().join(".season.k1LLed.tmp");
-    std::fs::create_dir_all(left.join("frames/run=1")).unwrap();
-    std::fs::write(left.join("frames/run=1/part-0.parquet"), b"half").unwrap();
+    std::fs::create_dir_all(left.join("frames")).unwrap();
+    std::fs::write(left.join("frames/RUN00001.parquet"), b"half").unwrap();
     // One whose writer lives (its lock held) stays.
     let live = dir.path().join(".season.al1ve0.tmp");
     std::fs::create_dir(&live).unwrap();

@@ -235,7 +235,7 @@ fn every_log_command(path: &Path, dir: &Path) {
 /// Draws `figure` through the command's own output path.
 fn draw(figure: &impl Figure, dir: &Path, name: &str) {
     let out = wobblog::output::Output::create(&dir.join(name), &[]).unwrap();
-    wobblog::plot::render(figure, out).unwrap();
+    wobblog::plot::render(figure, out, &wobblog::plot::FigureArgs::default()).unwrap();
 }
 
 /// Time for new cases for each harness, from `WOBBLOG_FUZZ_SECONDS`; none

@@ -89,6 +89,6 @@ fn export_writes_a_copied_run_once() {
         .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
         .collect();
     runs.sort();
-    assert_eq!(runs, ["run=1", "run=2"]);
+    assert_eq!(runs, ["RUN00001.parquet", "RUN00002.parquet"]);
     assert!(!dataset.join("frames/card=ben").exists(), "{stderr}");
 }

@@ -206,8 +206,9 @@ fn sweep_key_draws_each_factors_swatch_as_its_line() {
     let svg = std::fs::read_to_string(&fig).unwrap();
     // The key's frame is the last rectangle before its first entry; the
     // swatches are the level segments inside it.
-    let first = svg.find("wobble (x 0.5)").expect("the key");
-    let frame = &svg[svg[..first].rfind("<rect").unwrap()..first];
+    let first = svg.find("wobble: x 0.5").expect("the key");
+    let frame_at = svg[..first].rfind("<rect").unwrap();
+    let frame = &svg[frame_at..first];
     let number = |name: &str| -> i32 {
         let at = frame.find(&format!(" {name}=\"")).unwrap() + name.len() + 3;
         frame[at..at + frame[at..].find('"').unwrap()]
@@ -217,7 +218,7 @@ fn sweep_key_draws_each_factors_swatch_as_its_line() {
     let (left, top) = (number("x"), number("y"));
     let (right, bottom) = (left + number("width"), top + number("height"));
     let mut rows: Vec<(i32, Vec<(u32, i32)>)> = Vec::new();
-    for (y, width, x0, x1) in level_segments(&svg[first..]) {
+    for (y, width, x0, x1) in level_segments(&svg[frame_at..]) {
         if x0 < left || x1 > right || y < top || y > bottom {
             continue;
         }

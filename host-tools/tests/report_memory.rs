@@ -84,6 +84,7 @@ fn row(i: usize) -> Row {
         }),
         utc_us: None,
         derived: Default::default(),
+        run: None,
     }
 }
 

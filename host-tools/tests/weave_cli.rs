@@ -182,6 +182,43 @@ fn wobble_lists_the_weave_ring_downs() {
     );
 }
 
+/// `events --episodes` lists the host's episodes, the weave's ring-down
+/// among them, as `wobble` finds them; without it, the log's events alone.
+#[test]
+fn events_list_the_weave_ring_down_when_asked() {
+    let dir = campaign();
+    let log = dir.path().join("RUN00003.WBL");
+    let v: Value = serde_json::from_str(&run_ok(&["wobble", "--json"], &log)).unwrap();
+    let lines = run_ok(&["events", "--json", "--episodes"], &log);
+    let listed: Vec<Value> = lines
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .filter(|e: &Value| e["event"] == "episode")
+        .collect();
+    let episodes = v["episodes"].as_array().unwrap();
+    assert_eq!(listed.len(), episodes.len(), "{lines}");
+    for (e, w) in listed.iter().zip(episodes) {
+        assert_eq!(e["mode"], w["mode"], "{e} {w}");
+        assert_eq!(e["t_s"], w["onset_s"], "{e} {w}");
+        assert_eq!(e["freq_hz"], w["freq_hz"], "{e} {w}");
+    }
+    assert!(listed.iter().any(|e| e["mode"] == "weave"), "{lines}");
+    // In time order among the log's own events.
+    let times: Vec<f64> = lines
+        .lines()
+        .map(|l| {
+            serde_json::from_str::<Value>(l).unwrap()["t_s"]
+                .as_f64()
+                .unwrap()
+        })
+        .collect();
+    assert!(times.windows(2).all(|w| w[0] <= w[1]), "{times:?}");
+    let table = run_ok(&["events", "--episodes"], &log);
+    assert!(table.contains("weave (host): 0.8"), "{table}");
+    let plain = run_ok(&["events", "--json"], &log);
+    assert!(!plain.contains("\"episode\""), "{plain}");
+}
+
 /// The data set's episodes table has a `mode` column with the weave's rows,
 /// and its kicks table the weave's kicks, each used by the prediction.
 #[test]

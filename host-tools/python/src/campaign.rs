@@ -66,6 +66,7 @@ pub fn margin<'py>(
         trend: choice::<Trend>("trend", trend)?,
         ride_margin: ride_margin_pct,
         mode: wobblog::analysis::KickMode::Wobble,
+        figure: wobblog::plot::FigureArgs::default(),
     };
     let logs = detached(py, "margin", || {
         Ok(wobblog::inputs::distinct(expand(&args.inputs)?))

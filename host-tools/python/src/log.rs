@@ -244,10 +244,10 @@ impl Log {
         let path = self.path.clone();
         let lines = detached(py, &self.shown(), || {
             let mut lines = Vec::new();
-            let walked = walk(&path, |e, utc| {
+            let walked = walk(&path, |e, utc_us| {
                 let line = JsonEvent {
                     t_s: e.t_s,
-                    utc,
+                    utc: utc_us.and_then(wobblog::time::iso8601_unix_us),
                     kind: &e.kind,
                 };
                 lines.push(serde_json::to_value(line).unwrap_or_default());

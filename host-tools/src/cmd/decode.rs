@@ -75,6 +75,8 @@ pub struct Export {
     pub columns: Vec<Column>,
     /// Rows inside this window only.
     pub window: TimeWindow,
+    /// The run number every row carries ([`Row::run`]), if any.
+    pub run: Option<u32>,
 }
 
 impl Export {
@@ -86,6 +88,20 @@ impl Export {
             delimiter: b',',
             columns: columns::COLUMNS.to_vec(),
             window: TimeWindow::default(),
+            run: None,
+        }
+    }
+
+    /// Every column of every row as Parquet, after a `run` column saying
+    /// `run` in each row: a dataset's frame file.
+    #[must_use]
+    pub fn dataset_frames(run: u32) -> Self {
+        let mut columns = vec![columns::RUN_COLUMN];
+        columns.extend(columns::COLUMNS);
+        Self {
+            columns,
+            run: Some(run),
+            ..Self::all(Format::Parquet)
         }
     }
 }
@@ -105,6 +121,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         delimiter: resolved.delimiter,
         columns: columns::select(args.columns.as_deref()).map_err(CliError::Usage)?,
         window: args.window.window(),
+        run: None,
     };
     export.window.check_order(&args.log)?;
     if export.format == Format::Mcap && args.columns.is_some() {
@@ -194,6 +211,7 @@ pub fn decode_to(
         rows_kept: 0,
         span_s: None,
         has_utc: false,
+        run: export.run,
     };
     let mut rows = RowAssembler::new();
     let mut losses = Losses::default();
@@ -278,6 +296,8 @@ struct WindowedSink<W: Write + Send> {
     span_s: Option<(f64, f64)>,
     /// Whether the log has a sync pair.
     has_utc: bool,
+    /// The run number every row carries, if any.
+    run: Option<u32>,
 }
 
 impl<W: Write + Send> WindowedSink<W> {
@@ -294,7 +314,16 @@ impl<W: Write + Send> WindowedSink<W> {
             (a.min(row.t_s), b.max(row.t_s))
         }));
         self.rows_kept += u64::from(inside);
-        self.keep(inside, |w| w.write(row));
+        match self.run {
+            Some(run) => {
+                let row = Row {
+                    run: Some(run),
+                    ..*row
+                };
+                self.keep(inside, |w| w.write(&row));
+            }
+            None => self.keep(inside, |w| w.write(row)),
+        }
     }
 
     fn gps(&mut self, fix: &GpsFix) {

@@ -8,7 +8,7 @@ use crate::cmd::logs::one_log;
 use crate::events::{EventConverter, LogEvent, TimeOrder};
 use crate::output::Output;
 use crate::reader::read_log_try;
-use crate::time::{utc_text_at, SyncPair};
+use crate::time::{iso8601_unix_us, utc_text_at, utc_us_after_pair, SyncPair};
 use crate::CliError;
 use wobble_core::format::{Event, Record};
 
@@ -20,6 +20,11 @@ pub struct Args {
     /// `--json` (or `--format jsonl`) for JSON instead of text.
     #[command(flatten)]
     pub output: crate::cmd::logs::JsonArgs,
+    /// Also list what the host measures in the frames: each wobble episode
+    /// and weave ring-down as `wobblog wobble` finds it (`episode` events at
+    /// their onset, with the mode). A second reading of the log.
+    #[arg(long)]
+    pub episodes: bool,
 }
 
 /// Runs `wobblog events`.
@@ -33,44 +38,86 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         "events",
         "list them one by one, or `wobblog summary` for every run's episodes and losses",
     )?;
+    let json = args.output.is_json()?;
     let mut out = Output::stdout(&[&args.log])?;
-    match list(&args.log, args.output.is_json()?, &mut out)? {
+    let host = if args.episodes {
+        let mut all: Vec<LogEvent> = crate::analysis::Ride::load(&args.log)?
+            .all_episodes()
+            .iter()
+            .map(LogEvent::of_episode)
+            .collect();
+        all.sort_by(|a, b| a.t_s.total_cmp(&b.t_s));
+        all
+    } else {
+        Vec::new()
+    };
+    match list(&args.log, json, host, &mut out)? {
         Ok(()) => out.commit(),
         Err(e) => Err(out.error(e)),
     }
 }
 
-/// Writes the events of the log at `path` to `out`, as a table (time,
+/// Writes the events of the log at `path` to `out`, with `host` (events of
+/// the host's own measurement, in time order) among them, as a table (time,
 /// kind, details; then their number) or as JSON lines.
 ///
 /// # Errors
 /// The log cannot be read (the outer error) or `out` failed (the inner).
-pub fn list(path: &Path, json: bool, out: impl Write) -> Result<std::io::Result<()>, CliError> {
+pub fn list(
+    path: &Path,
+    json: bool,
+    host: Vec<LogEvent>,
+    out: impl Write,
+) -> Result<std::io::Result<()>, CliError> {
     let mut listing = Listing {
         out,
         json,
         count: 0,
     };
-    let walked = walk(path, |e, utc| listing.event(&e, utc))?;
-    Ok(walked.and_then(|()| listing.finish()))
+    let mut host = host.into_iter().peekable();
+    // The host's events have no UTC of their own: the latest the log's
+    // events had places them, as the frames are placed.
+    let mut pairs: Vec<SyncPair> = Vec::new();
+    let walked = walk_with_pairs(path, &mut pairs, |e, utc_us, pairs| {
+        while let Some(h) = host.next_if(|h| h.t_s < e.t_s) {
+            listing.event(&h, utc_text_at(pairs, h.t_s))?;
+        }
+        listing.event(&e, utc_us.and_then(iso8601_unix_us))
+    })?;
+    Ok(walked.and_then(|()| {
+        for h in host {
+            listing.event(&h, utc_text_at(&pairs, h.t_s))?;
+        }
+        listing.finish()
+    }))
 }
 
 /// Hands the events of the log at `path` to `visit` in time order, holding
-/// only the few that may still move ([`TimeOrder`]), each with its UTC
-/// through the sync pairs read so far, as `decode`'s `utc` column places a
-/// frame. An error from `visit` ends the walk and is the
+/// only the few that may still move ([`TimeOrder`]), each with its UTC (µs
+/// since 1970) through the sync pairs read so far, as `decode`'s `utc`
+/// column places a frame. An error from `visit` ends the walk and is the
 /// inner result.
 ///
 /// # Errors
 /// The log cannot be read.
 pub fn walk<E>(
     path: &Path,
-    mut visit: impl FnMut(LogEvent, Option<String>) -> Result<(), E>,
+    mut visit: impl FnMut(LogEvent, Option<i64>) -> Result<(), E>,
+) -> Result<Result<(), E>, CliError> {
+    let mut pairs = Vec::new();
+    walk_with_pairs(path, &mut pairs, |e, utc_us, _| visit(e, utc_us))
+}
+
+/// [`walk`], handing `visit` the sync pairs read so far as well; `pairs`
+/// holds every pair of the log afterwards.
+fn walk_with_pairs<E>(
+    path: &Path,
+    pairs: &mut Vec<SyncPair>,
+    mut visit: impl FnMut(LogEvent, Option<i64>, &[SyncPair]) -> Result<(), E>,
 ) -> Result<Result<(), E>, CliError> {
     let mut converter = EventConverter::new();
     let mut order = TimeOrder::new();
     // Every pair: an event held back may come before the latest one.
-    let mut pairs: Vec<SyncPair> = Vec::new();
     let walked = read_log_try(path, |event| {
         if let Event::Record(Record::UtcSync(pair)) = &event {
             if let Ok(ms) = i64::try_from(pair.unix_ms) {
@@ -79,16 +126,16 @@ pub fn walk<E>(
         }
         match converter.convert(&event) {
             Some(e) => order.push(e, &mut |e: LogEvent| {
-                let utc = utc_text_at(&pairs, e.t_s);
-                visit(e, utc)
+                let utc = utc_us_after_pair(pairs, e.t_s);
+                visit(e, utc, pairs)
             }),
             None => Ok(()),
         }
     })?;
     Ok(walked.and_then(|()| {
         order.finish(&mut |e: LogEvent| {
-            let utc = utc_text_at(&pairs, e.t_s);
-            visit(e, utc)
+            let utc = utc_us_after_pair(pairs, e.t_s);
+            visit(e, utc, pairs)
         })
     }))
 }

@@ -1,5 +1,5 @@
-//! `wobblog export`: every log of a card, or of a folder of cards, as one
-//! Hive-partitioned Parquet dataset.
+//! `wobblog export`: every log of a card, or of a folder of cards, as
+//! Parquet datasets, one per table.
 
 use std::path::PathBuf;
 
@@ -11,15 +11,19 @@ use crate::CliError;
 
 const AFTER_HELP: &str = "\
 Layout: one folder per table, each a dataset of its own:
-  DATASET/frames/run=1/part-0.parquet   one file per run, the columns of
-                                        `wobblog decode` (under card=NAME/
-                                        too for a folder of cards)
+  DATASET/frames/RUN00001.parquet       one file per run, a `run` column
+                                        then the columns of `wobblog decode`
+                                        (under card=NAME/ for a folder of cards)
   DATASET/runs/part-0.parquet           one row per run, as `wobblog summary`
-  DATASET/episodes/part-0.parquet       one row per wobble episode, as
-                                        `wobblog wobble`, censoring included
-Partition values are plain (run=1), so readers type them; a card's name
-is percent-encoded as Hive readers decode it (card=rider%3Danna); every file
-carries its columns' units as metadata (unit.NAME). Default options open it:
+  DATASET/episodes/part-0.parquet       one row per episode, wobble and weave,
+                                        as `wobblog wobble`, censoring included
+  DATASET/kicks/part-0.parquet          one row per kick, as `wobblog margin`
+                                        takes them, with whether it was used
+  DATASET/events/part-0.parquet         one row per event, as `wobblog events`
+Every table has a `run` column; a card's name is a Hive partition of the
+frames, percent-encoded as readers decode it (card=rider%3Danna), and a
+`card` column of the other tables. Every file carries its columns' units as
+metadata (unit.NAME). Default options open it:
   polars.scan_parquet('DATASET/frames/')
   pyarrow.parquet.read_table('DATASET/frames')
   duckdb: SELECT run, max(steer_deg) FROM 'DATASET/frames/**/*.parquet' GROUP BY run;

@@ -62,6 +62,9 @@ pub struct Args {
     /// the roll rate; the host's kicks only, no `--plot` or `--model`).
     #[arg(long, value_enum, default_value_t = KickMode::Wobble)]
     pub mode: KickMode,
+    /// The figure's size and resolution (`--size`, `--dpi`).
+    #[command(flatten)]
+    pub figure: crate::plot::FigureArgs,
 }
 
 /// A riding margin in per cent: a number from 0 to 90.
@@ -233,7 +236,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
     // Drawn only when every log was read: a failed command leaves an old
     // figure as it was.
     if let (Some(out), Ok(())) = (plot_out, &result) {
-        render(&figure(&report, margin), out)?;
+        render(&figure(&report, margin), out, &args.figure)?;
     }
     result.and(printed)
 }

@@ -7,8 +7,8 @@ use crate::analysis::run::{log_name, read_rows};
 use crate::cmd::info::summarise;
 use crate::cmd::logs::{one_log, warn_losses};
 use crate::output::Output;
-use crate::plot::timeplot::TimePlotBuilder;
-use crate::plot::{render, ImageKind};
+use crate::plot::timeplot::{TimePlotBuilder, SIZE_PX};
+use crate::plot::{render, FigureArgs, ImageKind};
 use crate::summary::Summary;
 use crate::time::WindowArgs;
 use crate::CliError;
@@ -28,6 +28,9 @@ pub struct Args {
     /// of seconds since boot.
     #[arg(long)]
     pub utc: bool,
+    /// The figure's size and resolution (`--size`, `--dpi`).
+    #[command(flatten)]
+    pub figure: FigureArgs,
 }
 
 /// Runs `wobblog plot`: one pass for what the log records (its time span,
@@ -86,8 +89,9 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         (a, b) if b <= a && fs_hz > 0.0 => (a, a + 1.0 / fs_hz),
         span => span,
     };
-    let mut builder =
-        TimePlotBuilder::new(&name, &summary, data_s, fs_hz, window_s).ok_or_else(no_frames)?;
+    let width_px = args.figure.size.map_or(SIZE_PX.0, |s| s.0);
+    let mut builder = TimePlotBuilder::new(&name, &summary, data_s, fs_hz, window_s, width_px)
+        .ok_or_else(no_frames)?;
     // The episodes drawn come from the same reading of the frames.
     let mut analysis = RideAnalysis::new(fs_hz, &summary.config);
     read_rows(
@@ -106,7 +110,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
     if args.utc {
         figure.label_utc(pairs.clone());
     }
-    render(&figure, out)
+    render(&figure, out, &args.figure)
 }
 
 /// Says which stretch a run cut by time jumps is plotted over.

@@ -31,6 +31,9 @@ pub struct Args {
     /// Only episodes whose onset falls in this window (`--from`, `--to`).
     #[command(flatten)]
     pub window: WindowArgs,
+    /// The figure's size and resolution (`--size`, `--dpi`).
+    #[command(flatten)]
+    pub figure: crate::plot::FigureArgs,
 }
 
 /// The episodes of one run, as printed.
@@ -108,7 +111,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
                 )
             })
             .collect();
-        render(&ModePlot::new(runs), out)?;
+        render(&ModePlot::new(runs), out, &args.figure)?;
     }
     result.and(printed)
 }

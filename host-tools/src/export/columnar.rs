@@ -383,6 +383,7 @@ mod tests {
             gps: None,
             utc_us: None,
             derived: Default::default(),
+            run: None,
         };
         let fix = GpsColumns {
             lat_deg: 52.0,

@@ -109,6 +109,15 @@ pub const COLUMNS: [Column; 14] = [
     },
 ];
 
+/// The run number of a dataset's frame files ([`Row::run`]): the first
+/// column there, so that a file read alone, or by a reader that drops
+/// partition folders, still says which run each frame is of.
+pub const RUN_COLUMN: Column = Column {
+    name: "run",
+    kind: Kind::Integer,
+    value: |r| Value::Integer(r.run.map(i64::from)),
+};
+
 /// A derived column: given only when named ([`super::derived`]).
 macro_rules! derived {
     ($name:literal, $row:ident => $value:expr) => {

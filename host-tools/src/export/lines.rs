@@ -188,6 +188,7 @@ mod tests {
             gps: None,
             utc_us: None,
             derived: Default::default(),
+            run: None,
         };
         (0..n)
             .map(|i| Row {

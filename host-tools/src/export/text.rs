@@ -269,6 +269,7 @@ mod tests {
                     ),
                     utc_us,
                     derived: Default::default(),
+                    run: None,
                 },
             )
     }

@@ -7,8 +7,9 @@
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
+use super::key::{self, Swatch};
 use super::modes::{DOT_PX, ZERO_LINE_COLOUR};
-use super::{numbers_chart, padded_range, titled_page, Figure, FONT};
+use super::{numbers_chart, padded_range, titled_page, Figure};
 use crate::analysis::margin::{Margin, Trend};
 
 /// One kick as drawn.
@@ -115,9 +116,13 @@ impl Figure for MarginPlot {
         let model = curve.iter().map(|p| p.1);
         let line = band.iter().map(|b| b.1 .0);
         let y_range = padded_range(dots.chain(model).chain(line).chain([0.0]), 1.0);
+        // Room for the longest key any prediction can have, so that the
+        // figures of two campaigns share their layout.
+        let key_px = key::width_px(&root, &KEY_LABELS)?;
+        let mut entries: Vec<(String, Swatch)> = Vec::new();
         let mut chart = numbers_chart(
             &root,
-            16,
+            (MARGIN_PX, key_px),
             (x_range.clone(), y_range.clone()),
             ("speed (m/s)", "growth rate sigma (1/s)"),
         )?;
@@ -131,9 +136,8 @@ impl Figure for MarginPlot {
                     outline,
                     BAND.mix(0.6).filled(),
                 )))
-                .map_err(err)?
-                .label("95 % band: the fit's; beyond the kicks, with the bend")
-                .legend(|(x, y)| Rectangle::new([(x, y - 5), (x + 20, y + 5)], BAND.filled()));
+                .map_err(err)?;
+            entries.push((BAND_LABEL.into(), Swatch::Fill(BAND.to_rgba())));
         }
         if let [Some(lo), hi] = self.margin.ci95_mps {
             let hi = hi.unwrap_or(x_range.end).min(x_range.end);
@@ -144,11 +148,8 @@ impl Figure for MarginPlot {
                         [(lo, y_range.start), (hi, y_range.end)],
                         CROSSING.mix(0.12).filled(),
                     )))
-                    .map_err(err)?
-                    .label("wobble speed, 95 % interval")
-                    .legend(|(x, y)| {
-                        Rectangle::new([(x, y - 5), (x + 20, y + 5)], CROSSING.mix(0.3).filled())
-                    });
+                    .map_err(err)?;
+                entries.push((INTERVAL_LABEL.into(), Swatch::Fill(CROSSING.mix(0.3))));
             }
         }
         chart
@@ -161,12 +162,12 @@ impl Figure for MarginPlot {
             let fit: Vec<(f64, f64)> = band.iter().map(|(u, b)| (*u, b.0)).collect();
             chart
                 .draw_series(LineSeries::new(fit, FIT.stroke_width(2)))
-                .map_err(err)?
-                .label(match self.margin.trend {
-                    Trend::Line => "robust line, bent by the shape prior",
-                    Trend::Quadratic => "robust quadratic",
-                })
-                .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], FIT.stroke_width(2)));
+                .map_err(err)?;
+            let label = match self.margin.trend {
+                Trend::Line => LINE_LABEL,
+                Trend::Quadratic => "robust quadratic",
+            };
+            entries.push((label.into(), Swatch::line(FIT, 2)));
         }
         if let Some(w) = self.margin.wobble_speed_mps.filter(|w| x_range.contains(w)) {
             chart
@@ -174,11 +175,11 @@ impl Figure for MarginPlot {
                     vec![(w, y_range.start), (w, y_range.end)],
                     CROSSING.stroke_width(2),
                 )))
-                .map_err(err)?
-                .label(format!("predicted wobble speed {w:.2} m/s"))
-                .legend(|(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 20, y)], CROSSING.stroke_width(2))
-                });
+                .map_err(err)?;
+            entries.push((
+                format!("predicted wobble speed {w:.2} m/s"),
+                Swatch::line(CROSSING, 2),
+            ));
         }
         for (speed, colour, what) in [
             (self.margin.advice.ride_below_mps, RIDE, "ride below"),
@@ -196,11 +197,8 @@ impl Figure for MarginPlot {
                     vec![(v, y_range.start), (v, y_range.end)],
                     colour.stroke_width(2),
                 )))
-                .map_err(err)?
-                .label(format!("{what} {v:.2} m/s"))
-                .legend(move |(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2))
-                });
+                .map_err(err)?;
+            entries.push((format!("{what} {v:.2} m/s"), Swatch::line(colour, 2)));
         }
         if self.model_curve.is_some() {
             let label = self.model_speed.map_or("fitted model".to_string(), |s| {
@@ -211,11 +209,8 @@ impl Figure for MarginPlot {
                     curve.iter().map(|&(u, s)| (u, clip(s))),
                     MODEL.stroke_width(2),
                 ))
-                .map_err(err)?
-                .label(label)
-                .legend(|(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 20, y)], MODEL.stroke_width(2))
-                });
+                .map_err(err)?;
+            entries.push((label, Swatch::line(MODEL, 2)));
         }
         for (colour, used, label) in [
             (USED, true, "kick (±2 SD)"),
@@ -244,18 +239,23 @@ impl Figure for MarginPlot {
                         colour.filled(),
                     )
                 }))
-                .map_err(err)?
-                .label(label)
-                .legend(move |(x, y)| Circle::new((x + 10, y), DOT_PX - 1, colour.filled()));
+                .map_err(err)?;
+            entries.push((label.into(), Swatch::Dot(colour, DOT_PX - 1)));
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperLeft)
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .label_font((FONT, 13))
-            .draw()
-            .map_err(err)?;
-        Ok(())
+        key::draw(&root, chart.plotting_area(), key_px, &entries)
     }
 }
+
+/// Space around the chart, px.
+const MARGIN_PX: u32 = 16;
+const BAND_LABEL: &str = "95 % band: the fit's; beyond the kicks, with the bend";
+const INTERVAL_LABEL: &str = "wobble speed, 95 % interval";
+const LINE_LABEL: &str = "robust line, bent by the shape prior";
+/// The longest entries the key can hold (speeds as wide as they are drawn).
+const KEY_LABELS: [&str; 5] = [
+    BAND_LABEL,
+    INTERVAL_LABEL,
+    LINE_LABEL,
+    "predicted wobble speed 00.00 m/s",
+    "fitted model, wobble speed 00.00 m/s",
+];

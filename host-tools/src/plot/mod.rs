@@ -4,6 +4,7 @@
 //! Text is drawn with the DejaVu Sans font compiled into the program, so
 //! plotting needs no system font libraries; an SVG carries the font with it.
 
+pub mod key;
 pub mod margin;
 pub mod modes;
 mod svg_font;
@@ -26,12 +27,131 @@ use crate::CliError;
 pub const FONT: &str = "DejaVu Sans";
 static FONT_BYTES: &[u8] = include_bytes!("../../assets/DejaVuSans.ttf");
 
-/// A figure that can draw itself on any plotters backend.
+/// A figure that can draw itself on any plotters backend, at any size.
 pub trait Figure {
-    /// Pixel size of the figure.
+    /// The figure's own size, px, when `--size` does not give one.
     fn size_px(&self) -> (u32, u32);
-    /// Draws the figure on `root`.
+    /// Draws the figure on `root`, laid out to `root`'s size.
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String>;
+}
+
+/// Layout pixels per inch: a figure is laid out in CSS pixels, so an SVG
+/// opens at its size and a PNG at `--dpi 96` has one pixel per layout pixel.
+pub const PX_PER_INCH: f64 = 96.0;
+
+/// `--size` and `--dpi`, shared by every command that draws a figure.
+#[derive(clap::Args, Clone, Debug)]
+pub struct FigureArgs {
+    /// Figure size, `WxH`, in layout pixels (96 to the inch) or with a unit
+    /// for both: `1400x900`, `7x4.5in`, `18x11cm`, `180x110mm`. Text keeps
+    /// its size, so a larger figure holds more detail, not larger letters.
+    /// Default: the figure's own size.
+    #[arg(long, value_name = "WxH[UNIT]", value_parser = parse_size)]
+    pub size: Option<(u32, u32)>,
+    /// PNG resolution, dots per inch: 96 draws one pixel per layout pixel,
+    /// 300 a print-ready image of the same figure. SVG is drawn without a
+    /// resolution and ignores it.
+    #[arg(long, value_name = "DPI", default_value_t = PX_PER_INCH, value_parser = parse_dpi)]
+    pub dpi: f64,
+}
+
+/// The smallest figure drawn, layout px: below it axes and keys overlap.
+pub const MIN_SIZE_PX: (u32, u32) = (480, 320);
+/// The largest PNG drawn, pixels: a typing slip must not ask for gigabytes.
+const MAX_PNG_PIXELS: f64 = 200e6;
+
+/// `--size`: `WxH` with an optional unit (`px`, `in`, `cm`, `mm`), in
+/// layout pixels.
+///
+/// # Errors
+/// What is wrong with `text`, with an example.
+pub fn parse_size(text: &str) -> Result<(u32, u32), String> {
+    let t = text.trim().to_ascii_lowercase();
+    let (number, px_per_unit) = [
+        ("px", 1.0),
+        ("in", PX_PER_INCH),
+        ("cm", PX_PER_INCH / 2.54),
+        ("mm", PX_PER_INCH / 25.4),
+    ]
+    .into_iter()
+    .find_map(|(unit, scale)| t.strip_suffix(unit).map(|n| (n, scale)))
+    .unwrap_or((&t, 1.0));
+    let bad = |why: &str| {
+        format!("{why}: give WxH with an optional unit (px, in, cm, mm), as 1400x900 or 7x4.5in")
+    };
+    let (w, h) = number
+        .split_once('x')
+        .ok_or_else(|| bad("no `x` between width and height"))?;
+    let side = |v: &str| -> Result<f64, String> {
+        let v: f64 = v
+            .trim()
+            .parse()
+            .map_err(|_| bad(&format!("`{}` is not a number", v.trim())))?;
+        Ok(v * px_per_unit)
+    };
+    let (w, h) = (side(w)?, side(h)?);
+    let (min_w, min_h) = MIN_SIZE_PX;
+    if !(w >= f64::from(min_w) && h >= f64::from(min_h)) {
+        return Err(format!(
+            "{text} is {w:.0}x{h:.0} px; figures are at least {min_w}x{min_h} px ({:.1}x{:.1} in)",
+            f64::from(min_w) / PX_PER_INCH,
+            f64::from(min_h) / PX_PER_INCH
+        ));
+    }
+    if w * h > MAX_PNG_PIXELS {
+        return Err(format!(
+            "{text} is {w:.0}x{h:.0} px, larger than any figure needs"
+        ));
+    }
+    Ok((w.round() as u32, h.round() as u32))
+}
+
+/// `--dpi`: 24 to 2400.
+///
+/// # Errors
+/// `text` is not a number in that range.
+pub fn parse_dpi(text: &str) -> Result<f64, String> {
+    match text.trim().parse::<f64>() {
+        Ok(dpi) if (24.0..=2400.0).contains(&dpi) => Ok(dpi),
+        _ => Err(format!(
+            "{text}: give dots per inch from 24 to 2400 (300 for print)"
+        )),
+    }
+}
+
+impl Default for FigureArgs {
+    /// Each figure's own size at 96 dpi.
+    fn default() -> Self {
+        Self {
+            size: None,
+            dpi: PX_PER_INCH,
+        }
+    }
+}
+
+impl FigureArgs {
+    /// The size to draw `figure` at.
+    #[must_use]
+    pub fn size_of(&self, figure: &impl Figure) -> (u32, u32) {
+        self.size.unwrap_or_else(|| figure.size_px())
+    }
+
+    /// The PNG's size in pixels for a figure of `size` layout px.
+    ///
+    /// # Errors
+    /// The image would be larger than any figure needs.
+    pub fn png_pixels(&self, (w, h): (u32, u32)) -> Result<(u32, u32), String> {
+        let scale = self.dpi / PX_PER_INCH;
+        let (pw, ph) = (f64::from(w) * scale, f64::from(h) * scale);
+        if pw * ph > MAX_PNG_PIXELS {
+            return Err(format!(
+                "{pw:.0}x{ph:.0} pixels at {} dpi is larger than any figure needs; \
+                 lower --dpi or --size",
+                self.dpi
+            ));
+        }
+        Ok(((pw.round() as u32).max(1), (ph.round() as u32).max(1)))
+    }
 }
 
 /// Image file types, chosen by the output file's extension.
@@ -60,41 +180,70 @@ impl ImageKind {
     }
 }
 
-/// Draws `figure` into `out`, PNG or SVG by the output's extension, and
-/// commits it. The image is drawn in memory (plotters' own file writing
-/// would bypass the atomic output and report errors as debug text).
-pub fn render(figure: &impl Figure, mut out: Output) -> Result<(), CliError> {
+/// Draws `figure` into `out`, PNG or SVG by the output's extension, at
+/// `look`'s size and resolution, and commits it. The image is drawn in
+/// memory (plotters' own file writing would bypass the atomic output and
+/// report errors as debug text).
+pub fn render(figure: &impl Figure, mut out: Output, look: &FigureArgs) -> Result<(), CliError> {
     let kind = ImageKind::of(out.name())?;
-    register_font();
-    let bytes = draw(figure, kind)
+    let bytes = draw(figure, kind, look)
         .map_err(|e| CliError::file(out.name(), format!("cannot draw the plot: {e}")))?;
     out.write_all(&bytes).map_err(|e| out.error(e))?;
     out.commit()
 }
 
-fn draw(figure: &impl Figure, kind: ImageKind) -> Result<Vec<u8>, String> {
-    let size = figure.size_px();
+/// The figure as an image file's bytes. A PNG is the SVG rasterised by
+/// resvg: anti-aliased at any resolution, and the same drawing as the SVG.
+fn draw(figure: &impl Figure, kind: ImageKind, look: &FigureArgs) -> Result<Vec<u8>, String> {
+    let size = look.size_of(figure);
+    let svg = svg_at(figure, size)?;
     match kind {
-        ImageKind::Png => {
-            let (w, h) = size;
-            let mut pixels = vec![0u8; w as usize * h as usize * 3];
-            {
-                let root = BitMapBackend::with_buffer(&mut pixels, size).into_drawing_area();
-                figure.draw(&root)?;
-                root.present().map_err(|e| e.to_string())?;
-            }
-            encode_png(&pixels, size).map_err(|e| e.to_string())
-        }
-        ImageKind::Svg => {
-            let mut svg = String::new();
-            {
-                let root = SVGBackend::with_string(&mut svg, size).into_drawing_area();
-                figure.draw(&root)?;
-                root.present().map_err(|e| e.to_string())?;
-            }
-            Ok(svg_font::embed(&svg, FONT, FONT_BYTES)?.into_bytes())
-        }
+        ImageKind::Png => rasterise(&svg, size, look.png_pixels(size)?),
+        ImageKind::Svg => Ok(svg_font::embed(&svg, FONT, FONT_BYTES)?.into_bytes()),
     }
+}
+
+/// `figure` drawn at `size` as SVG text, without an embedded font.
+fn svg_at(figure: &impl Figure, size: (u32, u32)) -> Result<String, String> {
+    register_font();
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, size).into_drawing_area();
+        figure.draw(&root)?;
+        root.present().map_err(|e| e.to_string())?;
+    }
+    Ok(svg)
+}
+
+/// `svg` (laid out at `size` px) as a PNG of `pixels`, over white.
+fn rasterise(svg: &str, size: (u32, u32), pixels: (u32, u32)) -> Result<Vec<u8>, String> {
+    use resvg::{tiny_skia, usvg};
+    static FONTS: std::sync::OnceLock<std::sync::Arc<usvg::fontdb::Database>> =
+        std::sync::OnceLock::new();
+    let fonts = FONTS.get_or_init(|| {
+        let mut db = usvg::fontdb::Database::new();
+        db.load_font_data(FONT_BYTES.to_vec());
+        std::sync::Arc::new(db)
+    });
+    let options = usvg::Options {
+        font_family: FONT.into(),
+        fontdb: fonts.clone(),
+        ..usvg::Options::default()
+    };
+    let tree = usvg::Tree::from_str(svg, &options).map_err(|e| e.to_string())?;
+    let (w, h) = pixels;
+    let mut pixmap = tiny_skia::Pixmap::new(w, h).ok_or("the image has no pixels")?;
+    pixmap.fill(tiny_skia::Color::WHITE);
+    let scale = |px: u32, layout: u32| px as f32 / layout.max(1) as f32;
+    let transform = tiny_skia::Transform::from_scale(scale(w, size.0), scale(h, size.1));
+    resvg::render(&tree, transform, &mut pixmap.as_mut());
+    // Every pixel is opaque over the white fill: premultiplied RGBA is RGB.
+    let rgb: Vec<u8> = pixmap
+        .data()
+        .chunks_exact(4)
+        .flat_map(|p| [p[0], p[1], p[2]])
+        .collect();
+    encode_png(&rgb, pixels).map_err(|e| e.to_string())
 }
 
 /// `figure` as SVG text to place inside a page, without the embedded font
@@ -104,14 +253,7 @@ fn draw(figure: &impl Figure, kind: ImageKind) -> Result<Vec<u8>, String> {
 /// # Errors
 /// The backend's error, as text.
 pub fn svg_inline(figure: &impl Figure) -> Result<String, String> {
-    register_font();
-    let mut svg = String::new();
-    {
-        let root = SVGBackend::with_string(&mut svg, figure.size_px()).into_drawing_area();
-        figure.draw(&root)?;
-        root.present().map_err(|e| e.to_string())?;
-    }
-    Ok(svg)
+    svg_at(figure, figure.size_px())
 }
 
 /// 8-bit RGB pixels, row by row, as a PNG file.
@@ -234,21 +376,23 @@ pub fn titled_page<DB: DrawingBackend>(
     root.titled(title, (FONT, 20)).map_err(|e| e.to_string())
 }
 
-/// A chart of `x_range` by `y_range` on `area`, `margin_px` from its edge,
-/// with its mesh drawn: `x_desc` and `y_desc` as the axes' names and
+/// A chart of `x_range` by `y_range` on `area`, `margin_px` from its edge
+/// and `key_px` from its right edge (room for [`draw_key_beside`]), with
+/// its mesh drawn: `x_desc` and `y_desc` as the axes' names and
 /// [`tick_label`] ticks. The axes of the margin and mode figures.
 ///
 /// # Errors
 /// The backend's error, as text.
 pub fn numbers_chart<'a, DB: DrawingBackend>(
     area: &'a DrawingArea<DB, Shift>,
-    margin_px: u32,
+    (margin_px, key_px): (u32, u32),
     (x_range, y_range): (Range<f64>, Range<f64>),
     (x_desc, y_desc): (&str, &str),
 ) -> Result<ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>, String> {
     let err = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
     let mut chart = ChartBuilder::on(area)
         .margin(margin_px)
+        .margin_right(margin_px.max(key_px))
         .x_label_area_size(44)
         .y_label_area_size(64)
         .build_cartesian_2d(x_range, y_range)

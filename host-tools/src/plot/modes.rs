@@ -84,8 +84,8 @@ pub struct ModePlot {
     runs: Vec<(String, Vec<Episode>)>,
 }
 
-/// Figure size, px: the complex plane on the left, the two speed panels in
-/// the middle, the key on the right.
+/// The figure's own size, px: the complex plane on the left, the two speed
+/// panels in the middle, the key on the right.
 const SIZE_PX: (u32, u32) = (1400, 720);
 /// Width of the key, px.
 const KEY_PX: u32 = 200;
@@ -158,7 +158,7 @@ impl ModePlot {
             SigmaAxis::None => 1.0,
         };
         let y_range = padded_range(ys, y_span);
-        let mut chart = numbers_chart(area, 12, (x_range.clone(), y_range.clone()), labels)?;
+        let mut chart = numbers_chart(area, (12, 0), (x_range.clone(), y_range.clone()), labels)?;
         let zero_line = match sigma_on {
             SigmaAxis::X => Some(vec![(0.0, y_range.start), (0.0, y_range.end)]),
             SigmaAxis::Y => Some(vec![(x_range.start, 0.0), (x_range.end, 0.0)]),
@@ -217,9 +217,10 @@ impl Figure for ModePlot {
 
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String> {
         let root = titled_page(root, "Wobble modes")?;
-        let (plots, key) = root.split_horizontally(SIZE_PX.0 - KEY_PX);
-        let (plane, by_speed) = plots.split_horizontally((SIZE_PX.0 - KEY_PX) * 11 / 20);
-        let (sigma, freq) = by_speed.split_vertically((SIZE_PX.1 - 30) / 2);
+        let (w, h) = root.dim_in_pixel();
+        let (plots, key) = root.split_horizontally(w.saturating_sub(KEY_PX));
+        let (plane, by_speed) = plots.split_horizontally(w.saturating_sub(KEY_PX) * 11 / 20);
+        let (sigma, freq) = by_speed.split_vertically(h / 2);
         self.panel(
             &plane,
             (X_LABEL, Y_LABEL),

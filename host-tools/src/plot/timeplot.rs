@@ -6,6 +6,7 @@ use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
+use super::key::{self, Swatch};
 use super::{padded_range, tick_label, titled_page, Decimator, Figure, FONT};
 use crate::analysis::filter::follows;
 use crate::analysis::roll::RollStream;
@@ -66,12 +67,12 @@ pub struct TimePlot {
     /// Sync pairs and the UTC midnight (ms since 1970) before the
     /// window's start, when the time axis is in UTC.
     utc: Option<(Vec<SyncPair>, i64)>,
+    /// Figure width, px: the lines are kept at twice its resolution.
+    width_px: u32,
 }
 
-/// Figure width, px.
-const WIDTH_PX: u32 = 1200;
-/// Height of each panel, px.
-const PANEL_HEIGHT_PX: u32 = 220;
+/// The figure's own size, px: 220 px a panel below the title.
+pub const SIZE_PX: (u32, u32) = (1200, 40 + 220 * PANELS.len() as u32);
 
 /// Builds a [`TimePlot`] in one pass over the frames, in memory that does
 /// not grow with the run: each panel keeps its lowest and highest point per
@@ -119,8 +120,8 @@ impl Panels {
 impl TimePlotBuilder {
     /// The figure of the run `name`, whose frames span `data_s` (first and
     /// last in file order) at `fs_hz`, between `from_s` and `to_s` (the whole
-    /// run where absent), shading and marking what `summary` records.
-    /// `None` if no frame can fall in the window.
+    /// run where absent), shading and marking what `summary` records, for
+    /// a figure `width_px` wide. `None` if no frame can fall in the window.
     #[must_use]
     pub fn new(
         name: &str,
@@ -128,6 +129,7 @@ impl TimePlotBuilder {
         data_s: (f64, f64),
         fs_hz: f64,
         (from_s, to_s): (Option<f64>, Option<f64>),
+        width_px: u32,
     ) -> Option<Self> {
         let (first, last) = data_s;
         let window_s = from_s.unwrap_or(first).max(first)..to_s.unwrap_or(last).min(last);
@@ -151,7 +153,7 @@ impl TimePlotBuilder {
             .collect();
         // One tick per pixel column at most: a log of 100 000 kick records
         // would otherwise draw each of them.
-        let column_s = (window_s.end - window_s.start) / f64::from(WIDTH_PX);
+        let column_s = (window_s.end - window_s.start) / f64::from(width_px);
         let mut kicks_s: Vec<f64> = summary
             .kick_records
             .iter()
@@ -176,7 +178,7 @@ impl TimePlotBuilder {
             .filter(|&(a, b)| a < b && overlaps(a, b))
             .map(clip)
             .collect();
-        let columns = 2 * WIDTH_PX as usize;
+        let columns = 2 * width_px as usize;
         Some(Self {
             panels: Panels {
                 lines: std::array::from_fn(|_| Decimator::new(&window_s, columns)),
@@ -192,6 +194,7 @@ impl TimePlotBuilder {
                     lost_s,
                     jumps_s,
                     utc: None,
+                    width_px,
                 },
                 period_s: 1.0 / fs_hz,
                 last_s: None,
@@ -236,6 +239,7 @@ impl TimePlot {
             data_s,
             run.sample_rate_hz(),
             (from_s, to_s),
+            SIZE_PX.0,
         )?;
         for i in 0..run.len() {
             builder.push(run, i);
@@ -320,12 +324,11 @@ impl TimePlot {
         &self.episodes_s
     }
 
-    /// `span` widened about its middle to [`MIN_SPAN_PX`] when narrower,
-    /// within the window.
+    /// `span` widened about its middle to [`MIN_SPAN_PX`] of a plot
+    /// `plot_px` wide when narrower, within the window.
     #[must_use]
-    pub fn visible(&self, (a, b): (f64, f64)) -> (f64, f64) {
+    pub fn visible(&self, (a, b): (f64, f64), plot_px: f64) -> (f64, f64) {
         let w = &self.window_s;
-        let plot_px = f64::from(WIDTH_PX - Y_LABEL_AREA_PX - 30);
         let min_s = (w.end - w.start) * MIN_SPAN_PX / plot_px;
         if b - a >= min_s {
             return (a, b);
@@ -378,12 +381,59 @@ impl TimePlot {
 
 impl Figure for TimePlot {
     fn size_px(&self) -> (u32, u32) {
-        (WIDTH_PX, 40 + PANEL_HEIGHT_PX * PANELS.len() as u32)
+        (self.width_px, SIZE_PX.1)
     }
 
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String> {
         let err = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
         let root = titled_page(root, &self.title)?;
+        // The shaded spans, each kind in the key if present.
+        let shaded = [
+            (
+                &self.alerts_s,
+                ALERT_COLOUR.mix(0.18),
+                "wobble alert (on board)",
+            ),
+            (
+                &self.lost_s,
+                LOST_COLOUR.mix(0.35),
+                "data lost (missing blocks)",
+            ),
+            (
+                &self.jumps_s,
+                JUMP_COLOUR.mix(0.3),
+                "time jump (logger clock)",
+            ),
+            (
+                &self.episodes_s,
+                EPISODE_COLOUR.mix(0.22),
+                "wobble episode (host)",
+            ),
+            (
+                &self.weave_s,
+                WEAVE_COLOUR.mix(0.22),
+                "weave ring-down (host)",
+            ),
+        ];
+        let entries: Vec<(String, Swatch)> = shaded
+            .iter()
+            .filter(|(spans, ..)| !spans.is_empty())
+            .map(|&(_, colour, label)| (label.to_string(), Swatch::Fill(colour)))
+            .chain(
+                (!self.markers_s.is_empty())
+                    .then(|| ("rider marker".into(), Swatch::Upright(MARKER_COLOUR, 2))),
+            )
+            .chain((!self.kicks_s.is_empty()).then(|| {
+                (
+                    "kick record (board)".into(),
+                    Swatch::Upright(KICK_COLOUR, 3),
+                )
+            }))
+            .collect();
+        // The key stands beside the top panel; every panel leaves its
+        // room so the time axes line up.
+        let labels: Vec<&str> = entries.iter().map(|e| e.0.as_str()).collect();
+        let key_px = key::width_px(&root, &labels)?;
         let panels = root.split_evenly((PANELS.len(), 1));
         let last = PANELS.len() - 1;
         for (k, ((area, label), series)) in panels.iter().zip(PANELS).zip(&self.series).enumerate()
@@ -392,7 +442,7 @@ impl Figure for TimePlot {
             // The bottom panel also holds the time axis's title.
             let x_label_px = if k == last { 48 } else { 28 };
             let mut chart = ChartBuilder::on(area)
-                .margin_right(20)
+                .margin_right(20.max(key_px))
                 .margin_left(10)
                 .margin_top(6)
                 .x_label_area_size(x_label_px)
@@ -421,49 +471,17 @@ impl Figure for TimePlot {
                 .light_line_style(WHITE.mix(0.0))
                 .draw()
                 .map_err(err)?;
+            let plot_px = f64::from(chart.plotting_area().dim_in_pixel().0);
             let span = |&s: &(f64, f64), colour: RGBAColor| {
-                let (a, b) = self.visible(s);
+                let (a, b) = self.visible(s, plot_px);
                 Rectangle::new([(self.x(a), y.start), (self.x(b), y.end)], colour.filled())
             };
-            // The shaded spans, each kind in the key of the top panel if present.
-            let shaded = [
-                (
-                    &self.alerts_s,
-                    ALERT_COLOUR.mix(0.18),
-                    "wobble alert (on board)",
-                ),
-                (
-                    &self.lost_s,
-                    LOST_COLOUR.mix(0.35),
-                    "data lost (missing blocks)",
-                ),
-                (
-                    &self.jumps_s,
-                    JUMP_COLOUR.mix(0.3),
-                    "time jump (logger clock)",
-                ),
-                (
-                    &self.episodes_s,
-                    EPISODE_COLOUR.mix(0.22),
-                    "wobble episode (host)",
-                ),
-                (
-                    &self.weave_s,
-                    WEAVE_COLOUR.mix(0.22),
-                    "weave ring-down (host)",
-                ),
-            ];
-            for (spans, colour, label) in shaded {
-                let drawn = chart
+            for (spans, colour, _) in shaded {
+                chart
                     .draw_series(spans.iter().map(|s| span(s, colour)))
                     .map_err(err)?;
-                if k == 0 && !spans.is_empty() {
-                    drawn.label(label).legend(move |(x, y)| {
-                        Rectangle::new([(x, y - 6), (x + 16, y + 6)], colour.filled())
-                    });
-                }
             }
-            let markers = chart
+            chart
                 .draw_series(self.markers_s.iter().map(|&t| {
                     PathElement::new(
                         vec![(self.x(t), y.start), (self.x(t), y.end)],
@@ -471,17 +489,9 @@ impl Figure for TimePlot {
                     )
                 }))
                 .map_err(err)?;
-            if k == 0 && !self.markers_s.is_empty() {
-                markers.label("rider marker").legend(|(x, y)| {
-                    PathElement::new(
-                        vec![(x + 8, y - 7), (x + 8, y + 7)],
-                        MARKER_COLOUR.stroke_width(2),
-                    )
-                });
-            }
             // The board's kick records: a tick along the top of each panel.
             let tick = (y.end - y.start) * 0.15;
-            let kicks = chart
+            chart
                 .draw_series(self.kicks_s.iter().map(|&t| {
                     PathElement::new(
                         vec![(self.x(t), y.end - tick), (self.x(t), y.end)],
@@ -489,14 +499,6 @@ impl Figure for TimePlot {
                     )
                 }))
                 .map_err(err)?;
-            if k == 0 && !self.kicks_s.is_empty() {
-                kicks.label("kick record (board)").legend(|(x, y)| {
-                    PathElement::new(
-                        vec![(x + 8, y - 7), (x + 8, y + 7)],
-                        KICK_COLOUR.stroke_width(3),
-                    )
-                });
-            }
             for points in series {
                 let line =
                     LineSeries::new(points.iter().map(|&(t, v)| (self.x(t), v)), LINE_COLOUR);
@@ -508,22 +510,8 @@ impl Figure for TimePlot {
                 };
                 chart.draw_series(line).map_err(err)?;
             }
-            let keyed = !(self.alerts_s.is_empty()
-                && self.lost_s.is_empty()
-                && self.jumps_s.is_empty()
-                && self.markers_s.is_empty()
-                && self.kicks_s.is_empty()
-                && self.episodes_s.is_empty()
-                && self.weave_s.is_empty());
-            if k == 0 && keyed {
-                chart
-                    .configure_series_labels()
-                    .label_font((FONT, 13))
-                    .background_style(WHITE.mix(0.9))
-                    .border_style(BLACK.mix(0.5))
-                    .position(SeriesLabelPosition::UpperLeft)
-                    .draw()
-                    .map_err(err)?;
+            if k == 0 {
+                key::draw(area, chart.plotting_area(), key_px, &entries)?;
             }
         }
         Ok(())

@@ -32,6 +32,9 @@ pub struct Args {
     /// Speeds of the model curve FROM:TO:STEP, m/s.
     #[arg(long, default_value = "0:10:0.05")]
     pub speeds: Speeds,
+    /// The figure's size and resolution (`--size`, `--dpi`).
+    #[command(flatten)]
+    pub figure: crate::plot::FigureArgs,
 }
 
 /// Runs `wobblog model compare`.
@@ -85,7 +88,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
     // committed then, and an old one stays as it was.
     if let (Some(out), Ok(())) = (out, &loaded) {
         let figure = figure(&set.name, &model, &args.speeds.0, &args.params, &found)?;
-        render(&figure, out)?;
+        render(&figure, out, &args.figure)?;
     }
     loaded
 }

@@ -5,12 +5,12 @@
 //! and measured points can be laid over it (Figure 8).
 
 use plotters::coord::Shift;
-use plotters::element::DashedPathElement;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 use wobble_model::sweep::REAL_TOL;
 use wobble_model::{Mode, Sweep};
 
+use crate::plot::key::{self, Swatch};
 use crate::plot::{padded_range, Figure, FONT};
 
 /// How a sweep's lines are drawn.
@@ -24,6 +24,18 @@ pub enum Line {
     Dotted,
     /// Dashed (a second model).
     Dashed,
+}
+
+impl Line {
+    /// Stroke width, px, and dash and gap lengths of a broken line.
+    fn stroke(self) -> (u32, Option<(u32, u32)>) {
+        match self {
+            Self::Thick => (3, None),
+            Self::Thin => (1, None),
+            Self::Dotted => (2, Some((2, 4))),
+            Self::Dashed => (2, Some((8, 6))),
+        }
+    }
 }
 
 /// One sweep on the figure.
@@ -145,10 +157,38 @@ impl EigenFigure {
         })
     }
 
+    /// The key's name of `mode` drawn from `layer`.
+    fn key_name(&self, mode: Mode, layer: &Layer) -> String {
+        if self.layers.len() > 1 {
+            format!("{mode}: {}", layer.label)
+        } else {
+            mode.to_string()
+        }
+    }
+
+    /// Every name the key holds, in order.
+    fn key_names(&self) -> Vec<String> {
+        let mut names: Vec<String> = Vec::new();
+        for (layer, branch) in self.branches() {
+            let name = self.key_name(branch.mode, layer);
+            if !names.contains(&name) {
+                names.push(name);
+            }
+        }
+        if !self.measured.is_empty() {
+            names.push(MEASURED_LABEL.into());
+        }
+        names
+    }
+
+    /// One panel: the real parts with the key beside them, or the
+    /// frequencies; both leave `key_px` on the right so their speed axes
+    /// line up.
     fn panel<DB: DrawingBackend>(
         &self,
         area: &DrawingArea<DB, Shift>,
         frequency: bool,
+        key_px: u32,
     ) -> Result<(), String> {
         let err = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
         let pick = |v: wobble_model::Complex<f64>| {
@@ -183,6 +223,7 @@ impl EigenFigure {
         let mut chart = ChartBuilder::on(area)
             .caption(caption, (FONT, 20))
             .margin(12)
+            .margin_right(12.max(key_px))
             .x_label_area_size(36)
             .y_label_area_size(56)
             .build_cartesian_2d(x.clone(), y)
@@ -203,51 +244,38 @@ impl EigenFigure {
                 )))
                 .map_err(err)?;
         }
-        let mut labelled: Vec<(Mode, String)> = Vec::new();
+        let mut entries: Vec<(String, Swatch)> = Vec::new();
         for (layer, branch) in self.branches() {
             let c = colour(branch.mode);
             for run in runs(
                 &layer.sweep.speeds_mps,
                 branch.values.iter().map(|v| pick(*v)),
             ) {
-                let series = match layer.line {
-                    Line::Thick => chart.draw_series(LineSeries::new(
-                        spaced(run, |p| chart.backend_coord(p)),
-                        c.stroke_width(3),
-                    )),
-                    Line::Thin => chart.draw_series(LineSeries::new(run, c.stroke_width(1))),
-                    Line::Dotted => {
-                        chart.draw_series(DashedLineSeries::new(run, 2, 4, c.stroke_width(2)))
-                    }
-                    Line::Dashed => {
-                        chart.draw_series(DashedLineSeries::new(run, 8, 6, c.stroke_width(2)))
-                    }
+                let (width, dashes) = layer.line.stroke();
+                let style = c.stroke_width(width);
+                match (layer.line, dashes) {
+                    (Line::Thick, _) => chart
+                        .draw_series(LineSeries::new(
+                            spaced(run, |p| chart.backend_coord(p)),
+                            style,
+                        ))
+                        .map(drop),
+                    (_, Some((dash, gap))) => chart
+                        .draw_series(DashedLineSeries::new(run, dash, gap, style))
+                        .map(drop),
+                    (_, None) => chart.draw_series(LineSeries::new(run, style)).map(drop),
                 }
                 .map_err(err)?;
-                let key = (branch.mode, layer.label.clone());
-                if !frequency && !labelled.contains(&key) {
-                    let name = if self.layers.len() > 1 {
-                        format!("{} ({})", branch.mode, layer.label)
-                    } else {
-                        branch.mode.to_string()
-                    };
-                    // The key's swatch drawn as the line is: dotted and
+                let name = self.key_name(branch.mode, layer);
+                if !frequency && !entries.iter().any(|e| e.0 == name) {
+                    // The key's swatch is drawn as the line is: dotted and
                     // dashed layers must be told apart there too.
-                    let (width, dash, gap) = match layer.line {
-                        Line::Thick => (3, 24, 0),
-                        Line::Thin => (1, 24, 0),
-                        Line::Dotted => (2, 2, 4),
-                        Line::Dashed => (2, 8, 6),
+                    let swatch = Swatch::Line {
+                        colour: c,
+                        width,
+                        dashes,
                     };
-                    series.label(name).legend(move |(px, py)| {
-                        DashedPathElement::new(
-                            vec![(px, py), (px + 24, py)],
-                            dash,
-                            gap,
-                            c.stroke_width(width),
-                        )
-                    });
-                    labelled.push(key);
+                    entries.push((name, swatch));
                 }
             }
         }
@@ -288,38 +316,35 @@ impl EigenFigure {
             }
         }
         if !self.measured.is_empty() {
-            let s = chart
+            chart
                 .draw_series(self.measured.iter().map(dot))
                 .map_err(err)?;
-            if !frequency {
-                s.label("measured (open: censored)")
-                    .legend(|(px, py)| Circle::new((px + 8, py), 4, BLACK.filled()));
-            }
+            entries.push((MEASURED_LABEL.into(), Swatch::Dot(BLACK, 4)));
         }
-        if !frequency {
-            chart
-                .configure_series_labels()
-                .label_font((FONT, 13))
-                .background_style(WHITE.mix(0.85))
-                .border_style(BLACK)
-                .position(SeriesLabelPosition::LowerLeft)
-                .draw()
-                .map_err(err)?;
+        if frequency {
+            return Ok(());
         }
-        Ok(())
+        key::draw(area, chart.plotting_area(), key_px, &entries)
     }
 }
 
+/// The key's name for measured points.
+const MEASURED_LABEL: &str = "measured (open: censored)";
+
 impl Figure for EigenFigure {
     fn size_px(&self) -> (u32, u32) {
-        (1000, 900)
+        (1200, 900)
     }
 
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String> {
         root.fill(&WHITE).map_err(|e| e.to_string())?;
-        let (top, bottom) = root.split_vertically(480);
-        self.panel(&top, false)?;
-        self.panel(&bottom, true)
+        let key_px = key::width_px(root, &self.key_names())?;
+        // The real parts, with the title and the key, take a little more
+        // than half the height.
+        let (_, h) = root.dim_in_pixel();
+        let (top, bottom) = root.split_vertically(h * 8 / 15);
+        self.panel(&top, false, key_px)?;
+        self.panel(&bottom, true, key_px)
     }
 }
 

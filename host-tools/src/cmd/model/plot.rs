@@ -41,6 +41,9 @@ pub struct Args {
     /// Also draw the twist and the modes named `other` (tyre lags, ...).
     #[arg(long)]
     pub all_modes: bool,
+    /// The figure's size and resolution (`--size`, `--dpi`).
+    #[command(flatten)]
+    pub figure: crate::plot::FigureArgs,
 }
 
 /// Runs `wobblog model plot`.
@@ -76,7 +79,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         measured: Vec::new(),
         critical,
     };
-    render(&figure, out)
+    render(&figure, out, &args.figure)
 }
 
 fn label(model: &Model) -> String {

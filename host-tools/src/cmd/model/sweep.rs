@@ -34,6 +34,9 @@ pub struct Args {
     /// Also draw the figure into this `.png` or `.svg` file.
     #[arg(short, long)]
     pub output: Option<PathBuf>,
+    /// The figure's size and resolution (`--size`, `--dpi`).
+    #[command(flatten)]
+    pub figure: crate::plot::FigureArgs,
 }
 
 /// One variant of the parameter set: a parameter of the file scaled, or
@@ -102,7 +105,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
             measured: Vec::new(),
             critical: Vec::new(),
         };
-        render(&figure, out)?;
+        render(&figure, out, &args.figure)?;
     }
     Ok(())
 }

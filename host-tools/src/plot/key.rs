@@ -1,0 +1,163 @@
+//! A figure's key, drawn beside its plot rather than over the data: the
+//! chart leaves [`width_px`] free on its right and [`draw`] fills it.
+//! (plotters' own series labels clip their swatches to the plotting area,
+//! so they can only sit on the data.)
+
+use plotters::coord::{CoordTranslate, Shift};
+use plotters::element::DashedPathElement;
+use plotters::prelude::*;
+
+use super::FONT;
+
+/// Text size of a key, px.
+const FONT_PX: u32 = 13;
+/// Space between a plot and its key, px.
+const GAP_PX: u32 = 12;
+/// Width of an entry's swatch, px.
+const SWATCH_PX: i32 = 24;
+/// Padding inside the key's border, px.
+const PADDING_PX: i32 = 6;
+/// Space between the key and the figure's edge, px.
+const EDGE_PX: u32 = 6;
+/// Height of one entry, px.
+const LINE_PX: i32 = 18;
+
+/// How an entry shows what it names.
+#[derive(Clone, Copy, Debug)]
+pub enum Swatch {
+    /// A filled box (a shaded span or band).
+    Fill(RGBAColor),
+    /// A short upright line (a marker across the plot), of this width.
+    Upright(RGBColor, u32),
+    /// A line along the swatch.
+    Line {
+        /// Colour.
+        colour: RGBColor,
+        /// Stroke width, px.
+        width: u32,
+        /// Dash and gap lengths, px, for a broken line.
+        dashes: Option<(u32, u32)>,
+    },
+    /// A filled dot of this radius.
+    Dot(RGBColor, i32),
+}
+
+impl Swatch {
+    /// A solid line of `width`.
+    #[must_use]
+    pub fn line(colour: RGBColor, width: u32) -> Self {
+        Self::Line {
+            colour,
+            width,
+            dashes: None,
+        }
+    }
+
+    fn draw<DB: DrawingBackend>(
+        self,
+        area: &DrawingArea<DB, Shift>,
+        (x, y): (i32, i32),
+    ) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
+        let end = x + SWATCH_PX;
+        match self {
+            Self::Fill(colour) => area.draw(&Rectangle::new(
+                [(x + 2, y - 6), (end - 2, y + 6)],
+                colour.filled(),
+            )),
+            Self::Upright(colour, width) => {
+                let mid = x + SWATCH_PX / 2;
+                area.draw(&PathElement::new(
+                    vec![(mid, y - 7), (mid, y + 7)],
+                    colour.stroke_width(width),
+                ))
+            }
+            Self::Line {
+                colour,
+                width,
+                dashes,
+            } => {
+                let path = vec![(x, y), (end, y)];
+                let style = colour.stroke_width(width);
+                match dashes {
+                    Some((dash, gap)) => area.draw(&DashedPathElement::new(path, dash, gap, style)),
+                    None => area.draw(&PathElement::new(path, style)),
+                }
+            }
+            Self::Dot(colour, r) => {
+                area.draw(&Circle::new((x + SWATCH_PX / 2, y), r, colour.filled()))
+            }
+        }
+    }
+}
+
+/// The margin a key of `labels` needs beside a plot, px: the gaps, the
+/// swatch, the padding and the widest label; 0 for no labels.
+///
+/// # Errors
+/// The font cannot measure the text.
+pub fn width_px<DB: DrawingBackend, S: AsRef<str>>(
+    area: &DrawingArea<DB, Shift>,
+    labels: &[S],
+) -> Result<u32, String> {
+    let font = TextStyle::from((FONT, FONT_PX).into_font());
+    let mut widest = None;
+    for label in labels {
+        let (w, _) = area
+            .estimate_text_size(label.as_ref(), &font)
+            .map_err(|e| e.to_string())?;
+        widest = widest.max(Some(w));
+    }
+    Ok(widest.map_or(0, |w| {
+        GAP_PX + SWATCH_PX.unsigned_abs() + 3 * PADDING_PX.unsigned_abs() + w + EDGE_PX
+    }))
+}
+
+/// Draws the key of `entries` (label and swatch, top to bottom) in the
+/// right `width_px` of `area` (the [`width_px`] of its labels), level with
+/// the top of `plot`, the chart's plotting area.
+///
+/// # Errors
+/// The backend's error, as text.
+pub fn draw<DB: DrawingBackend, CT: CoordTranslate>(
+    area: &DrawingArea<DB, Shift>,
+    plot: &DrawingArea<DB, CT>,
+    width_px: u32,
+    entries: &[(String, Swatch)],
+) -> Result<(), String> {
+    if entries.is_empty() {
+        return Ok(());
+    }
+    let top = plot.get_base_pixel().1 - area.get_base_pixel().1;
+    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
+    let (w, _) = area.dim_in_pixel();
+    let left = i32::try_from(w.saturating_sub(width_px) + GAP_PX).map_err(|e| e.to_string())?;
+    let right = i32::try_from(w.saturating_sub(EDGE_PX + 1)).map_err(|e| e.to_string())?;
+    let rows = i32::try_from(entries.len()).map_err(|e| e.to_string())?;
+    let bottom = top + 2 * PADDING_PX + rows * LINE_PX;
+    area.draw(&Rectangle::new(
+        [(left, top), (right, bottom)],
+        WHITE.filled(),
+    ))
+    .map_err(err)?;
+    area.draw(&Rectangle::new(
+        [(left, top), (right, bottom)],
+        BLACK.mix(0.4).stroke_width(1),
+    ))
+    .map_err(err)?;
+    let font =
+        TextStyle::from((FONT, FONT_PX).into_font()).pos(plotters::style::text_anchor::Pos::new(
+            plotters::style::text_anchor::HPos::Left,
+            plotters::style::text_anchor::VPos::Center,
+        ));
+    for (k, (label, swatch)) in (0..).zip(entries) {
+        let y = top + PADDING_PX + k * LINE_PX + LINE_PX / 2;
+        swatch.draw(area, (left + PADDING_PX, y)).map_err(err)?;
+        area.draw(&Text::new(
+            label.clone(),
+            (left + 2 * PADDING_PX + SWATCH_PX, y),
+            font.clone(),
+        ))
+        .map_err(err)?;
+    }
+    Ok(())
+}
