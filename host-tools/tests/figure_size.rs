@@ -30,6 +30,22 @@ fn draw(args: &[&str]) {
     wobblog().args(args).assert().success();
 }
 
+/// `wobblog plot LOG -o OUT EXTRA...`: its exit code and standard error.
+fn plot(log: &Path, out: &Path, extra: &[&str]) -> (Option<i32>, String) {
+    let done = wobblog()
+        .arg("plot")
+        .arg(log)
+        .arg("-o")
+        .arg(out)
+        .args(extra)
+        .output()
+        .unwrap();
+    (
+        done.status.code(),
+        String::from_utf8_lossy(&done.stderr).into_owned(),
+    )
+}
+
 /// A PNG's width and height, and its pixels as RGB.
 fn png_pixels(path: &Path) -> ((u32, u32), Vec<u8>) {
     let decoder = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(path).unwrap()));
@@ -170,39 +186,18 @@ fn bad_sizes_are_usage_errors_that_say_what_to_give() {
         ("7by5", "no `x`"),
         ("100000x100000", "larger than any figure needs"),
     ] {
-        let out = wobblog()
-            .arg("plot")
-            .arg(&log)
-            .arg("-o")
-            .arg(&png)
-            .args(["--size", size])
-            .assert()
-            .code(2);
-        let err = String::from_utf8_lossy(&out.get_output().stderr).to_string();
+        let (code, err) = plot(&log, &png, &["--size", size]);
+        assert_eq!(code, Some(2), "--size {size}: {err}");
         assert!(err.contains(says), "--size {size}: {err}");
     }
     for dpi in ["0", "-96", "5000", "many"] {
-        let out = wobblog()
-            .arg("plot")
-            .arg(&log)
-            .arg("-o")
-            .arg(&png)
-            .arg(format!("--dpi={dpi}"))
-            .assert()
-            .code(2);
-        let err = String::from_utf8_lossy(&out.get_output().stderr).to_string();
+        let (code, err) = plot(&log, &png, &[&format!("--dpi={dpi}")]);
+        assert_eq!(code, Some(2), "--dpi {dpi}: {err}");
         assert!(err.contains("24 to 2400"), "--dpi {dpi}: {err}");
     }
     // Each sane alone, together too many pixels: refused, nothing written.
-    let out = wobblog()
-        .arg("plot")
-        .arg(&log)
-        .arg("-o")
-        .arg(&png)
-        .args(["--size", "10000x10000", "--dpi", "1200"])
-        .assert()
-        .code(1);
-    let err = String::from_utf8_lossy(&out.get_output().stderr).to_string();
+    let (code, err) = plot(&log, &png, &["--size", "10000x10000", "--dpi", "1200"]);
+    assert_eq!(code, Some(1), "{err}");
     assert!(err.contains("lower --dpi or --size"), "{err}");
     assert!(!png.exists());
 }
@@ -215,13 +210,7 @@ fn png_lines_are_anti_aliased() {
     let dir = tempfile::tempdir().unwrap();
     let log = ride(dir.path());
     let png = dir.path().join("fig6.png");
-    wobblog()
-        .arg("plot")
-        .arg(&log)
-        .arg("-o")
-        .arg(&png)
-        .assert()
-        .success();
+    assert_eq!(plot(&log, &png, &[]).0, Some(0));
     let (_, pixels) = png_pixels(&png);
     let line = [LINE_COLOUR.0, LINE_COLOUR.1, LINE_COLOUR.2].map(f64::from);
     let partial = pixels
@@ -247,15 +236,13 @@ fn keys_stand_beside_the_data() {
     let dir = tempfile::tempdir().unwrap();
     let log = ride(dir.path());
     let fig6 = dir.path().join("fig6.svg");
-    wobblog()
-        .arg("plot")
-        .arg(&log)
-        .arg("-o")
-        .arg(&fig6)
-        .assert()
-        .success();
+    assert_eq!(plot(&log, &fig6, &[]).0, Some(0));
     let svg = std::fs::read_to_string(&fig6).unwrap();
-    let right = rightmost_point(&svg, &format!("#{:02X}{:02X}{:02X}", 0x1f, 0x4e, 0x9a));
+    let line = format!(
+        "#{:02X}{:02X}{:02X}",
+        LINE_COLOUR.0, LINE_COLOUR.1, LINE_COLOUR.2
+    );
+    let right = rightmost_point(&svg, &line);
     assert!(right > 900.0, "{right}");
     let texts = texts_at(&svg);
     for label in [

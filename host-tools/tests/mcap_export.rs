@@ -369,3 +369,51 @@ fn columns_that_no_message_carries_are_refused() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("none is a field of an MCAP message"));
     assert!(!mcap.exists());
 }
+
+/// The derived signals, when named, are `/sensors` fields with the values
+/// the CSV gives them (NaN where the CSV cell is empty).
+#[test]
+fn derived_columns_are_sensor_fields_when_named() {
+    let dir = tempfile::tempdir().unwrap();
+    let log = dir.path().join("RUN00003.WBL");
+    analysis_support::standard_log(&log);
+    let columns = "steer_deg,roll_deg,steer_bp_deg,wobble_env_deg";
+    let by_topic = read_back(&decode(
+        &log,
+        &dir.path().join("derived.mcap"),
+        &["--columns", columns],
+    ));
+    let sensors = &by_topic["/sensors"];
+    assert!(
+        sensors[0].schema.ends_with(
+            ": float64 steer_deg\nfloat64 roll_deg\nfloat64 steer_bp_deg\nfloat64 wobble_env_deg\n"
+        ),
+        "{}",
+        sensors[0].schema
+    );
+    let csv = analysis_support::stdout_of(
+        wobblog()
+            .arg("decode")
+            .arg(&log)
+            .args(["--columns", columns]),
+    );
+    let rows: Vec<Vec<Option<f64>>> = csv
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').map(|c| c.parse().ok()).collect())
+        .collect();
+    assert_eq!(rows.len(), sensors.len());
+    let mut compared = 0;
+    for (row, message) in rows.iter().zip(sensors) {
+        for (cell, value) in row.iter().zip(message.cdr_f64()) {
+            match cell {
+                Some(c) => {
+                    assert!((c - value).abs() <= 1e-9 * c.abs().max(1.0), "{c} {value}");
+                    compared += 1;
+                }
+                None => assert!(value.is_nan(), "{value}"),
+            }
+        }
+    }
+    assert!(compared > 3 * rows.len(), "{compared}");
+}

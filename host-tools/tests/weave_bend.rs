@@ -6,21 +6,10 @@
 //! from the model's eigenvalues by finite differences, not from the
 //! margin's code.
 
-use std::path::Path;
-
 use wobble_model::eig::eigenvalues;
+use wobble_model::params::{measured_bicycle_file, MEASURED_BICYCLES};
 use wobble_model::{Model, ParamSet};
 use wobblog::analysis::margin::BendPrior;
-
-const BICYCLES: [&str; 7] = [
-    "Benchmark",
-    "Browser",
-    "Crescendo",
-    "Fisher",
-    "Pista",
-    "Stratos",
-    "Yellow",
-];
 
 /// sigma of the weave (the oscillatory pair) at speed `u`.
 fn weave_sigma(model: &Model, u: f64) -> f64 {
@@ -35,11 +24,9 @@ fn weave_sigma(model: &Model, u: f64) -> f64 {
 
 #[test]
 fn the_weaves_bend_in_reciprocal_speed_lies_within_the_prior() {
-    let dir =
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("bicycle-model/tests/data/bicycleparameters");
     let mut betas = Vec::new();
-    for b in BICYCLES {
-        let set = ParamSet::load(&dir.join(format!("{b}Benchmark.txt"))).unwrap();
+    for b in MEASURED_BICYCLES {
+        let set = ParamSet::load(&measured_bicycle_file(b)).unwrap();
         let model = Model::whipple_of(&set).unwrap();
         // The weave speed by bisection on sigma (stable above it).
         let (mut lo, mut hi) = (2.0, 8.0);

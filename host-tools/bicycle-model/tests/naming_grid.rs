@@ -5,11 +5,10 @@
 
 mod support;
 
-use std::path::Path;
-
 use proptest::prelude::*;
 use support::bundled;
 
+use wobble_model::params::{measured_bicycle_file, MEASURED_BICYCLES};
 use wobble_model::{Complex, CriticalSpeed, Mode, Model, ParamSet, Survey, Sweep};
 
 /// Every bicycle: the bundled parameter files and BicycleParameters' files.
@@ -21,20 +20,11 @@ fn bicycles() -> Vec<(String, Model)> {
         "test-bicycle.toml",
     ]
     .map(|f| (f.to_owned(), bundled(f)));
-    let measured = [
-        "Benchmark",
-        "Browser",
-        "Crescendo",
-        "Fisher",
-        "Pista",
-        "Stratos",
-        "Yellow",
-    ]
-    .map(|b| {
-        let path = Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("tests/data/bicycleparameters")
-            .join(format!("{b}Benchmark.txt"));
-        (format!("{b}Benchmark.txt"), ParamSet::load(&path).unwrap())
+    let measured = MEASURED_BICYCLES.map(|b| {
+        (
+            format!("{b}Benchmark.txt"),
+            ParamSet::load(&measured_bicycle_file(b)).unwrap(),
+        )
     });
     bundled_files
         .into_iter()

@@ -332,31 +332,69 @@ pub(crate) fn speed_text(v: Option<f64>, what: &str) -> String {
 /// Names and keys that come from files or the command line are shown with
 /// control and bidirectional characters escaped.
 fn render_text(r: &Report, logs: usize) -> String {
-    use crate::text::escape_controls;
-    use std::fmt::Write;
     let mut o = answer_text(r, logs);
-    if !r.kicks.is_empty() {
-        let _ = writeln!(
-            o,
-            "  t_s       speed_mps  freq_hz  sigma_per_s  sigma_sd_per_s  amp_deg  source     used  log"
-        );
-    }
-    for k in &r.kicks {
-        let _ = writeln!(
-            o,
-            "  {:8.2}  {:9.2}  {:7.2}  {:11.3}  {:14.3}  {:7.2}  {:9}  {:4}  {}",
+    let lines = r.kicks.iter().map(|k| KickLine {
+        values: [
             k.kick.t_s,
             k.kick.speed_mps,
             k.kick.freq_hz,
             k.kick.sigma_per_s,
             k.kick.sigma_sd_per_s,
             k.kick.amp_deg,
-            k.kick.source.as_str(),
+        ],
+        source: Some(k.kick.source.as_str()),
+        used: k.used,
+        log: &k.log,
+    });
+    kick_table(&mut o, ("amp_deg", 2), lines);
+    o
+}
+
+/// One kick of a table: t_s, speed_mps, freq_hz, sigma_per_s,
+/// sigma_sd_per_s and the amplitude; where its values come from (the
+/// wobble's kicks); whether the trend used it; its log.
+pub(crate) struct KickLine<'a> {
+    pub values: [f64; 6],
+    pub source: Option<&'a str>,
+    pub used: bool,
+    pub log: &'a str,
+}
+
+/// Appends the table of `lines` (nothing for none) to `o`: the amplitude
+/// named `amp_name`, frequencies to `freq_decimals`, a `source` column when
+/// the lines have one.
+pub(crate) fn kick_table<'a>(
+    o: &mut String,
+    (amp_name, freq_decimals): (&str, usize),
+    lines: impl Iterator<Item = KickLine<'a>>,
+) {
+    use crate::text::escape_controls;
+    use std::fmt::Write;
+    let mut lines = lines.peekable();
+    let Some(first) = lines.peek() else {
+        return;
+    };
+    let source = if first.source.is_some() {
+        "  source   "
+    } else {
+        ""
+    };
+    let _ = writeln!(
+        o,
+        "  t_s       speed_mps  freq_hz  sigma_per_s  sigma_sd_per_s  {amp_name}{source}  used  log"
+    );
+    let amp_width = amp_name.len();
+    for k in lines {
+        let [t, speed, freq, sigma, sd, amp] = k.values;
+        let source = k.source.map_or(String::new(), |s| format!("  {s:9}"));
+        let _ = writeln!(
+            o,
+            "  {t:8.2}  {speed:9.2}  {freq:7.freq_decimals$}  {sigma:11.3}  {sd:14.3}  \
+             {amp:amp_width$.2}{source}  {:4}  {}",
             if k.used { "yes" } else { "no" },
-            escape_controls(&k.log)
+            escape_controls(k.log)
         );
     }
-    o
 }
 
 /// The answer in words, as the table form begins: the kicks counted, the

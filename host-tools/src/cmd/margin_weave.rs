@@ -12,7 +12,7 @@ use crate::analysis::margin::weave::{predict_weave, WeaveMargin};
 use crate::analysis::margin::KickPoint;
 use crate::analysis::weave::load_weave_kicks;
 use crate::cmd::logs::{for_each_log, print, print_json, warn_losses};
-use crate::cmd::margin::{speed_text, Args};
+use crate::cmd::margin::{kick_table, speed_text, Args, KickLine};
 use crate::output::Output;
 use crate::CliError;
 
@@ -106,7 +106,6 @@ pub fn run(args: &Args, logs: &[PathBuf]) -> Result<(), CliError> {
 
 /// The table form: the answer in words, then every kick.
 fn render_text(r: &WeaveReport, logs: usize) -> String {
-    use crate::text::escape_controls;
     use std::fmt::Write;
     let m = &r.margin;
     let mut o = String::new();
@@ -141,25 +140,19 @@ fn render_text(r: &WeaveReport, logs: usize) -> String {
     for w in &m.warnings {
         let _ = writeln!(o, "warning: {w}");
     }
-    if !r.kicks.is_empty() {
-        let _ = writeln!(
-            o,
-            "  t_s       speed_mps  freq_hz  sigma_per_s  sigma_sd_per_s  roll_deg  used  log"
-        );
-    }
-    for k in &r.kicks {
-        let _ = writeln!(
-            o,
-            "  {:8.2}  {:9.2}  {:7.3}  {:11.3}  {:14.3}  {:8.2}  {:4}  {}",
+    let lines = r.kicks.iter().map(|k| KickLine {
+        values: [
             k.kick.t_s,
             k.kick.speed_mps,
             k.kick.freq_hz,
             k.kick.sigma_per_s,
             k.kick.sigma_sd_per_s,
             k.kick.amp_deg,
-            if k.used { "yes" } else { "no" },
-            escape_controls(&k.log)
-        );
-    }
+        ],
+        source: None,
+        used: k.used,
+        log: &k.log,
+    });
+    kick_table(&mut o, ("roll_deg", 3), lines);
     o
 }

@@ -76,9 +76,19 @@ pub const EVENTS_TOPIC: &str = "/events";
 /// The ROS 2 type of a `/sensors` message.
 const SENSORS_SCHEMA_NAME: &str = "wobblog_msgs/msg/Sensors";
 
-/// The columns a `/sensors` message may carry: the CSV's after `t_s` and
-/// before the GPS (`ax_g` ... `speed_mps`).
+/// The stored columns a `/sensors` message may carry: the CSV's after `t_s`
+/// and before the GPS (`ax_g` ... `speed_mps`).
 const SENSOR_FIELDS: &[&str] = super::CSV_COLUMNS.split_at(9).0.split_at(1).1;
+
+/// Whether `column` is a field of `/sensors`: a stored sensor column, or a
+/// derived one (`roll_deg`, `steer_bp_deg`, `wobble_env_deg`, when named;
+/// NaN where the filter has no value yet).
+fn is_sensor_field(column: &str) -> bool {
+    SENSOR_FIELDS.contains(&column)
+        || super::columns::DERIVED_COLUMNS
+            .iter()
+            .any(|c| c.name == column)
+}
 
 /// Where the GPS columns go in MCAP ([`home_of`]).
 pub const GPS_HOME: &str = "/gps (foxglove.LocationFix)";
@@ -91,7 +101,7 @@ pub fn home_of(column: &str) -> Option<&'static str> {
         "t_s" => Some("every message's publish time (ns since boot)"),
         "utc" => Some("every message's log time (ns since 1970, UTC)"),
         "gps_lat_deg" | "gps_lon_deg" => Some(GPS_HOME),
-        _ if SENSOR_FIELDS.contains(&column) => Some(SENSORS_TOPIC),
+        _ if is_sensor_field(column) => Some(SENSORS_TOPIC),
         _ => None,
     }
 }
@@ -198,7 +208,7 @@ impl<W: Write> McapWriter<W> {
         };
         let chosen: Vec<Column> = columns
             .iter()
-            .filter(|c| SENSOR_FIELDS.contains(&c.name))
+            .filter(|c| is_sensor_field(c.name))
             .copied()
             .collect();
         let sensors = if chosen.is_empty() {
@@ -287,7 +297,7 @@ impl<W: Write> McapWriter<W> {
         body.clear();
         body.extend_from_slice(&CDR_LE);
         for column in &sensors.columns {
-            // Sensor fields are numbers in every row.
+            // Sensor fields are numbers (derived ones absent at first).
             if let Value::Number(v) = (column.value)(row) {
                 body.extend_from_slice(&v.unwrap_or(f64::NAN).to_le_bytes());
             }

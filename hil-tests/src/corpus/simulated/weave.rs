@@ -38,15 +38,7 @@ use super::sensors::{Channel, GYRO_BIAS_DPS, GYRO_LSB_DPS, GYRO_NOISE_DPS};
 use crate::corpus::signal::FS_HZ;
 
 /// The bicycles, by the name of their `*Benchmark.txt`.
-pub const BICYCLES: [&str; 7] = [
-    "Benchmark",
-    "Browser",
-    "Crescendo",
-    "Fisher",
-    "Pista",
-    "Stratos",
-    "Yellow",
-];
+pub use wobble_model::params::MEASURED_BICYCLES as BICYCLES;
 
 /// How long a pass lasts, s (its kick 3-4 s in).
 pub const PASS_S: f64 = 15.0;
@@ -125,9 +117,7 @@ pub struct Campaign {
 /// The parameter file of `bicycle`.
 #[must_use]
 pub fn params_path(bicycle: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../host-tools/bicycle-model/tests/data/bicycleparameters")
-        .join(format!("{bicycle}Benchmark.txt"))
+    wobble_model::params::measured_bicycle_file(bicycle)
 }
 
 /// The Whipple model of `bicycle`.

@@ -8,12 +8,14 @@
 
 mod benchmark_txt;
 pub mod keys;
+mod measured;
 mod toml_file;
 
 use std::collections::BTreeMap;
 use std::fmt;
 use std::path::{Path, PathBuf};
 
+pub use measured::{measured_bicycle_file, MEASURED_BICYCLES};
 pub use toml_file::to_toml;
 
 /// One value as written in a parameter file.
