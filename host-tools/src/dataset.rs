@@ -21,13 +21,14 @@ use crate::analysis::campaign_kicks::{
 use crate::analysis::kicks::{Kick, KickMode};
 use crate::analysis::margin::weave::predict_weave;
 use crate::analysis::margin::{predict, KickPoint, Trend};
-use crate::analysis::run::read_rows;
 use crate::analysis::{Cut, Episode, Ride, Stability};
+use crate::cmd::decode::Taps;
 use crate::cmd::summary::{logs_in, RunRow};
 use crate::events::{EventKind, LogEvent};
 use crate::export::columns::{Column, Kind, Value};
 use crate::export::parquet::ParquetWriter;
 use crate::output::Output;
+use crate::rows::Row;
 use crate::CliError;
 
 /// The folder of each table in a dataset.
@@ -439,40 +440,54 @@ fn episodes_columns() -> Vec<Column<EpisodesRow>> {
 /// Writes `rows` as the one file of the table folder `dir`.
 /// One event's row of `events.parquet`: what `wobblog events --json` lists.
 pub struct EventsRow {
-    entry: LogEntry,
+    /// Shared by the log's events: a flood of records costs no copy each.
+    entry: std::sync::Arc<LogEntry>,
     event: LogEvent,
     /// UTC, µs since 1970, where the log has it.
     utc_us: Option<i64>,
 }
 
 impl EventsRow {
-    /// The event's numbers: frequency (Hz), growth rate (1/s), amplitude
-    /// (deg) and speed (m/s), where its kind has them.
-    fn numbers(&self) -> [Option<f64>; 4] {
+    /// The event's numbers: frequency (Hz), growth rate and its standard
+    /// error (1/s), amplitude (deg) and speed (m/s), where its kind has them.
+    fn numbers(&self) -> [Option<f64>; 5] {
         match &self.event.kind {
-            EventKind::AlertOn { freq_hz, amp_deg } => [Some(*freq_hz), None, Some(*amp_deg), None],
+            EventKind::AlertOn { freq_hz, amp_deg } => {
+                [Some(*freq_hz), None, None, Some(*amp_deg), None]
+            }
             EventKind::Kick {
                 speed_mps,
                 freq_hz,
                 sigma_per_s,
                 amp_deg,
-                ..
+                sigma_se_per_s,
             } => [
                 Some(*freq_hz),
                 Some(*sigma_per_s),
+                Some(*sigma_se_per_s),
                 Some(*amp_deg),
                 *speed_mps,
             ],
             EventKind::MarginEstimate(m)
             | EventKind::Approaching(m)
-            | EventKind::ApproachingOff(m) => [None, None, None, m.speed_mps],
-            _ => [None; 4],
+            | EventKind::ApproachingOff(m) => [None, None, None, None, m.speed_mps],
+            _ => [None; 5],
+        }
+    }
+
+    /// The details in words, as `wobblog events` prints them, for the
+    /// kinds whose number columns do not hold all they say.
+    fn details(&self) -> Option<String> {
+        match &self.event.kind {
+            EventKind::AlertOn { .. } | EventKind::AlertOff | EventKind::Kick { .. } => None,
+            kind => Some(kind.describe()),
         }
     }
 }
 
 /// The columns of `events.parquet`: the time, the kind, its numbers where
-/// it has them, and the details in words as `wobblog events` prints them.
+/// it has them, and the details in words as `wobblog events` prints them
+/// where the numbers do not say it all.
 fn events_columns() -> Vec<Column<EventsRow>> {
     let mut columns = identity!(EventsRow).to_vec();
     columns.extend([
@@ -489,32 +504,23 @@ fn events_columns() -> Vec<Column<EventsRow>> {
         },
         number!(EventsRow, "freq_hz", r => r.numbers()[0]),
         number!(EventsRow, "sigma_per_s", r => r.numbers()[1]),
-        number!(EventsRow, "amp_deg", r => r.numbers()[2]),
-        number!(EventsRow, "speed_mps", r => r.numbers()[3]),
+        number!(EventsRow, "sigma_se_per_s", r => r.numbers()[2]),
+        number!(EventsRow, "amp_deg", r => r.numbers()[3]),
+        number!(EventsRow, "speed_mps", r => r.numbers()[4]),
         Column {
             name: "details",
             kind: Kind::Text,
-            value: |r| Value::Text(Some(r.event.kind.describe())),
+            value: |r| Value::Text(r.details()),
         },
     ]);
     columns
 }
 
-/// Writes the events of `entry`'s log, in time order, to `table` as they
-/// are read: a log of millions of records never sits in memory.
-fn write_events<W: std::io::Write + Send>(
-    entry: &LogEntry,
-    table: &mut ParquetWriter<W, EventsRow>,
-    table_path: &Path,
-) -> Result<(), CliError> {
-    crate::cmd::events::walk(&entry.path, |event, utc_us| {
-        table.write(&EventsRow {
-            entry: entry.clone(),
-            event,
-            utc_us,
-        })
-    })?
-    .map_err(|e| CliError::file(table_path, e))
+/// The events table being written: each log's events go in as its frames
+/// are decoded, so a log of millions of records never sits in memory.
+struct EventsTable<'a, W: std::io::Write + Send> {
+    writer: ParquetWriter<W, EventsRow>,
+    path: &'a Path,
 }
 
 /// The file of the table in folder `dir`, created (the folder too).
@@ -560,44 +566,70 @@ pub enum Outcome<'a> {
 
 /// The kicks of `ride` (read from `entry`) as `wobblog margin` takes them
 /// (`--kicks best`), the weave's after them. A card record without a speed
-/// takes the frames' speed after it: a second reading of the log, made
-/// only when there is such a record.
-fn kicks_of(entry: &LogEntry, ride: &Ride) -> Result<Vec<KicksRow>, CliError> {
-    let mut speeds = SpeedsAfter::for_records(&ride.summary.kick_records);
-    if !speeds.is_empty() {
-        read_rows(
-            &entry.path,
-            |_| {},
-            |row| speeds.push(row.t_s, row.speed_mps),
-        )?;
-    }
+/// takes the frames' speed after it, from `speeds` (gathered as the frames
+/// were written).
+fn kicks_of(entry: &LogEntry, ride: &Ride, speeds: &SpeedsAfter) -> Vec<KicksRow> {
     // A config the host refuses gives no wobble kicks, as in `margin`.
-    let wobble = ride_campaign_kicks(ride, Prefer::Best, &speeds).unwrap_or_default();
+    let wobble = ride_campaign_kicks(ride, Prefer::Best, speeds).unwrap_or_default();
     let mut rows: Vec<KicksRow> = wobble
         .iter()
         .map(|k| KicksRow::of(entry, KickMode::Wobble, k))
         .collect();
     rows.extend(ride.weave_kicks.iter().map(|k| KicksRow::weave(entry, k)));
-    Ok(rows)
+    rows
 }
 
-/// Writes one log's frame file and analysis; nothing of it stays on failure.
-fn write_log(entry: &LogEntry, dir: &Path) -> Result<Ride, CliError> {
+/// Writes one log's frame file, its events into `events`, and returns its
+/// analysis and the speeds after its card records that carry none (for its
+/// kicks); nothing of its frames stays on failure. A log that cannot be
+/// analysed fails before anything is written (and may be skipped); one
+/// whose second reading fails after its events went in fails the dataset.
+fn write_log<W: std::io::Write + Send>(
+    entry: &LogEntry,
+    dir: &Path,
+    events: &mut EventsTable<'_, W>,
+) -> Result<(Ride, SpeedsAfter), CliError> {
     // Analysed first: a log that cannot be read fails before a file is made.
     let ride = Ride::load(&entry.path)?;
     let part = dir.join(entry.frame_file());
     let folder = part.parent().unwrap_or(dir);
     std::fs::create_dir_all(folder).map_err(|e| CliError::file(folder, e))?;
+    let mut speeds = SpeedsAfter::for_records(&ride.summary.kick_records);
+    let needs_speeds = !speeds.is_empty();
+    let mut gather = |row: &Row| speeds.push(row.t_s, row.speed_mps);
+    let shared = std::sync::Arc::new(entry.clone());
+    let mut take = |event, utc_us| {
+        let row = EventsRow {
+            entry: shared.clone(),
+            event,
+            utc_us,
+        };
+        events
+            .writer
+            .write(&row)
+            .map_err(|e| CliError::file(events.path, e))
+    };
     let written = Output::create(&part, &[&entry.path]).and_then(|mut out| {
         let export = crate::cmd::decode::Export::dataset_frames(entry.run);
-        crate::cmd::decode::decode_to(&entry.path, &export, &mut out, &part)?;
+        let taps = Taps {
+            events: Some(&mut take),
+            rows: needs_speeds.then_some(&mut gather as &mut dyn FnMut(&Row)),
+        };
+        crate::cmd::decode::decode_with_events(&entry.path, &export, &mut out, &part, taps)?;
         out.commit()
     });
     if written.is_err() {
         // The folder only if it is empty: never data.
         let _ = std::fs::remove_dir(folder);
     }
-    written.map(|()| ride)
+    written.map(|()| (ride, speeds)).map_err(|e| match e {
+        // Not a log to leave out: some of its events are in.
+        CliError::File { path, message } if path == entry.path => CliError::Failed(format!(
+            "{}: {message} (read once, not a second time; no dataset written)",
+            crate::text::shown(&path)
+        )),
+        other => other,
+    })
 }
 
 /// Writes the dataset of `entries` into `dir` (which must exist and be
@@ -620,9 +652,12 @@ pub fn write_dataset(
     // Events are written as each log is read.
     let (events_path, mut events_out) = table_file(&dir.join(EVENTS))?;
     let events_columns = events_columns();
-    let mut events = ParquetWriter::new(&mut events_out, &events_columns);
+    let mut events = EventsTable {
+        writer: ParquetWriter::new(&mut events_out, &events_columns),
+        path: &events_path,
+    };
     for entry in entries {
-        let ride = match write_log(entry, dir) {
+        let (ride, speeds) = match write_log(entry, dir, &mut events) {
             Ok(ride) => ride,
             Err(e)
                 if !strict
@@ -635,8 +670,7 @@ pub fn write_dataset(
             Err(e) => return Err(e),
         };
         progress(entry, Outcome::Written(&ride));
-        kicks.extend(kicks_of(entry, &ride)?);
-        write_events(entry, &mut events, &events_path)?;
+        kicks.extend(kicks_of(entry, &ride, &speeds));
         episodes.extend(ride.all_episodes().into_iter().map(|episode| EpisodesRow {
             entry: entry.clone(),
             episode,
@@ -658,7 +692,8 @@ pub fn write_dataset(
     write_table(&dir.join(EPISODES), &episodes_columns(), &episodes)?;
     mark_used(&mut kicks);
     write_table(&dir.join(KICKS), &kicks_columns(), &kicks)?;
-    finish_table(&mut events, &events_columns).map_err(|e| CliError::file(&events_path, e))?;
+    finish_table(&mut events.writer, &events_columns)
+        .map_err(|e| CliError::file(&events_path, e))?;
     drop(events);
     events_out.commit()?;
     Ok(skipped)

@@ -252,7 +252,7 @@ PAPER = Choices(
 )
 
 if __name__ == "__main__":
-    write("params/test-bicycle.toml", "Seed paper's test bicycle, 83 kg rider", RIDER_KG, CORPUS)
+    write("params/test-bicycle.toml", "Test bicycle of the simulated rides (the seed paper's, head tuned), 83 kg rider", RIDER_KG, CORPUS)
     # The start of the identification (examples/identify.rs), which writes
     # params/paper-test-bicycle.toml and its light-rider file from it.
     write("identify/paper-test-bicycle-start.toml", "Seed paper's test bicycle, 83 kg rider (start of the identification)", RIDER_KG, PAPER)

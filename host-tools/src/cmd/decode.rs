@@ -3,7 +3,7 @@
 use std::io::{IsTerminal, Write};
 use std::path::{Path, PathBuf};
 
-use crate::events::{EventConverter, LogEvent};
+use crate::events::{EventConverter, EventWalk, LogEvent};
 use crate::export::columns::{self, Column};
 use crate::export::derived::Deriver;
 use crate::export::{Format, LogMetadata, RowWriter};
@@ -203,6 +203,38 @@ pub fn decode_to(
     out: impl Write + Send,
     out_name: &Path,
 ) -> Result<Losses, CliError> {
+    decode_with_events(log, export, out, out_name, Taps::default())
+}
+
+/// What else a decoding hands on as it reads the log, so that one reading
+/// serves several outputs (a dataset's frames, events and kicks).
+#[derive(Default)]
+pub struct Taps<'a> {
+    /// Takes the log's events in time order with their UTC (µs since
+    /// 1970), as `wobblog events` lists them; its first error ends the
+    /// decoding and is returned.
+    pub events: Option<&'a mut dyn FnMut(LogEvent, Option<i64>) -> Result<(), CliError>>,
+    /// Sees every row as assembled, before any window.
+    pub rows: Option<&'a mut dyn FnMut(&Row)>,
+}
+
+/// [`decode_to`], handing `taps` what they take as the log is read.
+///
+/// # Errors
+/// The log cannot be read, `out` fails, or the events' taker does.
+pub fn decode_with_events(
+    log: &Path,
+    export: &Export,
+    out: impl Write + Send,
+    out_name: &Path,
+    taps: Taps<'_>,
+) -> Result<Losses, CliError> {
+    let Taps {
+        events: mut events_to,
+        rows: mut rows_seen,
+    } = taps;
+    let mut walk = EventWalk::default();
+    let mut event_error: Option<CliError> = None;
     let mut sink = WindowedSink {
         writer: RowWriter::new(export.format, export.columns.clone(), export.delimiter, out),
         window: export.window,
@@ -232,6 +264,9 @@ pub fn decode_to(
     // Made at the first frame, when the header has given the frame rate.
     let mut deriver: Option<Option<Deriver>> = None;
     let mut rows_out = |row: &Row, meta: &LogMetadata, sink: &mut WindowedSink<_>| {
+        if let Some(seen) = rows_seen.as_mut() {
+            seen(row);
+        }
         let fs_hz = f64::from(meta.sample_rate_hz.unwrap_or(100).max(1));
         match deriver.get_or_insert_with(|| Deriver::for_columns(&names, fs_hz)) {
             Some(d) => d.push(row, &mut |r: &Row| sink.row(r)),
@@ -241,6 +276,9 @@ pub fn decode_to(
     read_log(log, |event| {
         losses.observe(&event);
         meta.observe(&event);
+        if let (Some(take), None) = (events_to.as_mut(), &event_error) {
+            event_error = walk.observe(&event, &mut |e, utc, _| take(e, utc)).err();
+        }
         if let Some(e) = events.as_mut().and_then(|c| c.convert(&event)) {
             sink.event(&e, &log_name);
         }
@@ -260,6 +298,12 @@ pub fn decode_to(
         }
     })?;
     rows.finish(&mut |row: &Row| rows_out(row, &meta, &mut sink));
+    if let (Some(take), None) = (events_to.as_mut(), &event_error) {
+        event_error = walk.finish(&mut |e, utc, _| take(e, utc)).err();
+    }
+    if let Some(e) = event_error {
+        return Err(e);
+    }
     if let Some(Some(d)) = &mut deriver {
         d.finish(&mut |r: &Row| sink.row(r));
     }

@@ -5,12 +5,11 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use crate::cmd::logs::one_log;
-use crate::events::{EventConverter, LogEvent, TimeOrder};
+use crate::events::{EventWalk, LogEvent};
 use crate::output::Output;
 use crate::reader::read_log_try;
-use crate::time::{iso8601_unix_us, utc_text_at, utc_us_after_pair, SyncPair};
+use crate::time::{iso8601_unix_us, utc_text_at, SyncPair};
 use crate::CliError;
-use wobble_core::format::{Event, Record};
 
 /// Arguments of `wobblog events`.
 #[derive(clap::Args)]
@@ -75,21 +74,24 @@ pub fn list(
         count: 0,
     };
     let mut host = host.into_iter().peekable();
-    // The host's events have no UTC of their own: the latest the log's
-    // events had places them, as the frames are placed.
-    let mut pairs: Vec<SyncPair> = Vec::new();
-    let walked = walk_with_pairs(path, &mut pairs, |e, utc_us, pairs| {
+    // The host's events have no UTC of their own: the latest pair the log
+    // had read by then places them, as the frames are placed.
+    let mut visit = |e: LogEvent, utc_us: Option<i64>, pairs: &[SyncPair]| {
         while let Some(h) = host.next_if(|h| h.t_s < e.t_s) {
             listing.event(&h, utc_text_at(pairs, h.t_s))?;
         }
         listing.event(&e, utc_us.and_then(iso8601_unix_us))
-    })?;
-    Ok(walked.and_then(|()| {
-        for h in host {
-            listing.event(&h, utc_text_at(&pairs, h.t_s))?;
-        }
-        listing.finish()
-    }))
+    };
+    let mut walk = EventWalk::default();
+    let walked = read_log_try(path, |event| walk.observe(&event, &mut visit))?;
+    Ok(walked
+        .and_then(|()| walk.finish(&mut visit))
+        .and_then(|()| {
+            for h in host {
+                listing.event(&h, utc_text_at(walk.pairs(), h.t_s))?;
+            }
+            listing.finish()
+        }))
 }
 
 /// Hands the events of the log at `path` to `visit` in time order, holding
@@ -104,40 +106,10 @@ pub fn walk<E>(
     path: &Path,
     mut visit: impl FnMut(LogEvent, Option<i64>) -> Result<(), E>,
 ) -> Result<Result<(), E>, CliError> {
-    let mut pairs = Vec::new();
-    walk_with_pairs(path, &mut pairs, |e, utc_us, _| visit(e, utc_us))
-}
-
-/// [`walk`], handing `visit` the sync pairs read so far as well; `pairs`
-/// holds every pair of the log afterwards.
-fn walk_with_pairs<E>(
-    path: &Path,
-    pairs: &mut Vec<SyncPair>,
-    mut visit: impl FnMut(LogEvent, Option<i64>, &[SyncPair]) -> Result<(), E>,
-) -> Result<Result<(), E>, CliError> {
-    let mut converter = EventConverter::new();
-    let mut order = TimeOrder::new();
-    // Every pair: an event held back may come before the latest one.
-    let walked = read_log_try(path, |event| {
-        if let Event::Record(Record::UtcSync(pair)) = &event {
-            if let Ok(ms) = i64::try_from(pair.unix_ms) {
-                pairs.push((pair.t_us as f64 / 1e6, ms));
-            }
-        }
-        match converter.convert(&event) {
-            Some(e) => order.push(e, &mut |e: LogEvent| {
-                let utc = utc_us_after_pair(pairs, e.t_s);
-                visit(e, utc, pairs)
-            }),
-            None => Ok(()),
-        }
-    })?;
-    Ok(walked.and_then(|()| {
-        order.finish(&mut |e: LogEvent| {
-            let utc = utc_us_after_pair(pairs, e.t_s);
-            visit(e, utc, pairs)
-        })
-    }))
+    let mut visit = |e, utc_us, _: &[SyncPair]| visit(e, utc_us);
+    let mut walk = EventWalk::default();
+    let walked = read_log_try(path, |event| walk.observe(&event, &mut visit))?;
+    Ok(walked.and_then(|()| walk.finish(&mut visit)))
 }
 
 /// One event of the JSON lines: its time since boot, UTC, kind and fields.

@@ -8,7 +8,7 @@
 //! store each field straight into its vector; any other table is filled
 //! through its columns' value functions ([`ValueColumns`]).
 
-use super::columns::{Column, Kind, Value, COLUMNS};
+use super::columns::{Column, Kind, Value, COLUMNS, RUN_COLUMN};
 use crate::rows::Row;
 
 /// One column's values for a batch of rows: a slot per row (absent values
@@ -183,7 +183,7 @@ impl<R> ColumnBuffers<R> for ValueColumns<R> {
 
 /// The buffers for decoded frames in `columns`: each field stored straight
 /// into its vector ([`RowColumns`]) when every column is one of
-/// [`COLUMNS`], else through the value functions.
+/// [`COLUMNS`] or [`RUN_COLUMN`], else through the value functions.
 #[must_use]
 pub fn row_buffers(columns: &[Column<Row>], rows: usize) -> Box<dyn ColumnBuffers<Row>> {
     match RowColumns::new(columns, rows) {
@@ -205,6 +205,7 @@ enum Field {
     GpsSpeed,
     GpsFix,
     Utc,
+    Run,
 }
 
 impl Field {
@@ -226,6 +227,7 @@ impl Field {
             "gps_speed_mps" => Self::GpsSpeed,
             "gps_fix" => Self::GpsFix,
             "utc" => Self::Utc,
+            "run" => Self::Run,
             _ => return None,
         })
     }
@@ -249,6 +251,8 @@ pub struct RowColumns {
     gps_fix: Vec<Option<&'static str>>,
     utc_us: Vec<i64>,
     has_utc: Vec<bool>,
+    run: Vec<i64>,
+    has_run: Vec<bool>,
 }
 
 impl RowColumns {
@@ -259,7 +263,10 @@ impl RowColumns {
         let fields = columns
             .iter()
             .map(|c| {
-                let known = COLUMNS.iter().any(|k| k.name == c.name && k.kind == c.kind);
+                let known = COLUMNS
+                    .iter()
+                    .chain([&RUN_COLUMN])
+                    .any(|k| k.name == c.name && k.kind == c.kind);
                 Field::of(c.name).filter(|_| known)
             })
             .collect::<Option<Vec<Field>>>()?;
@@ -277,6 +284,8 @@ impl RowColumns {
             gps_fix: Vec::new(),
             utc_us: Vec::new(),
             has_utc: Vec::new(),
+            run: Vec::new(),
+            has_run: Vec::new(),
         };
         new.reserve();
         Some(new)
@@ -301,6 +310,8 @@ impl RowColumns {
         self.gps_fix.reserve(n);
         self.utc_us.reserve(n);
         self.has_utc.reserve(n);
+        self.run.reserve(n);
+        self.has_run.reserve(n);
     }
 }
 
@@ -325,6 +336,8 @@ impl ColumnBuffers<Row> for RowColumns {
         self.gps_fix.push(row.gps.map(|g| g.fix.as_str()));
         self.utc_us.push(row.utc_us.unwrap_or_default());
         self.has_utc.push(row.utc_us.is_some());
+        self.run.push(row.run.map_or(0, i64::from));
+        self.has_run.push(row.run.is_some());
         Ok(())
     }
 
@@ -349,6 +362,7 @@ impl ColumnBuffers<Row> for RowColumns {
                 Field::GpsSpeed => Values::OptNumber(take(speed), take(&mut self.has_gps_speed)),
                 Field::GpsFix => Values::Label(take(&mut self.gps_fix)),
                 Field::Utc => Values::Utc(take(&mut self.utc_us), take(&mut self.has_utc)),
+                Field::Run => Values::Integer(take(&mut self.run), take(&mut self.has_run)),
             })
             .collect();
         // What no column took starts the next batch empty too.
@@ -360,6 +374,8 @@ impl ColumnBuffers<Row> for RowColumns {
         self.gps_fix.clear();
         self.utc_us.clear();
         self.has_utc.clear();
+        self.run.clear();
+        self.has_run.clear();
         self.reserve();
         chosen
     }
@@ -413,14 +429,27 @@ mod tests {
 
     #[test]
     fn every_frame_column_is_a_field_stored_as_its_value_function_gives_it() {
-        let mut fast = RowColumns::new(&COLUMNS, 4).expect("every column has a field");
-        let mut slow = ValueColumns::new(&COLUMNS, 4);
-        for row in rows() {
+        // A dataset's frame file: the run first, in some rows (the decoder's
+        // rows have none).
+        let mut columns = vec![RUN_COLUMN];
+        columns.extend(COLUMNS);
+        let mut fast = RowColumns::new(&columns, 4).expect("every column has a field");
+        let mut slow = ValueColumns::new(&columns, 4);
+        for (k, row) in rows().into_iter().enumerate() {
+            let row = Row {
+                run: (k > 0).then_some(7),
+                ..row
+            };
             fast.push(&row).unwrap();
             slow.push(&row).unwrap();
         }
         assert_eq!(fast.len(), 3);
-        assert_eq!(fast.take(), slow.take());
+        let taken = fast.take();
+        assert_eq!(
+            taken[0],
+            Values::Integer(vec![0, 7, 7], vec![false, true, true])
+        );
+        assert_eq!(taken, slow.take());
         assert!(fast.is_empty() && slow.is_empty());
     }
 

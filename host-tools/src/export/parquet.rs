@@ -25,12 +25,19 @@ use crate::rows::Row;
 /// Rows per row group: a few MB per group, so memory stays bounded on long
 /// runs while readers still get large, efficient column chunks.
 const ROW_GROUP_ROWS: usize = 65_536;
+/// Rows per row group of the other tables (runs, episodes, kicks, events):
+/// their rows go through one value per cell ([`super::columnar::Values`]),
+/// ten times a frame's memory, and only an events table of a flood of card
+/// records grows long.
+const TABLE_ROW_GROUP_ROWS: usize = 8_192;
 
 /// Writes rows into a Parquet file on any writer (the format is written
 /// front to back; only readers need to seek).
 pub struct ParquetWriter<W: Write + Send, R = Row> {
     state: State<W>,
     columns: Vec<Column<R>>,
+    /// Rows per row group.
+    group_rows: usize,
     /// The row group being built ([`super::columnar`]).
     buffers: Box<dyn ColumnBuffers<R>>,
 }
@@ -46,20 +53,36 @@ impl<W: Write + Send> ParquetWriter<W, Row> {
     /// A writer of decoded frames in `columns` on `out`, each field stored
     /// straight into its column ([`super::columnar::RowColumns`]).
     pub fn frames(out: W, columns: &[Column<Row>]) -> Self {
-        Self::with_buffers(out, columns, row_buffers(columns, ROW_GROUP_ROWS))
+        Self::with_buffers(
+            out,
+            columns,
+            row_buffers(columns, ROW_GROUP_ROWS),
+            ROW_GROUP_ROWS,
+        )
     }
 }
 
 impl<W: Write + Send, R: 'static> ParquetWriter<W, R> {
     /// A writer of `columns` on `out`.
     pub fn new(out: W, columns: &[Column<R>]) -> Self {
-        Self::with_buffers(out, columns, buffers(columns, ROW_GROUP_ROWS))
+        Self::with_buffers(
+            out,
+            columns,
+            buffers(columns, TABLE_ROW_GROUP_ROWS),
+            TABLE_ROW_GROUP_ROWS,
+        )
     }
 
-    fn with_buffers(out: W, columns: &[Column<R>], buffers: Box<dyn ColumnBuffers<R>>) -> Self {
+    fn with_buffers(
+        out: W,
+        columns: &[Column<R>],
+        buffers: Box<dyn ColumnBuffers<R>>,
+        group_rows: usize,
+    ) -> Self {
         Self {
             state: State::Idle(out),
             columns: columns.to_vec(),
+            group_rows,
             buffers,
         }
     }
@@ -122,7 +145,7 @@ impl<W: Write + Send, R: 'static> ParquetWriter<W, R> {
     /// Adds one row.
     pub fn write(&mut self, row: &R) -> Result<(), ParquetError> {
         self.buffers.push(row).map_err(ParquetError::General)?;
-        if self.buffers.len() >= ROW_GROUP_ROWS {
+        if self.buffers.len() >= self.group_rows {
             self.write_group()?;
         }
         Ok(())

@@ -338,6 +338,15 @@ impl TimePlot {
         (a, (a + min_s).min(w.end))
     }
 
+    /// `spans` as drawn on a plot `plot_px` wide: each made [`Self::visible`],
+    /// those that then overlap joined into one, in time order. One shape per
+    /// stretch: a campaign's thousand kicks would otherwise be a thousand
+    /// translucent boxes, darker where they overlap and slow to draw.
+    #[must_use]
+    pub fn visible_spans(&self, spans: &[(f64, f64)], plot_px: f64) -> Vec<(f64, f64)> {
+        join_overlaps(spans.iter().map(|&s| self.visible(s, plot_px)).collect())
+    }
+
     /// Stretches lost from the file drawn, s.
     #[must_use]
     pub fn lost_s(&self) -> &[(f64, f64)] {
@@ -472,13 +481,18 @@ impl Figure for TimePlot {
                 .draw()
                 .map_err(err)?;
             let plot_px = f64::from(chart.plotting_area().dim_in_pixel().0);
-            let span = |&s: &(f64, f64), colour: RGBAColor| {
-                let (a, b) = self.visible(s, plot_px);
-                Rectangle::new([(self.x(a), y.start), (self.x(b), y.end)], colour.filled())
-            };
             for (spans, colour, _) in shaded {
                 chart
-                    .draw_series(spans.iter().map(|s| span(s, colour)))
+                    .draw_series(
+                        self.visible_spans(spans, plot_px)
+                            .into_iter()
+                            .map(|(a, b)| {
+                                Rectangle::new(
+                                    [(self.x(a), y.start), (self.x(b), y.end)],
+                                    colour.filled(),
+                                )
+                            }),
+                    )
                     .map_err(err)?;
             }
             chart
@@ -611,9 +625,33 @@ fn clock_text(s: f64, decimals: usize) -> String {
     }
 }
 
+/// `spans` in time order, those that overlap or touch joined into one.
+fn join_overlaps(mut spans: Vec<(f64, f64)>) -> Vec<(f64, f64)> {
+    spans.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let mut joined: Vec<(f64, f64)> = Vec::with_capacity(spans.len());
+    for (a, b) in spans {
+        match joined.last_mut() {
+            Some(last) if a <= last.1 => last.1 = last.1.max(b),
+            _ => joined.push((a, b)),
+        }
+    }
+    joined
+}
+
 #[cfg(test)]
 mod tests {
-    use super::{clock_text, clock_ticks};
+    use super::{clock_text, clock_ticks, join_overlaps};
+
+    #[test]
+    fn overlapping_spans_are_joined_in_time_order() {
+        let spans = vec![(3.0, 4.0), (0.0, 1.0), (0.5, 2.0), (2.0, 2.5), (0.2, 0.3)];
+        assert_eq!(join_overlaps(spans), [(0.0, 2.5), (3.0, 4.0)]);
+        assert_eq!(
+            join_overlaps(vec![(1.0, 2.0), (2.5, 3.0)]),
+            [(1.0, 2.0), (2.5, 3.0)]
+        );
+        assert!(join_overlaps(Vec::new()).is_empty());
+    }
 
     #[test]
     fn clock_ticks_fall_on_round_clock_times() {
