@@ -206,14 +206,17 @@ pub fn decode_to(
     decode_with_events(log, export, out, out_name, Taps::default())
 }
 
+/// Takes a log's events in time order with their UTC (µs since 1970), as
+/// `wobblog events` lists them.
+pub type EventTaker<'a> = &'a mut dyn FnMut(LogEvent, Option<i64>) -> Result<(), CliError>;
+
 /// What else a decoding hands on as it reads the log, so that one reading
 /// serves several outputs (a dataset's frames, events and kicks).
 #[derive(Default)]
 pub struct Taps<'a> {
-    /// Takes the log's events in time order with their UTC (µs since
-    /// 1970), as `wobblog events` lists them; its first error ends the
-    /// decoding and is returned.
-    pub events: Option<&'a mut dyn FnMut(LogEvent, Option<i64>) -> Result<(), CliError>>,
+    /// Takes the log's events; its first error ends the decoding and is
+    /// returned.
+    pub events: Option<EventTaker<'a>>,
     /// Sees every row as assembled, before any window.
     pub rows: Option<&'a mut dyn FnMut(&Row)>,
 }
