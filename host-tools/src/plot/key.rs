@@ -161,3 +161,89 @@ pub fn draw<DB: DrawingBackend, CT: CoordTranslate>(
     }
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The SVG of a 600 x 300 figure whose plot starts 20 px down, with
+    /// the key of `entries` beside it, and the key's width.
+    fn drawn(entries: &[(String, Swatch)]) -> (String, u32) {
+        super::super::register_font();
+        let mut svg = String::new();
+        let labels: Vec<&str> = entries.iter().map(|e| e.0.as_str()).collect();
+        let key_px;
+        {
+            let root = SVGBackend::with_string(&mut svg, (600, 300)).into_drawing_area();
+            key_px = width_px(&root, &labels).unwrap();
+            let plot = root.margin(20, 0, 0, 0);
+            draw(&root, &plot, key_px, entries).unwrap();
+            root.present().unwrap();
+        }
+        (svg, key_px)
+    }
+
+    /// The `name` attribute of the SVG element `el` as a number.
+    fn attr(el: &str, name: &str) -> i32 {
+        let at = el.find(&format!(" {name}=\"")).unwrap() + name.len() + 3;
+        el[at..at + el[at..].find('"').unwrap()].parse().unwrap()
+    }
+
+    #[test]
+    fn a_key_fills_the_width_it_asked_for_level_with_the_plot() {
+        let entries = vec![
+            ("shaded".to_string(), Swatch::Fill(RED.mix(0.2))),
+            ("a much longer label".to_string(), Swatch::line(BLUE, 2)),
+            ("marker".to_string(), Swatch::Upright(GREEN, 2)),
+            (
+                "dashed".to_string(),
+                Swatch::Line {
+                    colour: BLACK,
+                    width: 2,
+                    dashes: Some((4, 3)),
+                },
+            ),
+            ("dot".to_string(), Swatch::Dot(BLACK, 4)),
+        ];
+        let (svg, key_px) = drawn(&entries);
+        let (short, _) = drawn(&entries[..1]);
+        assert!(key_px > 150 && key_px < 300, "{key_px}");
+        assert!(svg.len() > short.len());
+        // The frame: from the gap after the plot to the edge's margin,
+        // from the plot's top down one line per entry.
+        let frame = svg
+            .split("<rect")
+            .skip(1)
+            .find(|e| e.contains("fill=\"none\""))
+            .unwrap();
+        let left = 600 - i32::try_from(key_px).unwrap() + GAP_PX as i32;
+        assert_eq!(attr(frame, "x"), left);
+        assert_eq!(attr(frame, "y"), 20);
+        assert_eq!(
+            attr(frame, "x") + attr(frame, "width"),
+            600 - EDGE_PX as i32 - 1
+        );
+        assert_eq!(attr(frame, "height"), 2 * PADDING_PX + 5 * LINE_PX);
+        // Each label after its swatch, one line apart, in order.
+        let texts: Vec<&str> = svg.split("<text").skip(1).collect();
+        assert_eq!(texts.len(), 5);
+        for (k, (t, (label, _))) in texts.iter().zip(&entries).enumerate() {
+            assert!(t.contains(label.as_str()), "{t}");
+            assert_eq!(attr(t, "x"), left + 2 * PADDING_PX + SWATCH_PX);
+            let k = i32::try_from(k).unwrap();
+            let y = attr(t, "y");
+            let mid = 20 + PADDING_PX + k * LINE_PX + LINE_PX / 2;
+            assert!((y - mid).abs() <= LINE_PX / 2, "{label}: y {y}, line {mid}");
+        }
+        // The dashed swatch is broken, the solid one whole.
+        assert!(svg.matches("stroke=\"#000000\" stroke-width=\"2\"").count() >= 3);
+    }
+
+    #[test]
+    fn no_entries_no_key_and_no_room() {
+        let (svg, key_px) = drawn(&[]);
+        assert_eq!(key_px, 0);
+        assert!(!svg.contains("<rect"), "{svg}");
+        assert!(!svg.contains("<text"), "{svg}");
+    }
+}

@@ -444,6 +444,100 @@ mod tests {
     use proptest::prelude::*;
 
     #[test]
+    fn sizes_are_layout_pixels_in_any_unit() {
+        assert_eq!(parse_size("1400x900"), Ok((1400, 900)));
+        assert_eq!(parse_size("1400x900px"), Ok((1400, 900)));
+        // 96 to the inch, 2.54 cm to the inch, rounded to the pixel.
+        assert_eq!(parse_size(" 7X5IN "), Ok((672, 480)));
+        assert_eq!(parse_size("17x12cm"), Ok((643, 454)));
+        assert_eq!(parse_size("180x110mm"), Ok((680, 416)));
+        assert_eq!(parse_size("480x320"), Ok(MIN_SIZE_PX));
+        assert_eq!(parse_size("14142x14142"), Ok((14142, 14142)));
+        for (text, says) in [
+            ("479x900", "at least 480x320"),
+            ("480x319", "at least 480x320"),
+            ("NaNx900", "at least 480x320"),
+            ("7x", "is not a number"),
+            ("7by5", "no `x`"),
+            ("14143x14143", "larger than any figure needs"),
+        ] {
+            let err = parse_size(text).unwrap_err();
+            assert!(err.contains(says), "{text}: {err}");
+        }
+    }
+
+    #[test]
+    fn resolutions_run_from_24_to_2400_dpi() {
+        assert_eq!(parse_dpi("24"), Ok(24.0));
+        assert_eq!(parse_dpi(" 300 "), Ok(300.0));
+        assert_eq!(parse_dpi("2400"), Ok(2400.0));
+        for text in ["23.9", "2400.1", "NaN", "-96", "x"] {
+            assert!(
+                parse_dpi(text).unwrap_err().contains("24 to 2400"),
+                "{text}"
+            );
+        }
+    }
+
+    #[test]
+    fn a_png_has_dpi_over_96_pixels_per_layout_pixel() {
+        let at = |dpi: f64| FigureArgs { size: None, dpi };
+        assert_eq!(at(96.0).png_pixels((700, 500)), Ok((700, 500)));
+        assert_eq!(at(300.0).png_pixels((700, 500)), Ok((2188, 1563)));
+        assert_eq!(at(48.0).png_pixels((480, 320)), Ok((240, 160)));
+        assert_eq!(at(96.0).png_pixels((14142, 14142)), Ok((14142, 14142)));
+        let err = at(1200.0).png_pixels((10000, 10000)).unwrap_err();
+        assert!(err.contains("lower --dpi or --size"), "{err}");
+        assert!(at(96.0).png_pixels((14143, 14143)).is_err());
+    }
+
+    struct Blank;
+
+    impl Figure for Blank {
+        fn size_px(&self) -> (u32, u32) {
+            (640, 400)
+        }
+
+        fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String> {
+            root.fill(&WHITE).map_err(|e| e.to_string())?;
+            // A black bar across the middle third, top to bottom.
+            let (w, h) = root.dim_in_pixel();
+            let (w, h) = (i32::try_from(w).unwrap(), i32::try_from(h).unwrap());
+            root.draw(&Rectangle::new(
+                [(w / 3, 0), (2 * w / 3, h)],
+                BLACK.filled(),
+            ))
+            .map_err(|e| e.to_string())
+        }
+    }
+
+    #[test]
+    fn the_png_is_the_svg_drawn_at_the_size_and_resolution_asked() {
+        let look = |size: Option<(u32, u32)>, dpi: f64| FigureArgs { size, dpi };
+        assert_eq!(look(None, 96.0).size_of(&Blank), (640, 400));
+        assert_eq!(look(Some((900, 500)), 96.0).size_of(&Blank), (900, 500));
+        let png = draw(&Blank, ImageKind::Png, &look(Some((900, 500)), 192.0)).unwrap();
+        let mut reader = png::Decoder::new(std::io::Cursor::new(png))
+            .read_info()
+            .unwrap();
+        let mut pixels = vec![0; reader.output_buffer_size()];
+        let info = reader.next_frame(&mut pixels).unwrap();
+        assert_eq!((info.width, info.height), (1800, 1000));
+        assert_eq!(info.color_type, png::ColorType::Rgb);
+        // White left and right, black in the middle third: the drawing is
+        // scaled to the pixels, not cropped or tiled.
+        let at = |x: usize, y: usize| &pixels[(y * 1800 + x) * 3..][..3];
+        assert_eq!(at(100, 500), [255, 255, 255]);
+        assert_eq!(at(900, 10), [0, 0, 0]);
+        assert_eq!(at(900, 990), [0, 0, 0]);
+        assert_eq!(at(1700, 500), [255, 255, 255]);
+        let svg =
+            String::from_utf8(draw(&Blank, ImageKind::Svg, &look(None, 300.0)).unwrap()).unwrap();
+        assert!(svg.contains("width=\"640\" height=\"400\""), "{svg:.300}");
+        assert!(svg.contains("@font-face"), "{svg:.300}");
+    }
+
+    #[test]
     fn ticks_have_no_negative_zero() {
         assert_eq!(tick_label(-0.0), "0");
         assert_eq!(tick_label(-1e-17), "0");
