@@ -69,27 +69,50 @@ pub fn open_seekable(path: &Path) -> Result<(File, u64), CliError> {
         }
         Source::Stdin => Source::Stdin,
     };
-    let failed = |e: std::io::Error| {
-        CliError::file(
-            path,
-            format!(
-                "copying the stream to a temporary file in {} (to decode its blocks in order): {e}",
-                crate::text::shown(std::env::temp_dir())
-            ),
-        )
-    };
-    let mut copy = tempfile::tempfile().map_err(failed)?;
-    let len = match source {
-        Source::File(mut file) => copy_log(&mut file, &mut copy),
-        Source::Stdin => copy_log(&mut std::io::stdin().lock(), &mut copy),
-    }
-    .map_err(|e| match e {
-        Copy::Io(e) => failed(e),
-        Copy::Refused(message) => CliError::file(path, message),
-    })?;
+    let (mut copy, len) = match source {
+        Source::File(mut file) => copied(path, &mut file),
+        Source::Stdin => copied(path, &mut std::io::stdin().lock()),
+    }?;
+    let failed = |e| copy_failed(path, e);
     copy.seek(SeekFrom::Start(0)).map_err(failed)?;
     spooled.push((path.to_path_buf(), copy.try_clone().map_err(failed)?));
     Ok((copy, len))
+}
+
+/// Copies the log stream `from` to a temporary file that every later
+/// reading of `name` reads, as a stream given by its path is: for a stream
+/// that has no path (a Python file object).
+///
+/// # Errors
+/// As for a stream read through a path: no valid block in its first
+/// [`PROBE_LEN`] bytes, longer than [`MAX_LEN`], or the copy fails.
+pub fn adopt(name: &Path, from: &mut impl Read) -> Result<(), CliError> {
+    let (copy, _) = copied(name, from)?;
+    let mut spooled = SPOOLED.lock().unwrap_or_else(PoisonError::into_inner);
+    spooled.retain(|(p, _)| p != name);
+    spooled.push((name.to_path_buf(), copy));
+    Ok(())
+}
+
+/// `from` copied to a new unnamed temporary file, and its length.
+fn copied(path: &Path, from: &mut impl Read) -> Result<(File, u64), CliError> {
+    let mut copy = tempfile::tempfile().map_err(|e| copy_failed(path, e))?;
+    let len = copy_log(from, &mut copy).map_err(|e| match e {
+        Copy::Io(e) => copy_failed(path, e),
+        Copy::Refused(message) => CliError::file(path, message),
+    })?;
+    Ok((copy, len))
+}
+
+/// The error of a copy of the stream `path` that failed with `e`.
+fn copy_failed(path: &Path, e: std::io::Error) -> CliError {
+    CliError::file(
+        path,
+        format!(
+            "copying the stream to a temporary file in {} (to decode its blocks in order): {e}",
+            crate::text::shown(std::env::temp_dir())
+        ),
+    )
 }
 
 /// Where a stream is read from.
@@ -219,5 +242,29 @@ mod tests {
         let (second, len) = open_seekable(&fifo).unwrap();
         assert_eq!(len, bytes.len() as u64);
         assert_eq!(read_all(second), bytes);
+    }
+
+    #[test]
+    fn an_adopted_stream_is_read_under_its_name_and_a_second_one_replaces_it() {
+        let name = Path::new("<stream adopted>");
+        let bytes: Vec<u8> = (0..5000u32).map(|i| (i % 241) as u8).collect();
+        adopt(name, &mut bytes.as_slice()).unwrap();
+        for _ in 0..2 {
+            let (copy, len) = open_seekable(name).unwrap();
+            assert_eq!(len, bytes.len() as u64);
+            assert_eq!(read_all(copy), bytes);
+        }
+        adopt(name, &mut &b"other"[..]).unwrap();
+        assert_eq!(read_all(open_seekable(name).unwrap().0), b"other");
+        // Past PROBE_LEN without a block: refused, named, nothing adopted.
+        let zeros = std::io::repeat(0).take(PROBE_LEN + 1);
+        let refused = Path::new("<stream of zeros>");
+        let err = adopt(refused, &mut zeros.take(PROBE_LEN + 1)).unwrap_err();
+        assert!(
+            err.to_string()
+                .starts_with("<stream of zeros>: no valid log block"),
+            "{err}"
+        );
+        assert!(open_seekable(refused).is_err());
     }
 }

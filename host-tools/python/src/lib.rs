@@ -14,15 +14,17 @@ mod stream;
 mod table;
 mod window;
 
-use std::path::PathBuf;
+mod source;
 
 use pyo3::prelude::*;
 
-/// Opens the card log at `path` (`RUNnnnnn.WBL`): decodes it once, for its
-/// summary and its frames (kept for `frames()`), and warns
+/// Opens a card log, `source`: a path (`RUNnnnnn.WBL`), `"-"` for standard
+/// input, or a binary stream (an object with `read`); decodes it once, for
+/// its summary and its frames (kept for `frames()`), and warns
 /// (`wobblog.DamageWarning`) of what it lost.
 #[pyfunction]
-fn open(py: Python<'_>, path: PathBuf) -> PyResult<log::Log> {
+fn open(py: Python<'_>, source: &Bound<'_, PyAny>) -> PyResult<log::Log> {
+    let path = source::log_path(source)?;
     log::Log::open(py, path)
 }
 

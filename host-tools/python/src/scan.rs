@@ -22,7 +22,7 @@ use crate::window::window;
 /// folder of cards, as one table with the columns of `Log.frames()` then
 /// `run` (the number in the log's name) and, for a folder of cards, `card`
 /// (its directory's name): the columns of `wobblog export`'s frames
-/// dataset. Logs are decoded one at a time as the table is read, so memory
+/// dataset (whose files put `run` first). Logs are decoded one at a time as the table is read, so memory
 /// does not grow with their number.
 #[pyclass(module = "wobblog", name = "Scan", frozen)]
 pub struct Scan {

@@ -1,7 +1,10 @@
 """`wobblog.open`: a log's info, config and damage, as `wobblog info --json`
 and `wobblog config` give them; errors and warnings."""
 
+import io
 import os
+import subprocess
+import sys
 import threading
 import warnings
 
@@ -132,3 +135,41 @@ def test_a_log_from_a_pipe_is_read_like_its_file(golden, tmp_path):
     assert piped.info == file.info
     assert pa.table(piped.frames()).equals(pa.table(file.frames()))
     assert piped.events() == file.events()
+
+
+def test_a_stream_opens_as_its_file_does(golden):
+    path = golden["clean"]
+    data = open(path, "rb").read()
+    by_path = wobblog.open(path)
+    streams = [io.BytesIO(data), open(path, "rb")]
+    for stream in streams:
+        log = wobblog.open(stream)
+        assert log.info == by_path.info
+        assert log.frames().to_arrow().equals(by_path.frames().to_arrow())
+        # Read again after the stream is spent: the copy, not the stream.
+        assert log.events() == by_path.events()
+        assert str(log.path).startswith("<stream ")
+    streams[1].close()
+    with open(path, "rb") as named:
+        assert str(wobblog.open(named).path).endswith(f": {path}>")
+
+
+def test_standard_input_is_dash(golden):
+    script = ("import wobblog; log = wobblog.open('-'); "
+              "print(log.info['samples'], len(log.events()))")
+    with open(golden["clean"], "rb") as stdin:
+        out = subprocess.run([sys.executable, "-c", script], stdin=stdin,
+                             capture_output=True, text=True, check=False)
+    assert out.returncode == 0, out.stderr
+    log = wobblog.open(golden["clean"])
+    assert out.stdout.split() == [str(log.info["samples"]), str(len(log.events()))]
+
+
+def test_a_stream_that_is_no_log_or_not_bytes_is_refused(golden, tmp_path):
+    with pytest.raises(wobblog.WobblogError, match="binary mode"):
+        with open(golden["clean"], "r", encoding="latin-1") as text:
+            wobblog.open(text)
+    with pytest.raises(wobblog.WobblogError, match="no valid log block"):
+        wobblog.open(io.BytesIO(b"\0" * (17 << 20)))
+    with pytest.raises(wobblog.WobblogError, match="<stream"):
+        wobblog.open(io.BytesIO(b""))

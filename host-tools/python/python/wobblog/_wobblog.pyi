@@ -3,7 +3,7 @@
 import os
 from pathlib import Path
 from datetime import datetime
-from typing import Any, Optional, Sequence, Union
+from typing import Any, BinaryIO, Optional, Sequence, Union
 
 _Time = Union[float, int, datetime]
 _Path = Union[str, "os.PathLike[str]"]
@@ -101,16 +101,20 @@ def scan(
 ) -> Scan:
     """Every log of a card (``RUNnnnnn.WBL`` at its top) or a folder of cards as
     one table: ``Log.frames()``'s columns, then ``run`` and, for cards, ``card``
-    (the columns of ``wobblog export``'s frames dataset)."""
+    (the columns of ``wobblog export``'s frames dataset, whose files put ``run``
+    first)."""
 
 def summary(dir: _Path) -> list[dict[str, Any]]:
     """One row per run, as ``wobblog summary --json`` (``duration_s`` s,
     ``distance_m`` m, ``max_speed_mps`` and ``wobble_speed_mps`` m/s, ...)."""
 
-def open(path: _Path) -> Log:
+def open(source: Union[_Path, BinaryIO]) -> Log:
     """Opens a card log (``RUNnnnnn.WBL``), warning (``DamageWarning``) of what it lost.
-    The log is decoded once, here: its summary and its frames, which the ``Log``
-    keeps for ``frames()``."""
+    ``source``: a path, ``"-"`` for standard input, or a binary stream (an object
+    with ``read``: ``sys.stdin.buffer``, a pipe, ``io.BytesIO``, a file opened
+    with ``"rb"``), which is copied to an unnamed temporary file first, as the
+    command line copies a pipe. The log is decoded once, here: its summary and
+    its frames, which the ``Log`` keeps for ``frames()``."""
 
 def margin(
     inputs: Sequence[_Path],
