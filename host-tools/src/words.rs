@@ -16,16 +16,34 @@ const CLOSE_EDITS: usize = 3;
 
 /// What to say after "`name` is unknown": the known name closest to it
 /// when one is a few edits away (`did you mean "x"?`), otherwise every
-/// known name (`the parameters are a, b, c`, `what` naming them).
+/// known name (`the parameters are a, b, c`, `what` naming them). A name
+/// without a dot is also held against the last part of dotted ones
+/// (`trial` is a slip of `geometry.trail`).
 #[must_use]
 pub fn suggest(name: &str, known: &[&str], what: &str) -> String {
-    let closest = known
+    let edits = |k: &str| {
+        let last = k.rsplit('.').next().unwrap_or(k);
+        let whole = strsim::levenshtein(name, k);
+        if name.contains('.') {
+            whole
+        } else {
+            whole.min(strsim::levenshtein(name, last))
+        }
+    };
+    let best = known.iter().map(|k| edits(k)).min();
+    let close: Vec<&str> = known
         .iter()
-        .map(|k| (strsim::levenshtein(name, k), *k))
-        .min_by_key(|&(edits, _)| edits);
-    match closest {
-        Some((edits, k)) if edits <= CLOSE_EDITS.min(name.len() / 2) => {
+        .copied()
+        .filter(|k| Some(edits(k)) == best)
+        .collect();
+    match (best, close.as_slice()) {
+        (Some(edits), [k]) if edits <= CLOSE_EDITS.min(name.len() / 2) => {
             format!("did you mean {k:?}?")
+        }
+        // As near as each other: `mass` could be any body's.
+        (Some(edits), several) if edits <= CLOSE_EDITS.min(name.len() / 2) => {
+            let quoted: Vec<String> = several.iter().map(|k| format!("{k:?}")).collect();
+            format!("did you mean one of {}?", quoted.join(", "))
         }
         _ => format!("the {what} are {}", known.join(", ")),
     }
@@ -51,5 +69,25 @@ mod tests {
             super::suggest("mass", &known, "parameters"),
             "the parameters are steer_head.stiffness, steer_head.damping, trail"
         );
+        // The last part of a dotted name, as typed or with a slip.
+        let known = ["geometry.trail", "geometry.wheelbase", "rear_wheel.mass"];
+        for typed in ["trail", "trial", "wheelbse"] {
+            let said = super::suggest(typed, &known, "parameters");
+            assert!(
+                said.starts_with("did you mean \"geometry."),
+                "{typed}: {said}"
+            );
+        }
+        assert_eq!(
+            super::suggest("geometry.trial", &known, "parameters"),
+            "did you mean \"geometry.trail\"?"
+        );
+        // Several as near: all of them.
+        assert_eq!(
+            super::suggest("mass", &["fork.mass", "frame.mass", "trail"], "parameters"),
+            "did you mean one of \"fork.mass\", \"frame.mass\"?"
+        );
+        // A dotted name is not matched by its parts alone.
+        assert!(super::suggest("rear.mas", &known, "parameters").starts_with("the parameters"));
     }
 }

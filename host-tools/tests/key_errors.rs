@@ -101,12 +101,26 @@ fn an_unknown_param_gets_the_closest_parameter_or_the_list() {
         ]),
         1,
     );
+    // Every body has a mass: each is offered.
     assert!(
-        sweep.contains("mass: no such parameter in the file; the parameters of the file are "),
+        sweep.contains("mass: no such parameter in the file; did you mean one of \"fork.mass\", "),
         "{sweep}"
     );
+    assert!(sweep.contains("\"torso.mass\""), "{sweep}");
+    assert!(!sweep.contains("steer_head.stiffness"), "{sweep}");
+    // Far from every name: the list.
+    let far = failure_of(
+        wobblog().args(["model", "sweep"]).arg(params()).args([
+            "--param",
+            "saddle_height",
+            "--factors",
+            "1,2",
+        ]),
+        1,
+    );
+    assert!(far.contains("the parameters of the file are "), "{far}");
     for key in ["steer_head.stiffness", "front_tyre.cornering_stiffness"] {
-        assert!(sweep.contains(key), "{sweep}");
+        assert!(far.contains(key), "{far}");
     }
 }
 
