@@ -107,6 +107,32 @@ impl Scan {
         crate::stream::to_polars(slf.as_any())
     }
 
+    /// The frames as a `polars.LazyFrame` (needs polars): each log decoded
+    /// when the query reaches it, with the query's column choice, filter
+    /// and row limit applied to it before the next is read.
+    fn lazy<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyAny>> {
+        slf.py()
+            .import("wobblog._lazy")?
+            .call_method1("lazy_frame", (slf,))
+    }
+
+    /// One scan per log, in order, with this scan's columns and window
+    /// (what [`Self::lazy`] reads one after another).
+    fn _parts(&self) -> Vec<Self> {
+        self.entries
+            .iter()
+            .map(|e| Self {
+                entries: vec![e.clone()],
+                ..self.with_entries()
+            })
+            .collect()
+    }
+
+    /// This scan without its logs: its columns, no rows.
+    fn _empty(&self) -> Self {
+        self.with_entries()
+    }
+
     /// The frames as a `pyarrow.Table` (needs pyarrow).
     fn to_arrow<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyAny>> {
         crate::stream::to_arrow(slf.as_any())
@@ -114,6 +140,18 @@ impl Scan {
 
     fn __repr__(&self) -> String {
         format!("wobblog.Scan({} logs)", self.entries.len())
+    }
+}
+
+impl Scan {
+    /// This scan's columns, window and schema, with no logs.
+    fn with_entries(&self) -> Self {
+        Self {
+            entries: Vec::new(),
+            columns: self.columns.clone(),
+            window: self.window,
+            schema: self.schema.clone(),
+        }
     }
 }
 

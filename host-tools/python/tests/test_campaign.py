@@ -2,6 +2,7 @@
 cards, equal to `wobblog export`'s frames dataset and `wobblog summary --json`."""
 
 import shutil
+import warnings
 
 import polars as pl
 import pyarrow as pa
@@ -97,3 +98,25 @@ def test_summary_warns_of_an_unreadable_log(campaign, tmp_path):
     with pytest.warns(wobblog.DamageWarning, match=r"RUN00099\.WBL"):
         rows = wobblog.summary(card)
     assert [r["log"] for r in rows] == [f"RUN{i:05d}.WBL" for i in range(8)]
+
+
+def test_scan_as_a_lazy_frame_reads_only_what_the_query_needs(campaign, tmp_path):
+    scan = wobblog.scan(campaign)
+    whole = scan.to_polars()
+    lazy = scan.lazy()
+    assert isinstance(lazy, pl.LazyFrame)
+    assert lazy.collect_schema() == whole.schema
+    assert lazy.collect().equals(whole)
+    columns = ["run", "t_s", "steer_deg"]
+    query = lazy.filter(pl.col("run") == 5).select(columns)
+    assert query.collect().equals(whole.filter(pl.col("run") == 5).select(columns))
+    assert lazy.head(1500).collect().equals(whole.head(1500))
+    # A log past the rows asked for is never read: its damage is not met.
+    card = tmp_path / "card"
+    shutil.copytree(campaign, card)
+    (card / "RUN00099.WBL").write_bytes(b"\x55" * 4096)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", wobblog.DamageWarning)
+        assert wobblog.scan(card).lazy().head(10).collect().height == 10
+    with pytest.warns(wobblog.DamageWarning, match=r"RUN00099\.WBL"):
+        assert wobblog.scan(card).lazy().collect().height == 8 * 1000

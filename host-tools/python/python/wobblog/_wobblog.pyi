@@ -92,6 +92,10 @@ class Scan:
     def __arrow_c_stream__(self, requested_schema: Optional[object] = None) -> object: ...
     def to_polars(self) -> Any: ...
     def to_arrow(self) -> Any: ...
+    def lazy(self) -> Any:
+        """The frames as a ``polars.LazyFrame`` (needs polars): each log is decoded
+        when the query reaches it, and the query's columns, filter and row limit
+        are applied to its frames before the next log is read."""
 
 def scan(
     dir: _Path,
