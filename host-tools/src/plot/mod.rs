@@ -453,6 +453,8 @@ mod tests {
         assert_eq!(parse_size("180x110mm"), Ok((680, 416)));
         assert_eq!(parse_size("480x320"), Ok(MIN_SIZE_PX));
         assert_eq!(parse_size("14142x14142"), Ok((14142, 14142)));
+        // The largest figure itself is drawn.
+        assert_eq!(parse_size("20000x10000"), Ok((20000, 10000)));
         for (text, says) in [
             ("479x900", "at least 480x320"),
             ("480x319", "at least 480x320"),
