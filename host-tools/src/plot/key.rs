@@ -235,6 +235,15 @@ mod tests {
             let mid = 20 + PADDING_PX + k * LINE_PX + LINE_PX / 2;
             assert!((y - mid).abs() <= LINE_PX / 2, "{label}: y {y}, line {mid}");
         }
+        // The shaded swatch: a box inside the swatch's width, on its line.
+        let fill = svg
+            .split("<rect")
+            .skip(1)
+            .find(|e| e.contains("fill=\"#FF0000\""))
+            .unwrap();
+        assert_eq!(attr(fill, "x"), left + PADDING_PX + 2);
+        assert_eq!(attr(fill, "width"), SWATCH_PX - 4);
+        assert_eq!(attr(fill, "y"), 20 + PADDING_PX + LINE_PX / 2 - 6);
         // The dashed swatch is broken, the solid one whole.
         assert!(svg.matches("stroke=\"#000000\" stroke-width=\"2\"").count() >= 3);
     }

@@ -225,8 +225,9 @@ fn rasterise(svg: &str, size: (u32, u32), pixels: (u32, u32)) -> Result<Vec<u8>,
         db.load_font_data(FONT_BYTES.to_vec());
         std::sync::Arc::new(db)
     });
+    // Every text element names its family (plotters writes it), so the
+    // options need only the font itself.
     let options = usvg::Options {
-        font_family: FONT.into(),
         fontdb: fonts.clone(),
         ..usvg::Options::default()
     };
@@ -488,12 +489,48 @@ mod tests {
         assert_eq!(at(300.0).png_pixels((700, 500)), Ok((2188, 1563)));
         assert_eq!(at(48.0).png_pixels((480, 320)), Ok((240, 160)));
         assert_eq!(at(96.0).png_pixels((14142, 14142)), Ok((14142, 14142)));
+        assert_eq!(at(96.0).png_pixels((20000, 10000)), Ok((20000, 10000)));
+        assert_eq!(at(192.0).png_pixels((10000, 5000)), Ok((20000, 10000)));
         let err = at(1200.0).png_pixels((10000, 10000)).unwrap_err();
         assert!(err.contains("lower --dpi or --size"), "{err}");
         assert!(at(96.0).png_pixels((14143, 14143)).is_err());
     }
 
     struct Blank;
+
+    /// White, with one word in large text.
+    struct Word;
+
+    impl Figure for Word {
+        fn size_px(&self) -> (u32, u32) {
+            (480, 320)
+        }
+
+        fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String> {
+            root.fill(&WHITE).map_err(|e| e.to_string())?;
+            root.draw(&Text::new("WWW", (40, 100), (FONT, 120)))
+                .map_err(|e| e.to_string())
+        }
+    }
+
+    #[test]
+    fn png_text_is_drawn_with_the_bundled_font() {
+        let png = draw(&Word, ImageKind::Png, &FigureArgs::default()).unwrap();
+        let mut reader = png::Decoder::new(std::io::Cursor::new(png))
+            .read_info()
+            .unwrap();
+        let mut pixels = vec![0; reader.output_buffer_size()];
+        reader.next_frame(&mut pixels).unwrap();
+        // Three capital Ws at 120 px cover thousands of pixels, with
+        // anti-aliased edges; no font, no glyph: a white page.
+        let dark = pixels.chunks_exact(3).filter(|p| p[0] < 64).count();
+        let edge = pixels
+            .chunks_exact(3)
+            .filter(|p| (64..192).contains(&p[0]))
+            .count();
+        assert!(dark > 5000, "{dark} dark pixels");
+        assert!(edge > 200, "{edge} edge pixels");
+    }
 
     impl Figure for Blank {
         fn size_px(&self) -> (u32, u32) {
