@@ -9,6 +9,7 @@
 //! | PC0 (steering input) | the potentiometer, or any voltage between the rails | `adc_ring` |
 //! | microSD socket | a FAT32 card | `sd_card`, `main_smoke` (with the IMU fitted) |
 //! | microSD socket | exFAT, full FAT32 and FAT16 bench cards, as asked | `card_formats` |
+//! | none | | `sampler_cycles` |
 //!
 //! Run them with a probe attached: `cargo test -p wobble-on-target --target
 //! thumbv7em-none-eabihf` (the runner is probe-rs, see `firmware/docs/board.md`).
