@@ -289,6 +289,15 @@ pub enum BorCheck {
         /// FLASH_SR & [`FLASH_SR_ERRORS`].
         flash_sr: u32,
     },
+    /// Not written: the supply, measured through VREFINT just before, is
+    /// too low for level 3 (`supply::MIN_VDD_FOR_BOR3_MV`), or could not be
+    /// measured. The level stays as it was.
+    SupplyTooLow {
+        /// The level, unchanged.
+        was: BorLevel,
+        /// The supply the decision went by, mV (`None`: not measured).
+        vdd_mv: Option<u32>,
+    },
 }
 
 impl BorCheck {

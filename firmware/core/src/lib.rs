@@ -25,6 +25,7 @@ pub mod logger;
 pub mod selftest;
 pub mod stall;
 pub mod steering;
+pub mod supply;
 pub mod watchdog;
 pub mod wheel;
 pub mod wheel_capture;

@@ -24,6 +24,7 @@ use crate::boot::{BorCheck, ResetCause};
 use crate::drivers::icm42688::reg::WHO_AM_I_VALUE;
 use crate::imu_clock::NOMINAL_PERIOD_US;
 use crate::logger::layout::{u16_at, u32_at, FatLayout};
+use crate::supply::SupplyCheck;
 
 /// How long the rider turns the bar and spins the wheel, µs.
 pub const TEST_WINDOW_US: u64 = 10_000_000;
@@ -305,6 +306,19 @@ impl Check {
                 Some(BorCheck::Failed { was, flash_sr }) => {
                     write!(out, "was={was:?} not programmed flash_sr=0x{flash_sr:02x}")
                 }
+                Some(BorCheck::SupplyTooLow { was, vdd_mv: None }) => write!(
+                    out,
+                    "was={was:?} not programmed: supply not measured (VREFINT)"
+                ),
+                Some(BorCheck::SupplyTooLow {
+                    was,
+                    vdd_mv: Some(mv),
+                }) => write!(
+                    out,
+                    "was={was:?} not programmed: supply measured {mv} mV is too low to enable \
+                     level 3 (needs {} mV)",
+                    crate::supply::MIN_VDD_FOR_BOR3_MV
+                ),
             },
             Self::Stack => match m.stack_bytes {
                 None => out.write_str("not measured"),
@@ -436,11 +450,13 @@ impl QueueCheck {
 
 /// The LED code of the whole self-test: the first failing check of
 /// [`CHECKS`] ([`failure_code`]), else [`QUEUE_LED_CODE`] if the queue's
-/// check failed, else 0.
+/// check failed, else [`crate::supply::SUPPLY_LED_CODE`] if the supply's
+/// did, else 0.
 #[must_use]
-pub fn overall_code(m: &Measurements, queue: &QueueCheck) -> u8 {
+pub fn overall_code(m: &Measurements, queue: &QueueCheck, supply: &SupplyCheck) -> u8 {
     match failure_code(m) {
         0 if queue.verdict() == Verdict::Fail => QUEUE_LED_CODE,
+        0 if supply.verdict() == Verdict::Fail => crate::supply::SUPPLY_LED_CODE,
         code => code,
     }
 }
@@ -643,12 +659,22 @@ mod tests {
         read_report(&text, &mut |l| names.push((l.check, l.verdict))).unwrap();
         assert_eq!(names.len(), 11);
         assert_eq!(names[10], ("queue", Verdict::Fail));
-        // LED codes: the other checks first, then the queue's.
-        assert_eq!(overall_code(&good(), &fast), 0);
-        assert_eq!(overall_code(&good(), &slow), 11);
+        // LED codes: the other checks first, then the queue's, then the
+        // supply's.
+        let supply = SupplyCheck {
+            reading: crate::supply::measure(&[1500; 16], 1500),
+        };
+        let low = SupplyCheck {
+            reading: crate::supply::measure(&[1678; 16], 1500),
+        };
+        assert_eq!(overall_code(&good(), &fast, &supply), 0);
+        assert_eq!(overall_code(&good(), &slow, &supply), 11);
+        assert_eq!(overall_code(&good(), &slow, &low), 11);
+        assert_eq!(overall_code(&good(), &fast, &low), 12);
+        assert_eq!(overall_code(&good(), &fast, &SupplyCheck::default()), 12);
         let mut bad = good();
         bad.wheel_edges = 0;
-        assert_eq!(overall_code(&bad, &slow), 3);
+        assert_eq!(overall_code(&bad, &slow, &low), 3);
     }
 
     #[test]
@@ -661,7 +687,7 @@ mod tests {
     #[test]
     fn each_fault_fails_its_own_check_and_gives_its_code() {
         type Spoil = fn(&mut Measurements);
-        let cases: [(Check, Spoil); 23] = [
+        let cases: [(Check, Spoil); 24] = [
             (Check::Imu, |m| m.imu_id = Some(0x00)),
             (Check::Imu, |m| m.accel_g = Some(0.5)),
             (Check::Imu, |m| m.accel_g = None),
@@ -682,6 +708,13 @@ mod tests {
                 m.bor = Some(BorCheck::Failed {
                     was: BorLevel::Off,
                     flash_sr: 1 << 4,
+                });
+            }),
+            // A supply too low for level 3: kept, and the check fails.
+            (Check::Bor, |m| {
+                m.bor = Some(BorCheck::SupplyTooLow {
+                    was: BorLevel::Off,
+                    vdd_mv: Some(2950),
                 });
             }),
             (Check::Stack, |m| m.stack_bytes = Some((43_001, 86_000))),
@@ -718,6 +751,34 @@ mod tests {
             let code = CHECKS.iter().position(|&c| c == check).unwrap() as u8 + 1;
             assert_eq!(failure_code(&m), code);
         }
+    }
+
+    /// The `bor` line says why level 3 was not programmed.
+    #[test]
+    fn a_supply_too_low_for_level_3_is_named_in_the_bor_line() {
+        let line = |vdd_mv| {
+            let m = Measurements {
+                bor: Some(BorCheck::SupplyTooLow {
+                    was: BorLevel::Off,
+                    vdd_mv,
+                }),
+                ..good()
+            };
+            let text = report_of(&m);
+            text.lines()
+                .find(|l| l.starts_with("bor "))
+                .unwrap()
+                .to_owned()
+        };
+        assert_eq!(
+            line(Some(2950)),
+            "bor FAIL was=Off not programmed: supply measured 2950 mV is too low to enable \
+             level 3 (needs 3070 mV)"
+        );
+        assert_eq!(
+            line(None),
+            "bor FAIL was=Off not programmed: supply not measured (VREFINT)"
+        );
     }
 
     #[test]

@@ -8,13 +8,17 @@
 //! green LED on and one long beep; a failure, the red LED and the buzzer
 //! repeat the failing check's number (1 IMU, 2 steering, 3 wheel, 4 GPS,
 //! 5 card, 6 clock, 7 reset, 8 brown-out level, 9 stack, 10 IMU data-ready
-//! line, 11 record queue: the card too slow for it) until power-off.
+//! line, 11 record queue: the card too slow for it, 12 supply too low for
+//! the brown-out level) until power-off.
 //! The brown-out level is programmed here when it is below 2.7 V (never at
-//! boot): the check fails until a power cycle and a second self-test show
-//! the stored level.
+//! boot) and the supply, measured through VREFINT just before, is high
+//! enough for it (the core's `supply`; the report's `vdd` line, LED code
+//! 12 when too low): the check fails until a power cycle and a second
+//! self-test show the stored level.
 
 use embassy_futures::join::join;
 use embassy_stm32::gpio::Output;
+use embassy_stm32::peripherals::ADC1;
 use embassy_time::{Duration, Instant, Ticker, Timer};
 use embedded_sdmmc::{Mode, VolumeIdx};
 use wobble_core::app::gps_setup;
@@ -27,6 +31,7 @@ use wobble_core::selftest::{
     fat_free_mib, overall_code, write_report, Measurements, PulseTrain, QueueCheck,
     DATA_READY_WINDOW_US, TEST_WINDOW_US,
 };
+use wobble_core::supply::SupplyCheck;
 
 use crate::adapters::card::SdCard;
 use crate::adapters::gps::GpsAdapter;
@@ -226,9 +231,22 @@ pub async fn run(p: Parts, queue: &'static RecordQueue) -> ! {
     .await;
     m.gps_baud = outcome.found_baud;
     m.gps_rate_hz = outcome.rate_hz;
+    // The steering ring is done with: its drop stops the conversions and
+    // the DMA stream and gates ADC1's clock (embassy-stm32 0.6.0,
+    // `RingBufferedAdc`'s and `ReadableRingBuffer`'s `Drop`).
+    drop(steering);
+    // SAFETY: ADC1's only user, the steering ring above, is gone (its
+    // `Peri` was consumed into it at assembly); nothing else in the
+    // self-test touches ADC1.
+    let adc = unsafe { ADC1::steal() };
+    let supply = SupplyCheck {
+        reading: crate::adapters::supply::measure(adc),
+    };
+    defmt::info!("supply: {}", supply.reading);
     // The explicit step the boot never takes: the option bytes are written
-    // here, at the bench, and verified by the next self-test.
-    m.bor = Some(crate::startup::program_bor_level3());
+    // here, at the bench, on a supply measured high enough, and verified
+    // by the next self-test.
+    m.bor = Some(crate::startup::program_bor_level3(supply.reading));
     m.stack_bytes = Some(crate::startup::stack_use());
     let volumes = logger::volumes(card, FixedTime::EPOCH);
     m.card_free_mib = volumes.device(|card| fat_free_mib(card)).unwrap_or(0);
@@ -245,15 +263,18 @@ pub async fn run(p: Parts, queue: &'static RecordQueue) -> ! {
         high_water: queue.high_water(),
         slowest_write_us: speed.map(|(_, _, slowest)| slowest),
     };
-    let mut text = heapless::String::<768>::new();
-    if write_report(&m, &mut text).is_err() || queue.write_line(&mut text).is_err() {
+    let mut text = heapless::String::<1024>::new();
+    if write_report(&m, &mut text).is_err()
+        || queue.write_line(&mut text).is_err()
+        || supply.write_line(&mut text).is_err()
+    {
         defmt::warn!("self-test report cut short");
     }
     defmt::info!("{=str}", text.as_str());
     if !write_report_file(&volumes, &text) {
         defmt::error!("{} not written", REPORT);
     }
-    let code = overall_code(&m, &queue);
+    let code = overall_code(&m, &queue, &supply);
     if code == 0 {
         status_led.set_high();
         buzzer.set_high();

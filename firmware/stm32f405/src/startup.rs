@@ -17,6 +17,8 @@ use wobble_core::boot::{
     CRYSTAL_FAILED_MARK, FAULT_RESET_MARK, FLASH_SR_ERRORS,
 };
 
+use wobble_core::supply::{bor_step, BorStep, SupplyReading};
+
 use crate::clocks::HSE_STARTUP_TIMEOUT_MS;
 
 /// Reads why the MCU reset and clears the flags, so the next reset tells
@@ -88,16 +90,19 @@ pub fn bor_level() -> BorLevel {
 }
 
 /// Programs the brown-out reset to level 3 (2.7 V) if the option bytes
-/// hold anything else (the factory setting is off), with the other option
-/// bytes, read protection included, written back as read. Stale FLASH_SR
-/// error flags are cleared first and the ones the write raised are
-/// reported and cleared; the stored value is verified by the next
-/// self-test, after a power cycle loads it.
-pub fn program_bor_level3() -> BorCheck {
+/// hold anything else (the factory setting is off) and the core's
+/// `supply::bor_step` allows it on `supply`, the supply just measured
+/// through VREFINT (`adapters::supply::measure`): a supply too low, or not
+/// measured, leaves the option bytes alone. The other option bytes, read
+/// protection included, are written back as read. Stale FLASH_SR error
+/// flags are cleared first and the ones the write raised are reported and
+/// cleared; the stored value is verified by the next self-test, after a
+/// power cycle loads it.
+pub fn program_bor_level3(supply: Option<SupplyReading>) -> BorCheck {
     let optcr = FLASH.optcr().read().0;
     let was = BorLevel::from_optcr(optcr);
-    if was == BorLevel::Level3 {
-        return BorCheck::Level3;
+    if let BorStep::Keep(check) = bor_step(was, supply) {
+        return check;
     }
     let clear_errors = || {
         FLASH

@@ -7,4 +7,5 @@ pub mod gps;
 pub mod imu;
 pub mod rider;
 pub mod steering;
+pub mod supply;
 pub mod wheel;
