@@ -85,6 +85,9 @@ fn main() -> ! {
     }
     let mut board = Board::new(embassy_stm32::init(clocks::config(crystal)));
     startup::enable_flash_accelerator();
+    // A debugger's halt stops the time base, the capture timer and the
+    // watchdog together.
+    startup::freeze_timers_when_halted();
     // The writer closes the log when VDD falls below 2.9 V, and opens no
     // file before it is above.
     power::start(&SHARED);

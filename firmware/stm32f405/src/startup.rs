@@ -73,6 +73,23 @@ pub fn enable_flash_accelerator() {
     });
 }
 
+/// Stops the logger's timers while a debugger halts the core
+/// (DBGMCU_APB1_FZ, RM0090 38.16.4: DBG_TIM3_STOP, DBG_TIM5_STOP and
+/// DBG_IWDG_STOP): TIM3 is embassy-time's driver, TIM5 the wheel's and the
+/// IMU's capture time base, whose counts `wheel_capture::EdgeClock` maps
+/// onto embassy-time's, so the two stop and go together and a halt looks to
+/// the firmware like no time at all (no burst of missed ticks, no
+/// watchdog reset, no stale captures on resume). The watchdog's own start
+/// sets its bit again (`watchdog::freeze_when_halted`). No effect without
+/// a debugger; the register is cleared only by a power-on reset.
+pub fn freeze_timers_when_halted() {
+    pac::DBGMCU.apb1fzr().modify(|w| {
+        w.set_tim3(true);
+        w.set_tim5(true);
+        w.set_iwdg(true);
+    });
+}
+
 /// FLASH_OPTKEYR unlock sequence (RM0090 3.7.2).
 const OPT_KEYS: [u32; 2] = [0x0819_2A3B, 0x4C5D_6E7F];
 /// Option byte programming takes about 16 ms at most; a generous bound in
@@ -168,6 +185,13 @@ fn stack_bounds() -> (u32, u32) {
 fn guard_base() -> u32 {
     let (end, _) = stack_bounds();
     end.next_multiple_of(GUARD_BYTES)
+}
+
+/// The stack guard's region, as addresses: its base and its end (the
+/// lowest address the stack may use).
+pub fn guard_region() -> (u32, u32) {
+    let base = guard_base();
+    (base, base + GUARD_BYTES)
 }
 
 /// Puts a no-access MPU region at the bottom of the stack: a stack that

@@ -7,18 +7,30 @@
 //! | PA2 (GPS TX) | PA3 (GPS RX) | `gps_uart` |
 //! | PA9 (USART1 TX) to PA3, PA2 to PA10 (USART1 RX), instead of PA2-PA3 | a receiver played by USART1 | `gps_recovery` |
 //! | PC0 (steering input) | the potentiometer, or any voltage between the rails | `adc_ring` |
+//! | the IMU fitted | its INT1 on PA1 (the board's own wiring) | `imu_data_ready` |
 //! | microSD socket | a FAT32 card | `sd_card`, `main_smoke` (with the IMU fitted) |
 //! | microSD socket | exFAT, full FAT32 and FAT16 bench cards, as asked | `card_formats` |
-//! | none | | `sampler_cycles` |
+//! | microSD socket | the card of the relay power cuts (bench step 5b), as asked | `power_cut` |
+//! | none | | `sampler_cycles`, `stack_guard`, `debug_freeze`, `tim5_wrap` (its soak `#[ignore]`d: 75 min) |
+//! | none (a bench supply at 3.3 V) | | `power_detector` |
+//! | none | | `watchdog_reset`, `watchdog_stall` |
+//!
+//! The tests that ask the person at the bench for a card share its
+//! adapter ([`sd_card`]) and their deadline loop ([`poll_until`]).
 //!
 //! Run them with a probe attached: `cargo test -p wobble-on-target --target
 //! thumbv7em-none-eabihf` (the runner is probe-rs, see `firmware/docs/board.md`).
 #![no_std]
 #![warn(missing_docs)]
 
+use embassy_stm32::gpio::{Level, Output, Speed};
 use embassy_stm32::peripherals::{PB6, TIM4};
+use embassy_stm32::spi::Spi;
 use embassy_stm32::Peri;
-use wobble_stm32f405::pins::Board;
+use embassy_time::{Duration, Instant, Timer};
+use wobble_core::drivers::sdcard::IDENTIFICATION_CLOCK_HZ;
+use wobble_stm32f405::adapters::card::{self, SdCard};
+use wobble_stm32f405::pins::{Board, CardPins};
 use wobble_stm32f405::{clocks, startup};
 
 /// The pins of the PWM loop-back source, outside the logger's pin map.
@@ -35,6 +47,7 @@ pub fn board() -> (Board, PwmSource) {
     let crystal = startup::start_hse();
     let p = embassy_stm32::init(clocks::config(crystal));
     startup::enable_flash_accelerator();
+    startup::freeze_timers_when_halted();
     defmt::info!(
         "clocks from the {}",
         if crystal { "crystal" } else { "HSI" }
@@ -48,4 +61,42 @@ pub fn board() -> (Board, PwmSource) {
         }
     };
     (Board::new(p), pwm)
+}
+
+/// The card adapter on SPI2 at the identification clock, as the logger
+/// builds it (`assembly::card_and_config` without `CONFIG.TXT`).
+pub fn card_on(pins: CardPins) -> SdCard {
+    let bus = Spi::new_blocking(
+        pins.spi,
+        pins.sck,
+        pins.mosi,
+        pins.miso,
+        card::spi_config(IDENTIFICATION_CLOCK_HZ),
+    );
+    card::card(bus, Output::new(pins.cs, Level::High, Speed::VeryHigh))
+}
+
+/// The board brought up ([`board`]) and its card adapter ([`card_on`]).
+pub fn sd_card() -> SdCard {
+    let (board, _) = board();
+    card_on(board.card)
+}
+
+/// Calls `poll` every `period` until it gives a value, for at most
+/// `limit`: the value, or `None` at the deadline. The waits of the tests
+/// that ask the person at the bench for something (a card inserted, pulled,
+/// swapped).
+pub async fn poll_until<T>(
+    limit: Duration,
+    period: Duration,
+    mut poll: impl FnMut() -> Option<T>,
+) -> Option<T> {
+    let until = Instant::now() + limit;
+    while Instant::now() < until {
+        if let Some(value) = poll() {
+            return Some(value);
+        }
+        Timer::after(period).await;
+    }
+    None
 }

@@ -13,30 +13,16 @@ use defmt_rtt as _;
 #[cfg(test)]
 #[embedded_test::tests]
 mod tests {
-    use embassy_stm32::gpio::{Level, Output, Speed};
-    use embassy_stm32::spi::Spi;
-    use embassy_time::{Duration, Instant, Timer};
+    use embassy_time::{Duration, Instant};
     use embedded_sdmmc::BlockDevice;
-    use wobble_core::drivers::sdcard::IDENTIFICATION_CLOCK_HZ;
     use wobble_core::logger::{CardLogger, FixedTime, HeaderSpec, LoggerConfig, LoggerState};
     use wobble_core::selftest::fat_free_mib;
-    use wobble_stm32f405::adapters::card::{self, SdCard};
+    use wobble_on_target::{poll_until, sd_card as sd};
 
     /// How long the person at the bench has to insert the card asked for.
-    const INSERT_S: u64 = 60;
-
-    fn sd() -> SdCard {
-        let (board, _) = wobble_on_target::board();
-        let pins = board.card;
-        let bus = Spi::new_blocking(
-            pins.spi,
-            pins.sck,
-            pins.mosi,
-            pins.miso,
-            card::spi_config(IDENTIFICATION_CLOCK_HZ),
-        );
-        card::card(bus, Output::new(pins.cs, Level::High, Speed::VeryHigh))
-    }
+    const INSERT: Duration = Duration::from_secs(60);
+    /// How often the card is tried meanwhile (as a rider's swap is retried).
+    const RETRY: Duration = Duration::from_millis(200);
 
     const HEADER: HeaderSpec<'static> = HeaderSpec {
         firmware: "on-target card_formats",
@@ -58,41 +44,36 @@ mod tests {
             retry_period_ms: 200,
         };
         let mut logger = CardLogger::new(sd(), FixedTime::EPOCH, HEADER, config);
-        defmt::info!("insert {} ({} s)", card, INSERT_S);
-        let until = Instant::now() + Duration::from_secs(INSERT_S);
-        while Instant::now() < until {
+        defmt::info!("insert {} ({} s)", card, INSERT.as_secs());
+        let reached = poll_until(INSERT, RETRY, || {
             logger.poll(Instant::now().as_micros());
             let state = logger.state();
             defmt::assert!(!never(state), "{}: the logger says {}", card, state);
-            if want(state) {
-                defmt::info!("{}: {}", card, state);
-                return;
-            }
-            Timer::after_millis(200).await;
+            want(state).then_some(state)
+        })
+        .await;
+        match reached {
+            Some(state) => defmt::info!("{}: {}", card, state),
+            None => defmt::panic!(
+                "{}: the logger says {} at the deadline",
+                card,
+                logger.state()
+            ),
         }
-        defmt::panic!(
-            "{}: the logger says {} at the deadline",
-            card,
-            logger.state()
-        );
     }
 
     /// Asks for `card` and waits until it answers with a FAT volume; its
     /// free space as the self-test counts it, MiB.
     async fn free_space_of(card: &str) -> u32 {
         let sd = sd();
-        defmt::info!("insert {} ({} s)", card, INSERT_S);
-        let until = Instant::now() + Duration::from_secs(INSERT_S);
-        while Instant::now() < until {
-            if sd.num_blocks().is_ok() {
-                if let Some(free) = fat_free_mib(&sd) {
-                    defmt::info!("{}: {} MiB free", card, free);
-                    return free;
-                }
-            }
-            Timer::after_millis(200).await;
-        }
-        defmt::panic!("{}: no FAT volume answered", card);
+        defmt::info!("insert {} ({} s)", card, INSERT.as_secs());
+        let free = poll_until(INSERT, RETRY, || {
+            sd.num_blocks().ok().and_then(|_| fat_free_mib(&sd))
+        })
+        .await;
+        let free = defmt::unwrap!(free, "{}: no FAT volume answered", card);
+        defmt::info!("{}: {} MiB free", card, free);
+        free
     }
 
     #[test]

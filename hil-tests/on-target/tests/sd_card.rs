@@ -9,26 +9,10 @@ use defmt_rtt as _;
 #[cfg(test)]
 #[embedded_test::tests]
 mod tests {
-    use embassy_stm32::gpio::{Level, Output, Speed};
-    use embassy_stm32::spi::Spi;
-    use embassy_time::{Duration, Instant, Timer};
+    use embassy_time::Duration;
     use embedded_sdmmc::{BlockDevice, Mode, VolumeIdx, VolumeManager};
-    use wobble_core::drivers::sdcard::IDENTIFICATION_CLOCK_HZ;
     use wobble_core::logger::FixedTime;
-    use wobble_stm32f405::adapters::card::{self, SdCard};
-
-    fn sd() -> SdCard {
-        let (board, _) = wobble_on_target::board();
-        let pins = board.card;
-        let bus = Spi::new_blocking(
-            pins.spi,
-            pins.sck,
-            pins.mosi,
-            pins.miso,
-            card::spi_config(IDENTIFICATION_CLOCK_HZ),
-        );
-        card::card(bus, Output::new(pins.cs, Level::High, Speed::VeryHigh))
-    }
+    use wobble_on_target::{poll_until, sd_card as sd};
 
     #[test]
     fn a_file_is_written_flushed_and_read_back() {
@@ -58,15 +42,18 @@ mod tests {
         let card = sd();
         defmt::assert!(card.num_blocks().is_ok(), "no card at the start");
         defmt::info!("pull the card out, then push it back in (20 s)");
-        let until = Instant::now() + Duration::from_secs(20);
         let mut pulled = false;
-        while Instant::now() < until {
+        let back = poll_until(Duration::from_secs(20), Duration::from_millis(200), || {
             match (card.num_blocks().is_ok(), pulled) {
                 (false, _) => pulled = true,
-                (true, true) => return,
+                (true, true) => return Some(()),
                 (true, false) => {}
             }
-            Timer::after_millis(200).await;
+            None
+        })
+        .await;
+        if back.is_some() {
+            return;
         }
         defmt::panic!("the card was not pulled and pushed back in time");
     }

@@ -804,8 +804,10 @@ fn next_run<D: BlockDevice, T: TimeSource>(
     Ok(highest + 1)
 }
 
-/// `RUN00042.WBL` -> 42.
-fn parse_run(name: &ShortFileName) -> Option<u32> {
+/// `RUN00042.WBL` -> 42; `None` for any other name. Public for readers of
+/// a card (the on-target power-cut check walks every run file).
+#[must_use]
+pub fn parse_run(name: &ShortFileName) -> Option<u32> {
     let digits = name.base_name().strip_prefix(b"RUN")?;
     if name.extension() != b"WBL" || digits.len() != 5 {
         return None;
