@@ -136,21 +136,18 @@ impl RowAssembler {
                     self.gps = None;
                 }
                 if self.pending.len() >= MAX_PENDING_ROWS {
-                    if let Some((_, row)) = self.pending.pop_front() {
-                        emit(&row);
-                    }
+                    self.emit_first(emit);
                 }
                 let gps = self.gps_at(frame.t_us);
                 let sync = self.sync.filter(|s| s.t_us <= frame.t_us);
                 self.pending
                     .push_back((frame.t_us, Row::new(frame, gps, sync)));
-                while let Some(&(t, _)) = self.pending.front() {
-                    if t + GPS_WAIT_US >= frame.t_us {
-                        break;
-                    }
-                    if let Some((_, row)) = self.pending.pop_front() {
-                        emit(&row);
-                    }
+                while self
+                    .pending
+                    .front()
+                    .is_some_and(|&(t, _)| t + GPS_WAIT_US < frame.t_us)
+                {
+                    self.emit_first(emit);
                 }
             }
             Record::Gps(fix) => {
@@ -183,6 +180,15 @@ impl RowAssembler {
         for (_, row) in self.pending.drain(..) {
             emit(&row);
         }
+    }
+
+    /// Emits the first pending row and drops it (emitted where it lies:
+    /// a row is some 200 bytes, and moving each out would copy it).
+    fn emit_first(&mut self, emit: &mut impl FnMut(&Row)) {
+        if let Some((_, row)) = self.pending.front() {
+            emit(row);
+        }
+        self.pending.pop_front();
     }
 
     fn gps_at(&self, t_us: u64) -> Option<GpsColumns> {

@@ -32,23 +32,42 @@ pub struct RecordCount {
     pub rate_hz: Option<f64>,
 }
 
-/// The name `info` gives records of `record`'s kind.
-fn kind_name(record: &Record<'_>) -> &'static str {
+/// The names `info` gives the kinds of records, in [`kind_index`]'s order.
+const KIND_NAMES: [&str; 14] = [
+    "frame",
+    "gps_fix",
+    "gps_no_position",
+    "utc_sync",
+    "alert_on",
+    "alert_off",
+    "marker",
+    "dropout",
+    "fault",
+    "kick",
+    "margin",
+    "log_info",
+    "channel",
+    "config",
+];
+
+/// The place of `record`'s kind in [`KIND_NAMES`] (counted in an array
+/// while decoding: a map entry per record would cost more than the record).
+fn kind_index(record: &Record<'_>) -> usize {
     match record {
-        Record::Frame(_) => "frame",
-        Record::Gps(g) if g.lat_e7.is_some() && g.lon_e7.is_some() => "gps_fix",
-        Record::Gps(_) => "gps_no_position",
-        Record::UtcSync(_) => "utc_sync",
-        Record::Alert(a) if a.on => "alert_on",
-        Record::Alert(_) => "alert_off",
-        Record::Marker(_) => "marker",
-        Record::Dropout(_) => "dropout",
-        Record::Fault(_) => "fault",
-        Record::Kick(_) => "kick",
-        Record::Margin(_) => "margin",
-        Record::LogInfo(_) => "log_info",
-        Record::Channel(_) => "channel",
-        Record::Config(_) => "config",
+        Record::Frame(_) => 0,
+        Record::Gps(g) if g.lat_e7.is_some() && g.lon_e7.is_some() => 1,
+        Record::Gps(_) => 2,
+        Record::UtcSync(_) => 3,
+        Record::Alert(a) if a.on => 4,
+        Record::Alert(_) => 5,
+        Record::Marker(_) => 6,
+        Record::Dropout(_) => 7,
+        Record::Fault(_) => 8,
+        Record::Kick(_) => 9,
+        Record::Margin(_) => 10,
+        Record::LogInfo(_) => 11,
+        Record::Channel(_) => 12,
+        Record::Config(_) => 13,
     }
 }
 
@@ -174,19 +193,25 @@ impl Summary {
 #[derive(Default)]
 pub struct SummaryBuilder {
     summary: Summary,
+    /// Records of each kind of [`KIND_NAMES`].
+    kinds: [u64; KIND_NAMES.len()],
     /// First and last frame times of the current segment, µs.
     span_us: Option<(u64, u64)>,
     /// Time covered by the segments before it, µs.
     closed_us: u64,
     /// Frames of the current segment.
     segment_frames: u64,
-    rows: RowAssembler,
+    /// The rows, assembled here unless the caller assembles them
+    /// ([`SummaryBuilder::rows_elsewhere`]).
+    rows: Option<RowAssembler>,
     row_stats: RowStats,
 }
 
-/// What the summary takes from the decoded rows.
+/// What the summary takes from the decoded rows: GPS coverage and the UTC
+/// span. Given every row of the log in order (whatever part of it an
+/// output keeps).
 #[derive(Default)]
-struct RowStats {
+pub struct RowStats {
     with_gps: u64,
     /// The `utc` of the first and last row that has one, µs since 1970.
     first_utc_us: Option<i64>,
@@ -194,7 +219,8 @@ struct RowStats {
 }
 
 impl RowStats {
-    fn take(&mut self, row: &Row) {
+    /// Takes the log's next row.
+    pub fn take(&mut self, row: &Row) {
         self.with_gps += u64::from(row.gps.is_some());
         if let Some(us) = row.utc_us {
             self.first_utc_us.get_or_insert(us);
@@ -207,6 +233,18 @@ impl SummaryBuilder {
     /// An empty builder.
     #[must_use]
     pub fn new() -> Self {
+        Self {
+            rows: Some(RowAssembler::new()),
+            ..Self::default()
+        }
+    }
+
+    /// An empty builder for a caller that assembles the log's rows itself
+    /// (from the same records): it hands their [`RowStats`] to
+    /// [`SummaryBuilder::finish_with_rows`] rather than having every row
+    /// assembled twice.
+    #[must_use]
+    pub fn rows_elsewhere() -> Self {
         Self::default()
     }
 
@@ -219,7 +257,7 @@ impl SummaryBuilder {
         let Event::Record(record) = event else { return };
         let s = &mut self.summary;
         let t_s = record.t_us() as f64 / 1e6;
-        s.records.entry(kind_name(record)).or_default().count += 1;
+        self.kinds[kind_index(record)] += 1;
         match record {
             Record::Frame(f) => {
                 s.samples += 1;
@@ -271,8 +309,10 @@ impl SummaryBuilder {
             Record::Channel(_) | Record::Margin(_) => {}
             Record::Config(line) => s.config.push(line.text.to_string()),
         }
-        let stats = &mut self.row_stats;
-        self.rows.push(record, &mut |row: &Row| stats.take(row));
+        if let Some(rows) = &mut self.rows {
+            let stats = &mut self.row_stats;
+            rows.push(record, &mut |row: &Row| stats.take(row));
+        }
     }
 
     /// The frame rate the log has given so far (see
@@ -312,8 +352,23 @@ impl SummaryBuilder {
     /// The summary, given the decoder's totals.
     #[must_use]
     pub fn finish(mut self, stats: &DecodeStats) -> Summary {
-        let row_stats = &mut self.row_stats;
-        self.rows.finish(&mut |row: &Row| row_stats.take(row));
+        if let Some(rows) = &mut self.rows {
+            let row_stats = &mut self.row_stats;
+            rows.finish(&mut |row: &Row| row_stats.take(row));
+        }
+        self.finish_rows_taken(stats)
+    }
+
+    /// The summary, given the decoder's totals and those of the rows the
+    /// caller assembled (see [`SummaryBuilder::rows_elsewhere`]).
+    #[must_use]
+    pub fn finish_with_rows(mut self, stats: &DecodeStats, rows: RowStats) -> Summary {
+        self.rows = None;
+        self.row_stats = rows;
+        self.finish_rows_taken(stats)
+    }
+
+    fn finish_rows_taken(mut self, stats: &DecodeStats) -> Summary {
         self.close_segment();
         let mut s = self.summary;
         let utc_text = |us: Option<i64>| us.and_then(iso8601_unix_us);
@@ -321,8 +376,11 @@ impl SummaryBuilder {
         s.first_utc_us = self.row_stats.first_utc_us;
         s.last_utc = utc_text(self.row_stats.last_utc_us);
         s.duration_s = self.closed_us as f64 / 1e6;
-        for kind in s.records.values_mut() {
-            kind.rate_hz = (s.duration_s > 0.0).then(|| kind.count as f64 / s.duration_s);
+        for (name, &count) in KIND_NAMES.iter().zip(&self.kinds) {
+            if count > 0 {
+                let rate_hz = (s.duration_s > 0.0).then(|| count as f64 / s.duration_s);
+                s.records.insert(name, RecordCount { count, rate_hz });
+            }
         }
         s.gps_coverage_pct = if s.samples == 0 {
             0.0

@@ -10,6 +10,7 @@ use wobblog::export::columns::Column;
 use wobblog::losses::Losses;
 use wobblog::reader::read_log_until;
 use wobblog::rows::{Row, RowAssembler};
+use wobblog::summary::RowStats;
 use wobblog::time::TimeWindow;
 use wobblog::CliError;
 
@@ -27,6 +28,8 @@ pub struct Decoded {
     pub stats: DecodeStats,
     /// First and last boot time of every row (inside the window or not), s.
     pub span_s: Option<(f64, f64)>,
+    /// What a summary takes from every row (inside the window or not).
+    pub row_stats: RowStats,
     /// The log has a UTC sync pair.
     pub has_utc: bool,
 }
@@ -40,6 +43,7 @@ struct Built {
     table: TableBuilder<Row>,
     kept: u64,
     span_s: Option<(f64, f64)>,
+    row_stats: RowStats,
     failure: Option<arrow_schema::ArrowError>,
     /// Ctrl-C, which stopped the building (and so the decoding).
     interrupted: Option<PyErr>,
@@ -66,6 +70,7 @@ fn build(
         table: TableBuilder::frames(columns),
         kept: 0,
         span_s: None,
+        row_stats: RowStats::default(),
         failure: None,
         interrupted: None,
     };
@@ -73,6 +78,7 @@ fn build(
         built.span_s = Some(built.span_s.map_or((row.t_s, row.t_s), |(a, b)| {
             (a.min(row.t_s), b.max(row.t_s))
         }));
+        built.row_stats.take(row);
         // As `wobblog decode`: a row is in when its boot time or UTC (ms) is.
         if window.is_all() || window.contains(row.t_s, row.utc_us.map(|u| u / 1000)) {
             built.kept += 1;
@@ -160,6 +166,7 @@ pub fn walk(
         table,
         kept,
         span_s,
+        row_stats,
         failure,
         interrupted,
     } = built;
@@ -180,6 +187,7 @@ pub fn walk(
         table: Table::new(schema, batches),
         stats,
         span_s,
+        row_stats,
         has_utc,
     })
 }

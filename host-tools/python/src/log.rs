@@ -74,14 +74,16 @@ const ROLL_COLUMNS: [Column<RollRow>; 2] = [
 impl Log {
     /// Opens the log at `path`, warning of its losses.
     pub fn open(py: Python<'_>, path: PathBuf) -> PyResult<Self> {
-        // One pass: what `wobblog info` summarises and every frame.
+        // One pass: what `wobblog info` summarises and every frame, the
+        // summary's row totals taken from the frames' rows.
         let (summary, decoded) = py.detach(|| {
-            let mut builder = SummaryBuilder::new();
-            let decoded =
+            let mut builder = SummaryBuilder::rows_elsewhere();
+            let mut decoded =
                 crate::frames::walk(&path, &columns::COLUMNS, TimeWindow::default(), |event| {
                     builder.observe(event)
                 })?;
-            PyResult::Ok((builder.finish(&decoded.stats), decoded))
+            let rows = std::mem::take(&mut decoded.row_stats);
+            PyResult::Ok((builder.finish_with_rows(&decoded.stats, rows), decoded))
         })?;
         // The logger's own dropouts too: frames missing from the data
         // whatever their cause (`wobblog info` counts them with the losses).

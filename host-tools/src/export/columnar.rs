@@ -253,7 +253,14 @@ pub struct RowColumns {
     has_utc: Vec<bool>,
     run: Vec<i64>,
     has_run: Vec<bool>,
+    /// Rows not yet in the columns: stored a few hundred at a time, one
+    /// column after the other, each a tight loop (one row at a time, the
+    /// seventeen buffers' length checks and stores cost more than the row).
+    staged: Vec<Row>,
 }
+
+/// Rows staged before they are stored (a few pages of rows).
+const STAGED_ROWS: usize = 128;
 
 impl RowColumns {
     /// Columns for `columns` (with room for `rows` rows per batch), `None`
@@ -286,6 +293,7 @@ impl RowColumns {
             has_utc: Vec::new(),
             run: Vec::new(),
             has_run: Vec::new(),
+            staged: Vec::with_capacity(STAGED_ROWS),
         };
         new.reserve();
         Some(new)
@@ -315,38 +323,55 @@ impl RowColumns {
     }
 }
 
+impl RowColumns {
+    /// Stores the staged rows in the columns.
+    fn store_staged(&mut self) {
+        let rows = &self.staged;
+        let gps_speed = |r: &Row| r.gps.and_then(|g| g.speed_mps);
+        self.t_s.extend(rows.iter().map(|r| r.t_s));
+        for (i, v) in self.accel_g.iter_mut().enumerate() {
+            v.extend(rows.iter().map(|r| r.accel_g[i]));
+        }
+        for (i, v) in self.gyro_dps.iter_mut().enumerate() {
+            v.extend(rows.iter().map(|r| r.gyro_dps[i]));
+        }
+        self.steer_deg.extend(rows.iter().map(|r| r.steer_deg));
+        self.speed_mps.extend(rows.iter().map(|r| r.speed_mps));
+        let [lat, lon, speed] = &mut self.gps;
+        lat.extend(rows.iter().map(|r| r.gps.map_or(0.0, |g| g.lat_deg)));
+        lon.extend(rows.iter().map(|r| r.gps.map_or(0.0, |g| g.lon_deg)));
+        speed.extend(rows.iter().map(|r| gps_speed(r).unwrap_or_default()));
+        self.has_gps.extend(rows.iter().map(|r| r.gps.is_some()));
+        self.has_gps_speed
+            .extend(rows.iter().map(|r| gps_speed(r).is_some()));
+        self.gps_fix
+            .extend(rows.iter().map(|r| r.gps.map(|g| g.fix.as_str())));
+        self.utc_us
+            .extend(rows.iter().map(|r| r.utc_us.unwrap_or_default()));
+        self.has_utc.extend(rows.iter().map(|r| r.utc_us.is_some()));
+        self.run
+            .extend(rows.iter().map(|r| r.run.map_or(0, i64::from)));
+        self.has_run.extend(rows.iter().map(|r| r.run.is_some()));
+        self.staged.clear();
+    }
+}
+
 impl ColumnBuffers<Row> for RowColumns {
     fn push(&mut self, row: &Row) -> Result<(), String> {
-        self.t_s.push(row.t_s);
-        for (v, x) in self.accel_g.iter_mut().zip(row.accel_g) {
-            v.push(x);
+        self.staged.push(*row);
+        if self.staged.len() == STAGED_ROWS {
+            self.store_staged();
         }
-        for (v, x) in self.gyro_dps.iter_mut().zip(row.gyro_dps) {
-            v.push(x);
-        }
-        self.steer_deg.push(row.steer_deg);
-        self.speed_mps.push(row.speed_mps);
-        let [lat, lon, speed] = &mut self.gps;
-        lat.push(row.gps.map_or(0.0, |g| g.lat_deg));
-        lon.push(row.gps.map_or(0.0, |g| g.lon_deg));
-        let gps_speed = row.gps.and_then(|g| g.speed_mps);
-        speed.push(gps_speed.unwrap_or_default());
-        self.has_gps.push(row.gps.is_some());
-        self.has_gps_speed.push(gps_speed.is_some());
-        self.gps_fix.push(row.gps.map(|g| g.fix.as_str()));
-        self.utc_us.push(row.utc_us.unwrap_or_default());
-        self.has_utc.push(row.utc_us.is_some());
-        self.run.push(row.run.map_or(0, i64::from));
-        self.has_run.push(row.run.is_some());
         Ok(())
     }
 
     fn len(&self) -> usize {
-        self.t_s.len()
+        self.t_s.len() + self.staged.len()
     }
 
     fn take(&mut self) -> Vec<Values> {
         use std::mem::take;
+        self.store_staged();
         let [lat, lon, speed] = &mut self.gps;
         let chosen = self
             .fields

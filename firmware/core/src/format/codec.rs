@@ -14,6 +14,9 @@ use super::varint;
 
 /// Tag: 100 Hz frame.
 pub const TAG_FRAME: u8 = 0x01;
+/// Bytes of a frame after its time delta: six IMU words, steering, wheel
+/// count, edge age and speed (two bytes each), the status byte.
+const FRAME_FIXED_LEN: usize = 2 * 10 + 1;
 /// Tag: GPS fix.
 pub const TAG_GPS: u8 = 0x02;
 /// Tag: UTC sync pair.
@@ -444,15 +447,20 @@ impl<'a> Records<'a> {
                     .and_then(|d| u64::try_from(d).ok())
                     .and_then(|d| self.cursor_us.checked_add(d))
                     .ok_or(RecordError::Invalid(tag))?;
+                // The fixed part taken at once: one length check for the
+                // frame, not one per field (the host decodes millions).
+                let b: [u8; FRAME_FIXED_LEN] = r.take()?;
+                let word = |i: usize| [b[2 * i], b[2 * i + 1]];
+                let int = |i: usize| i16::from_le_bytes(word(i));
                 let frame = Frame {
                     t_us,
-                    accel: [r.i16()?, r.i16()?, r.i16()?],
-                    gyro: [r.i16()?, r.i16()?, r.i16()?],
-                    steer_cdeg: r.i16()?,
-                    wheel_count: r.u16()?,
-                    wheel_edge_age_us: r.u16()?,
-                    speed_mm_s: r.u16()?,
-                    status: FrameStatus(r.u8()?),
+                    accel: [int(0), int(1), int(2)],
+                    gyro: [int(3), int(4), int(5)],
+                    steer_cdeg: int(6),
+                    wheel_count: u16::from_le_bytes(word(7)),
+                    wheel_edge_age_us: u16::from_le_bytes(word(8)),
+                    speed_mm_s: u16::from_le_bytes(word(9)),
+                    status: FrameStatus(b[20]),
                 };
                 self.cursor_us = t_us;
                 Record::Frame(frame)
