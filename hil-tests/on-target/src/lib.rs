@@ -23,15 +23,18 @@
 #![no_std]
 #![warn(missing_docs)]
 
+use embassy_futures::select::{select, Either};
 use embassy_stm32::gpio::{Level, Output, Speed};
-use embassy_stm32::peripherals::{PB6, TIM4};
+use embassy_stm32::peripherals::{IWDG, PB6, TIM4};
 use embassy_stm32::spi::Spi;
 use embassy_stm32::Peri;
 use embassy_time::{Duration, Instant, Timer};
+use wobble_core::app::sampler::FRAME_PERIOD_US;
+use wobble_core::channels::SharedStatus;
 use wobble_core::drivers::sdcard::IDENTIFICATION_CLOCK_HZ;
 use wobble_stm32f405::adapters::card::{self, SdCard};
 use wobble_stm32f405::pins::{Board, CardPins};
-use wobble_stm32f405::{clocks, startup};
+use wobble_stm32f405::{clocks, startup, watchdog};
 
 /// The pins of the PWM loop-back source, outside the logger's pin map.
 pub struct PwmSource {
@@ -99,4 +102,50 @@ pub async fn poll_until<T>(
         Timer::after(period).await;
     }
     None
+}
+
+/// Runs the firmware's watchdog feeder (which starts the IWDG) for
+/// `run_for` while both task heartbeats move, as the logger's tasks beat
+/// them; returns with the watchdog running, to be fed no more.
+pub async fn feed_watchdog_for(iwdg: Peri<'static, IWDG>, run_for: Duration) {
+    // The feeder logs the queue's figures with the stack's once a minute.
+    static SHARED: SharedStatus = SharedStatus::new();
+    let queue = defmt::unwrap!(wobble_stm32f405::ccm::record_queue());
+    let start = Instant::now();
+    let heartbeats = async {
+        while Instant::now() - start < run_for {
+            watchdog::SAMPLER.beat();
+            watchdog::GPS.beat();
+            Timer::after_millis(10).await;
+        }
+    };
+    match select(watchdog::feed(iwdg, queue, &SHARED), heartbeats).await {
+        Either::First(never) => match never {},
+        Either::Second(()) => {}
+    }
+}
+
+/// The spacing of a log's frames as its reader meets them: how many, and
+/// how many are not one frame period after the frame before.
+#[derive(Default)]
+pub struct FrameSpacing {
+    /// Frames seen.
+    pub frames: u32,
+    /// Frames not [`FRAME_PERIOD_US`] after the one before.
+    pub steps_off: u32,
+    last_us: Option<u64>,
+}
+
+impl FrameSpacing {
+    /// Takes the next frame's time, µs.
+    pub fn see(&mut self, t_us: u64) {
+        if self
+            .last_us
+            .is_some_and(|last| t_us != last + FRAME_PERIOD_US)
+        {
+            self.steps_off += 1;
+        }
+        self.last_us = Some(t_us);
+        self.frames += 1;
+    }
 }

@@ -21,11 +21,8 @@ use defmt_rtt as _;
 #[cfg(test)]
 #[embedded_test::tests]
 mod tests {
-    use embassy_futures::select::{select, Either};
     use embassy_stm32::pac;
-    use embassy_time::{Duration, Instant, Timer};
-    use wobble_core::channels::SharedStatus;
-    use wobble_stm32f405::watchdog;
+    use embassy_time::Duration;
 
     /// Whether the three bits are set: (TIM3, TIM5, IWDG).
     fn frozen() -> (bool, bool, bool) {
@@ -47,20 +44,7 @@ mod tests {
         defmt::assert!(tim3, "TIM3 (embassy-time) runs on while halted");
         defmt::assert!(tim5, "TIM5 (capture time base) runs on while halted");
         // The watchdog's start, fed as the logger feeds it for a while.
-        static SHARED: SharedStatus = SharedStatus::new();
-        let queue = defmt::unwrap!(wobble_stm32f405::ccm::record_queue());
-        let start = Instant::now();
-        let heartbeats = async {
-            while Instant::now() - start < Duration::from_millis(500) {
-                watchdog::SAMPLER.beat();
-                watchdog::GPS.beat();
-                Timer::after_millis(10).await;
-            }
-        };
-        match select(watchdog::feed(board.watchdog, queue, &SHARED), heartbeats).await {
-            Either::First(never) => match never {},
-            Either::Second(()) => {}
-        }
+        wobble_on_target::feed_watchdog_for(board.watchdog, Duration::from_millis(500)).await;
         defmt::assert_eq!(frozen(), (true, true, true));
         let raw = pac::DBGMCU.apb1fzr().read().0;
         defmt::info!("DBGMCU_APB1_FZ = {=u32:#010x}", raw);

@@ -27,11 +27,12 @@ mod tests {
     use embassy_stm32::interrupt::{InterruptExt, Priority};
     use embassy_time::Instant;
     use embedded_sdmmc::{Mode, VolumeIdx};
-    use wobble_core::app::sampler::{self, Sampler, FRAME_PERIOD_US};
+    use wobble_core::app::sampler::{self, Sampler};
     use wobble_core::app::{gps, writer};
     use wobble_core::channels::{RecordQueue, SharedStatus};
     use wobble_core::format::{Decoder, Event, Record, BLOCK_LEN};
     use wobble_core::logger::{self, CardLogger, FixedTime, HeaderSpec, LoggerConfig, LoggerState};
+    use wobble_on_target::FrameSpacing;
     use wobble_stm32f405::adapters;
     use wobble_stm32f405::adapters::gps::GpsAdapter;
     use wobble_stm32f405::assembly::{card_and_config, header, sampler_parts, Ports};
@@ -86,10 +87,8 @@ mod tests {
         channels: u32,
         config_lines: usize,
         config_wrong: u32,
-        frames: u32,
-        /// Frames not 10 ms after the one before.
-        frame_steps_off: u32,
-        last_frame_us: Option<u64>,
+        /// The frames and those not 10 ms after the one before.
+        spacing: FrameSpacing,
         dropouts: u32,
         /// Gaps, skipped bytes, bad records, impossible values, time jumps.
         anomalies: u32,
@@ -118,16 +117,7 @@ mod tests {
                     }
                     self.config_lines += 1;
                 }
-                Record::Frame(frame) => {
-                    if self
-                        .last_frame_us
-                        .is_some_and(|last| frame.t_us != last + FRAME_PERIOD_US)
-                    {
-                        self.frame_steps_off += 1;
-                    }
-                    self.last_frame_us = Some(frame.t_us);
-                    self.frames += 1;
-                }
+                Record::Frame(frame) => self.spacing.see(frame.t_us),
                 Record::Dropout(_) => self.dropouts += 1,
                 _ => {}
             }
@@ -222,8 +212,8 @@ mod tests {
         defmt::assert!(log.channels > 0, "no channel definitions");
         defmt::assert_eq!(log.config_lines, spec.config.len());
         defmt::assert_eq!(log.config_wrong, 0);
-        defmt::assert_eq!(log.frames, FRAMES);
-        defmt::assert_eq!(log.frame_steps_off, 0);
+        defmt::assert_eq!(log.spacing.frames, FRAMES);
+        defmt::assert_eq!(log.spacing.steps_off, 0);
         defmt::assert_eq!(log.dropouts, 0);
         defmt::assert_eq!(log.anomalies, 0);
         defmt::assert_eq!(decoded.blocks_lost, 0);

@@ -30,10 +30,9 @@ mod tests {
 
     use embassy_time::Duration;
     use embedded_sdmmc::{BlockDevice, Mode, VolumeIdx};
-    use wobble_core::app::sampler::FRAME_PERIOD_US;
     use wobble_core::format::{DecodeStats, Decoder, Event, Record, SkipCause, BLOCK_LEN};
     use wobble_core::logger::{self, parse_run, FixedTime};
-    use wobble_on_target::{poll_until, sd_card};
+    use wobble_on_target::{poll_until, sd_card, FrameSpacing};
 
     /// Run files read at most (a card of ten cuts holds ten or so).
     const MAX_RUNS: usize = 128;
@@ -44,11 +43,9 @@ mod tests {
         records: u32,
         /// The first record is the log info naming this run.
         info_first: bool,
-        frames: u32,
+        /// The frames and those not 10 ms after the one before.
+        spacing: FrameSpacing,
         dropouts: u32,
-        /// Frames not 10 ms after the one before.
-        steps_off: u32,
-        last_frame_us: Option<u64>,
         /// Stretches skipped as a torn write leaves them: a block failing
         /// its CRC, bytes that are no block, a block cut short.
         torn: u32,
@@ -85,16 +82,7 @@ mod tests {
             }
             self.records += 1;
             match record {
-                Record::Frame(frame) => {
-                    if self
-                        .last_frame_us
-                        .is_some_and(|last| frame.t_us != last + FRAME_PERIOD_US)
-                    {
-                        self.steps_off += 1;
-                    }
-                    self.last_frame_us = Some(frame.t_us);
-                    self.frames += 1;
-                }
+                Record::Frame(frame) => self.spacing.see(frame.t_us),
                 Record::Dropout(_) => self.dropouts += 1,
                 _ => {}
             }
@@ -109,7 +97,7 @@ mod tests {
                 && self.torn <= 1
                 && d.bad_records == 0
                 && d.time_jumps == 0
-                && self.steps_off <= self.dropouts + self.torn
+                && self.spacing.steps_off <= self.dropouts + self.torn
                 && self.anomalies == 0
         }
     }
@@ -169,9 +157,9 @@ mod tests {
                 "{}: {} frames, {} dropout records, {} frame steps off 10 ms, {} torn stretches, \
                  info first {}: {} -> {}",
                 name.as_str(),
-                seen.frames,
+                seen.spacing.frames,
                 seen.dropouts,
-                seen.steps_off,
+                seen.spacing.steps_off,
                 seen.torn,
                 seen.info_first,
                 decoded,

@@ -10,13 +10,11 @@ use defmt_rtt as _;
 #[cfg(test)]
 #[embedded_test::tests]
 mod tests {
-    use embassy_futures::select::{select, Either};
     use embassy_stm32::pac;
-    use embassy_time::{Duration, Instant, Timer};
+    use embassy_time::{Duration, Instant};
     use wobble_core::boot::ResetCause;
-    use wobble_core::channels::SharedStatus;
     use wobble_core::watchdog::TIMEOUT_REQUEST_US;
-    use wobble_stm32f405::{startup, watchdog};
+    use wobble_stm32f405::startup;
 
     /// RCC_CSR bits 24-31: the reset flags (RM0090 7.3.21).
     const RESET_FLAGS: u32 = 0xFF00_0000;
@@ -43,23 +41,10 @@ mod tests {
     #[test]
     async fn a_fed_watchdog_lets_the_chip_run_past_its_timeout() {
         let (board, _) = wobble_on_target::board();
-        // The feeder logs the queue's figures with the stack's once a minute.
-        static SHARED: SharedStatus = SharedStatus::new();
-        let queue = defmt::unwrap!(wobble_stm32f405::ccm::record_queue());
         let run_for = Duration::from_micros(3 * TIMEOUT_REQUEST_US);
         let start = Instant::now();
-        let heartbeats = async {
-            while Instant::now() - start < run_for {
-                watchdog::SAMPLER.beat();
-                watchdog::GPS.beat();
-                Timer::after_millis(10).await;
-            }
-        };
         // A reset here fails the test: probe-rs loses the running test.
-        match select(watchdog::feed(board.watchdog, queue, &SHARED), heartbeats).await {
-            Either::First(never) => match never {},
-            Either::Second(()) => {}
-        }
+        wobble_on_target::feed_watchdog_for(board.watchdog, run_for).await;
         defmt::info!(
             "ran {} ms under the watchdog",
             (Instant::now() - start).as_millis()
