@@ -401,3 +401,37 @@ impl SummaryBuilder {
         s
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use wobble_core::format::GpsFix;
+
+    /// A fix counts as one with a position only with both coordinates (the
+    /// card's format stores them together; a record made otherwise must
+    /// not be counted as a position).
+    #[test]
+    fn a_fix_needs_both_coordinates_to_count_as_a_position() {
+        let mut builder = SummaryBuilder::new();
+        let fixes = [
+            (Some(520_000_000), Some(43_000_000)),
+            (Some(520_000_000), None),
+            (None, Some(43_000_000)),
+            (None, None),
+        ];
+        for (i, (lat_e7, lon_e7)) in fixes.into_iter().enumerate() {
+            let fix = GpsFix {
+                t_us: 1000 * i as u64,
+                lat_e7,
+                lon_e7,
+                ..GpsFix::default()
+            };
+            builder.observe(&Event::Record(Record::Gps(fix)));
+        }
+        let summary = builder.finish(&DecodeStats::default());
+        let count = |kind: &str| summary.records.get(kind).map(|c| c.count);
+        assert_eq!(count("gps_fix"), Some(1));
+        assert_eq!(count("gps_no_position"), Some(3));
+        assert_eq!(summary.gps_fixes, 4);
+    }
+}
