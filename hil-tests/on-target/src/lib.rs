@@ -32,6 +32,7 @@ use embassy_time::{Duration, Instant, Timer};
 use wobble_core::app::sampler::FRAME_PERIOD_US;
 use wobble_core::channels::SharedStatus;
 use wobble_core::drivers::sdcard::IDENTIFICATION_CLOCK_HZ;
+use wobble_core::format::{DecodeStats, Decoder, Event, BLOCK_LEN};
 use wobble_stm32f405::adapters::card::{self, SdCard};
 use wobble_stm32f405::pins::{Board, CardPins};
 use wobble_stm32f405::{clocks, startup, watchdog};
@@ -148,4 +149,31 @@ impl FrameSpacing {
         self.last_us = Some(t_us);
         self.frames += 1;
     }
+}
+
+/// Decodes a log file on the card with the core's decoder, two blocks of
+/// memory at a time, every event to `visit`; the decoder's totals.
+pub fn decode_file<D, T, const DIRS: usize, const FILES: usize, const VOLUMES: usize>(
+    file: &embedded_sdmmc::File<'_, D, T, DIRS, FILES, VOLUMES>,
+    mut visit: impl FnMut(Event<'_>),
+) -> DecodeStats
+where
+    D: embedded_sdmmc::BlockDevice,
+    T: embedded_sdmmc::TimeSource,
+{
+    let mut decoder = Decoder::new();
+    let mut buf = [0u8; 2 * BLOCK_LEN];
+    let mut held = 0;
+    loop {
+        held += defmt::unwrap!(file.read(&mut buf[held..]).ok());
+        let at_end = file.is_eof();
+        let used = decoder.feed(&buf[..held], at_end, &mut |event| visit(event));
+        buf.copy_within(used..held, 0);
+        held -= used;
+        if at_end {
+            break;
+        }
+        defmt::assert!(held < buf.len(), "the decoder consumed nothing");
+    }
+    *decoder.stats()
 }

@@ -30,9 +30,9 @@ mod tests {
     use wobble_core::app::sampler::{self, Sampler};
     use wobble_core::app::{gps, writer};
     use wobble_core::channels::{RecordQueue, SharedStatus};
-    use wobble_core::format::{Decoder, Event, Record, BLOCK_LEN};
+    use wobble_core::format::{Event, Record, BLOCK_LEN};
     use wobble_core::logger::{self, CardLogger, FixedTime, HeaderSpec, LoggerConfig, LoggerState};
-    use wobble_on_target::FrameSpacing;
+    use wobble_on_target::{decode_file, FrameSpacing};
     use wobble_stm32f405::adapters;
     use wobble_stm32f405::adapters::gps::GpsAdapter;
     use wobble_stm32f405::assembly::{card_and_config, header, sampler_parts, Ports};
@@ -185,23 +185,7 @@ mod tests {
         defmt::assert_eq!(file.length() % BLOCK_LEN as u32, 0, "whole blocks");
 
         let mut log = Log::default();
-        let mut decoder = Decoder::new();
-        let mut buf = [0u8; 2 * BLOCK_LEN];
-        let mut held = 0;
-        loop {
-            held += defmt::unwrap!(file.read(&mut buf[held..]).ok());
-            let at_end = file.is_eof();
-            let used = decoder.feed(&buf[..held], at_end, &mut |event| {
-                log.see(event, &spec, run);
-            });
-            buf.copy_within(used..held, 0);
-            held -= used;
-            if at_end {
-                break;
-            }
-            defmt::assert!(held < buf.len(), "the decoder consumed nothing");
-        }
-        let decoded = decoder.stats();
+        let decoded = decode_file(&file, |event| log.see(event, &spec, run));
         defmt::info!("{}: {}", name.as_str(), decoded);
 
         defmt::assert_eq!(

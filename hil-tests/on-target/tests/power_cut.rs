@@ -30,9 +30,9 @@ mod tests {
 
     use embassy_time::Duration;
     use embedded_sdmmc::{BlockDevice, Mode, VolumeIdx};
-    use wobble_core::format::{DecodeStats, Decoder, Event, Record, SkipCause, BLOCK_LEN};
+    use wobble_core::format::{DecodeStats, Event, Record, SkipCause};
     use wobble_core::logger::{self, parse_run, FixedTime};
-    use wobble_on_target::{poll_until, sd_card, FrameSpacing};
+    use wobble_on_target::{decode_file, poll_until, sd_card, FrameSpacing};
 
     /// Run files read at most (a card of ten cuts holds ten or so).
     const MAX_RUNS: usize = 128;
@@ -136,23 +136,9 @@ mod tests {
             defmt::unwrap!(write!(name, "RUN{run:05}.WBL").ok());
             let file = defmt::unwrap!(root.open_file_in_dir(name.as_str(), Mode::ReadOnly).ok());
             let mut seen = Run::default();
-            let mut decoder = Decoder::new();
-            let mut buf = [0u8; 2 * BLOCK_LEN];
-            let mut held = 0;
-            loop {
-                held += defmt::unwrap!(file.read(&mut buf[held..]).ok());
-                let at_end = file.is_eof();
-                let used = decoder.feed(&buf[..held], at_end, &mut |event| seen.see(event, run));
-                buf.copy_within(used..held, 0);
-                held -= used;
-                if at_end {
-                    break;
-                }
-                defmt::assert!(held < buf.len(), "the decoder consumed nothing");
-            }
+            let decoded = decode_file(&file, |event| seen.see(event, run));
             defmt::unwrap!(file.close().ok());
-            let decoded = decoder.stats();
-            let whole = seen.whole(decoded);
+            let whole = seen.whole(&decoded);
             defmt::info!(
                 "{}: {} frames, {} dropout records, {} frame steps off 10 ms, {} torn stretches, \
                  info first {}: {} -> {}",
