@@ -10,6 +10,7 @@ use wobble_core::format::{Event, MarginRecord, MarginState};
 
 use crate::codes::{dropout_meaning, fault_meaning};
 use crate::losses::{cause_name, LostBlocks};
+use crate::time::{utc_us_after_pair, SyncPair};
 
 /// One thing that happened, at a time since boot.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -488,6 +489,71 @@ fn record_event(record: &Record<'_>) -> Option<EventKind> {
     })
 }
 
+/// A log's events as its decoder hands them over, in time order, each with
+/// its UTC (µs since 1970) through the sync pairs read so far, as
+/// `decode`'s `utc` column places a frame: what `wobblog events` lists,
+/// run beside any other reading of the log.
+#[derive(Default)]
+pub struct EventWalk {
+    converter: EventConverter,
+    order: TimeOrder,
+    /// Every pair: an event held back may come before the latest one.
+    pairs: Vec<SyncPair>,
+}
+
+impl EventWalk {
+    /// Takes one decoder event; hands `visit` each event now in time order,
+    /// with its UTC and the pairs read so far. An error from `visit` is
+    /// returned.
+    ///
+    /// # Errors
+    /// `visit`'s.
+    pub fn observe<E>(
+        &mut self,
+        event: &Event<'_>,
+        visit: &mut impl FnMut(LogEvent, Option<i64>, &[SyncPair]) -> Result<(), E>,
+    ) -> Result<(), E> {
+        let Self {
+            converter,
+            order,
+            pairs,
+        } = self;
+        if let Event::Record(Record::UtcSync(pair)) = event {
+            if let Ok(ms) = i64::try_from(pair.unix_ms) {
+                pairs.push((pair.t_us as f64 / 1e6, ms));
+            }
+        }
+        match converter.convert(event) {
+            Some(e) => order.push(e, &mut |e: LogEvent| {
+                let utc = utc_us_after_pair(pairs, e.t_s);
+                visit(e, utc, pairs)
+            }),
+            None => Ok(()),
+        }
+    }
+
+    /// Hands `visit` the events still held, at the end of the log.
+    ///
+    /// # Errors
+    /// `visit`'s.
+    pub fn finish<E>(
+        &mut self,
+        visit: &mut impl FnMut(LogEvent, Option<i64>, &[SyncPair]) -> Result<(), E>,
+    ) -> Result<(), E> {
+        let pairs = &self.pairs;
+        std::mem::take(&mut self.order).finish(&mut |e: LogEvent| {
+            let utc = utc_us_after_pair(pairs, e.t_s);
+            visit(e, utc, pairs)
+        })
+    }
+
+    /// The log's sync pairs read so far.
+    #[must_use]
+    pub fn pairs(&self) -> &[SyncPair] {
+        &self.pairs
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -570,70 +636,5 @@ mod tests {
         let (out, most_held) = ordered(&still);
         assert_eq!(most_held, REORDER_MAX);
         assert_eq!(out, still);
-    }
-}
-
-/// A log's events as its decoder hands them over, in time order, each with
-/// its UTC (µs since 1970) through the sync pairs read so far, as
-/// `decode`'s `utc` column places a frame: what `wobblog events` lists,
-/// run beside any other reading of the log.
-#[derive(Default)]
-pub struct EventWalk {
-    converter: EventConverter,
-    order: TimeOrder,
-    /// Every pair: an event held back may come before the latest one.
-    pairs: Vec<crate::time::SyncPair>,
-}
-
-impl EventWalk {
-    /// Takes one decoder event; hands `visit` each event now in time order,
-    /// with its UTC and the pairs read so far. An error from `visit` is
-    /// returned.
-    ///
-    /// # Errors
-    /// `visit`'s.
-    pub fn observe<E>(
-        &mut self,
-        event: &Event<'_>,
-        visit: &mut impl FnMut(LogEvent, Option<i64>, &[crate::time::SyncPair]) -> Result<(), E>,
-    ) -> Result<(), E> {
-        let Self {
-            converter,
-            order,
-            pairs,
-        } = self;
-        if let Event::Record(Record::UtcSync(pair)) = event {
-            if let Ok(ms) = i64::try_from(pair.unix_ms) {
-                pairs.push((pair.t_us as f64 / 1e6, ms));
-            }
-        }
-        match converter.convert(event) {
-            Some(e) => order.push(e, &mut |e: LogEvent| {
-                let utc = crate::time::utc_us_after_pair(pairs, e.t_s);
-                visit(e, utc, pairs)
-            }),
-            None => Ok(()),
-        }
-    }
-
-    /// Hands `visit` the events still held, at the end of the log.
-    ///
-    /// # Errors
-    /// `visit`'s.
-    pub fn finish<E>(
-        &mut self,
-        visit: &mut impl FnMut(LogEvent, Option<i64>, &[crate::time::SyncPair]) -> Result<(), E>,
-    ) -> Result<(), E> {
-        let pairs = &self.pairs;
-        std::mem::take(&mut self.order).finish(&mut |e: LogEvent| {
-            let utc = crate::time::utc_us_after_pair(pairs, e.t_s);
-            visit(e, utc, pairs)
-        })
-    }
-
-    /// The log's sync pairs read so far.
-    #[must_use]
-    pub fn pairs(&self) -> &[crate::time::SyncPair] {
-        &self.pairs
     }
 }

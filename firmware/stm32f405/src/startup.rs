@@ -79,8 +79,8 @@ pub fn enable_flash_accelerator() {
 /// IMU's capture time base, whose counts `wheel_capture::EdgeClock` maps
 /// onto embassy-time's, so the two stop and go together and a halt looks to
 /// the firmware like no time at all (no burst of missed ticks, no
-/// watchdog reset, no stale captures on resume). The watchdog's own start
-/// sets its bit again (`watchdog::freeze_when_halted`). No effect without
+/// watchdog reset, no stale captures on resume). The watchdog's start calls
+/// it again (`watchdog::feed`). No effect without
 /// a debugger; the register is cleared only by a power-on reset.
 pub fn freeze_timers_when_halted() {
     pac::DBGMCU.apb1fzr().modify(|w| {

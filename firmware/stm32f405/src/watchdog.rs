@@ -11,7 +11,6 @@
 use core::cell::RefCell;
 use core::sync::atomic::{AtomicU32, Ordering};
 
-use embassy_stm32::pac;
 use embassy_stm32::peripherals::IWDG;
 use embassy_stm32::wdg::IndependentWatchdog;
 use embassy_stm32::Peri;
@@ -80,14 +79,6 @@ pub fn prove_alive() {
     });
 }
 
-/// Stops the watchdog's counter while a debugger halts the core
-/// (DBGMCU_APB1_FZ.DBG_IWDG_STOP, RM0090 38.16.4): a breakpoint would
-/// otherwise reset the MCU under the probe after 3-8 s. No effect
-/// without a debugger.
-pub fn freeze_when_halted() {
-    pac::DBGMCU.apb1fzr().modify(|w| w.set_iwdg(true));
-}
-
 /// Starts the watchdog and asks for feeds behind the writer; once a minute
 /// logs the stack's, the record queue's and the writer's worst figures.
 pub async fn feed(
@@ -95,7 +86,9 @@ pub async fn feed(
     queue: &'static RecordQueue,
     shared: &'static SharedStatus,
 ) -> ! {
-    freeze_when_halted();
+    // A breakpoint would otherwise reset the MCU under the probe after
+    // 3-8 s: the watchdog stops with the core, whoever brought the chip up.
+    crate::startup::freeze_timers_when_halted();
     let mut dog = IndependentWatchdog::new(iwdg, TIMEOUT_REQUEST_US as u32);
     dog.unleash();
     DOG.lock(|d| {

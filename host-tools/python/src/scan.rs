@@ -123,14 +123,14 @@ impl Scan {
             .iter()
             .map(|e| Self {
                 entries: vec![e.clone()],
-                ..self.with_entries()
+                ..self.without_logs()
             })
             .collect()
     }
 
     /// This scan without its logs: its columns, no rows.
     fn _empty(&self) -> Self {
-        self.with_entries()
+        self.without_logs()
     }
 
     /// The frames as a `pyarrow.Table` (needs pyarrow).
@@ -145,7 +145,7 @@ impl Scan {
 
 impl Scan {
     /// This scan's columns, window and schema, with no logs.
-    fn with_entries(&self) -> Self {
+    fn without_logs(&self) -> Self {
         Self {
             entries: Vec::new(),
             columns: self.columns.clone(),
