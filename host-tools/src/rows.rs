@@ -5,17 +5,13 @@ use crate::export::derived::Derived;
 use std::collections::VecDeque;
 
 use wobble_core::format::{
-    FixMode, Frame, FrameStatus, GpsFix, Record, UtcSync, ACCEL_COUNTS_PER_G, GYRO_COUNTS_PER_DPS,
+    FixMode, Frame, FrameStatus, GpsFix, Record, ACCEL_COUNTS_PER_G, GYRO_COUNTS_PER_DPS,
     STEER_COUNTS_PER_DEG,
 };
 
-/// A GPS fix older than this no longer fills a row's GPS columns.
-pub const GPS_STALE_US: u64 = 1_000_000;
-/// How long rows wait for a GPS fix stamped before them but written after.
-const GPS_WAIT_US: u64 = 500_000;
-/// Most rows held back, whatever the frame times say (0.5 s at 100 Hz is
-/// 50): times that stand still cannot make the assembler hoard memory.
-const MAX_PENDING_ROWS: usize = 4096;
+mod assembly;
+
+pub use assembly::{Assembly, PendingRows, GPS_STALE_US};
 
 /// The GPS columns of a row.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -77,45 +73,64 @@ pub struct Row {
 }
 
 impl Row {
-    fn new(frame: &Frame, gps: Option<GpsColumns>, sync: Option<UtcSync>) -> Self {
-        // In f64, so that every stored count prints as its exact value (or
-        // the shortest decimal that is nearest to it).
-        let scaled = |c: i16, counts_per_unit: f32| f64::from(c) / f64::from(counts_per_unit);
+    fn new(frame: &Frame, gps: Option<GpsColumns>, utc_us: Option<i64>) -> Self {
         Self {
-            t_s: frame.t_us as f64 / 1e6,
-            accel_g: frame.accel.map(|c| scaled(c, ACCEL_COUNTS_PER_G)),
-            gyro_dps: frame.gyro.map(|c| scaled(c, GYRO_COUNTS_PER_DPS)),
-            steer_deg: scaled(frame.steer_cdeg, STEER_COUNTS_PER_DEG),
-            speed_mps: f64::from(frame.speed_mm_s) / 1000.0,
+            t_s: seconds(frame.t_us),
+            accel_g: frame.accel.map(accel_g),
+            gyro_dps: frame.gyro.map(gyro_dps),
+            steer_deg: steer_deg(frame.steer_cdeg),
+            speed_mps: speed_mps(frame.speed_mm_s),
             wheel_count: frame.wheel_count,
             status: frame.status,
             gps,
-            utc_us: sync.and_then(|s| utc_us_at(s, frame.t_us)),
+            utc_us,
             derived: Derived::default(),
             run: None,
         }
     }
 }
 
-/// UTC at local time `t_us` through the pair `sync`, µs since 1970.
-fn utc_us_at(sync: UtcSync, t_us: u64) -> Option<i64> {
-    let offset_us = i64::try_from(t_us).ok()? - i64::try_from(sync.t_us).ok()?;
-    i64::try_from(sync.unix_ms)
-        .ok()?
-        .checked_mul(1000)?
-        .checked_add(offset_us)
+// A frame's counts in physical units, in f64, so that every stored count
+// prints as its exact value (or the shortest decimal that is nearest to
+// it). Rows and columns of rows ([`crate::export::frame_columns`]) both
+// convert with these.
+
+/// Seconds since boot.
+#[must_use]
+pub fn seconds(t_us: u64) -> f64 {
+    t_us as f64 / 1e6
 }
 
-/// Turns a stream of records into rows, in bounded memory.
-///
-/// A GPS fix is stamped when its first sentence began, so it reaches the
-/// card after frames that come later than it; rows are held back for
-/// [`GPS_WAIT_US`] so such a fix still fills them.
+/// Acceleration, g.
+#[must_use]
+pub fn accel_g(counts: i16) -> f64 {
+    f64::from(counts) / f64::from(ACCEL_COUNTS_PER_G)
+}
+
+/// Angular rate, deg/s.
+#[must_use]
+pub fn gyro_dps(counts: i16) -> f64 {
+    f64::from(counts) / f64::from(GYRO_COUNTS_PER_DPS)
+}
+
+/// Steering angle, degrees.
+#[must_use]
+pub fn steer_deg(counts: i16) -> f64 {
+    f64::from(counts) / f64::from(STEER_COUNTS_PER_DEG)
+}
+
+/// Wheel speed, m/s.
+#[must_use]
+pub fn speed_mps(mm_s: u16) -> f64 {
+    f64::from(mm_s) / 1000.0
+}
+
+/// Turns a stream of records into rows, in bounded memory (see
+/// [`Assembly`] for which fix and which UTC fill a row, and when).
 #[derive(Default)]
 pub struct RowAssembler {
-    pending: VecDeque<(u64, Row)>,
-    gps: Option<(u64, GpsColumns)>,
-    sync: Option<UtcSync>,
+    assembly: Assembly,
+    pending: VecDeque<Row>,
 }
 
 impl RowAssembler {
@@ -127,72 +142,49 @@ impl RowAssembler {
 
     /// Takes one record; calls `emit` for every row that is complete.
     pub fn push(&mut self, record: &Record<'_>, emit: &mut impl FnMut(&Row)) {
-        match record {
-            Record::Frame(frame) => {
-                // Time going back starts a new segment: nothing waits across
-                // it, and a fix from before it fills no row after it.
-                if self.pending.back().is_some_and(|&(t, _)| frame.t_us < t) {
-                    self.finish(emit);
-                    self.gps = None;
-                }
-                if self.pending.len() >= MAX_PENDING_ROWS {
-                    self.emit_first(emit);
-                }
-                let gps = self.gps_at(frame.t_us);
-                let sync = self.sync.filter(|s| s.t_us <= frame.t_us);
-                self.pending
-                    .push_back((frame.t_us, Row::new(frame, gps, sync)));
-                while self
-                    .pending
-                    .front()
-                    .is_some_and(|&(t, _)| t + GPS_WAIT_US < frame.t_us)
-                {
-                    self.emit_first(emit);
-                }
-            }
-            Record::Gps(fix) => {
-                let columns = GpsColumns::from_fix(fix);
-                let newer = self.gps.is_none_or(|(t, _)| fix.t_us >= t);
-                if newer {
-                    self.gps = columns.map(|c| (fix.t_us, c));
-                    for (t, row) in &mut self.pending {
-                        if *t >= fix.t_us {
-                            row.gps = columns.filter(|_| *t - fix.t_us <= GPS_STALE_US);
-                        }
-                    }
-                }
-            }
-            // Like a fix, a pair is stamped before frames written ahead of it.
-            Record::UtcSync(sync) if self.sync.is_none_or(|s| sync.t_us >= s.t_us) => {
-                self.sync = Some(*sync);
-                for (t, row) in &mut self.pending {
-                    if *t >= sync.t_us {
-                        row.utc_us = utc_us_at(*sync, *t);
-                    }
-                }
-            }
-            _ => {}
-        }
+        self.assembly.push(
+            record,
+            &mut Queue {
+                rows: &mut self.pending,
+                emit,
+            },
+        );
     }
 
     /// Emits the rows still held back.
     pub fn finish(&mut self, emit: &mut impl FnMut(&Row)) {
-        for (_, row) in self.pending.drain(..) {
-            emit(&row);
-        }
+        self.assembly.finish(&mut Queue {
+            rows: &mut self.pending,
+            emit,
+        });
+    }
+}
+
+/// Pending rows as rows, emitted once complete.
+struct Queue<'a, F> {
+    rows: &'a mut VecDeque<Row>,
+    emit: &'a mut F,
+}
+
+impl<F: FnMut(&Row)> PendingRows for Queue<'_, F> {
+    fn push(&mut self, frame: &Frame, gps: Option<GpsColumns>, utc_us: Option<i64>) {
+        self.rows.push_back(Row::new(frame, gps, utc_us));
     }
 
-    /// Emits the first pending row and drops it (emitted where it lies:
-    /// a row is some 200 bytes, and moving each out would copy it).
-    fn emit_first(&mut self, emit: &mut impl FnMut(&Row)) {
-        if let Some((_, row)) = self.pending.front() {
-            emit(row);
-        }
-        self.pending.pop_front();
+    fn set_gps(&mut self, i: usize, gps: Option<GpsColumns>) {
+        self.rows[i].gps = gps;
     }
 
-    fn gps_at(&self, t_us: u64) -> Option<GpsColumns> {
-        let (t, columns) = self.gps?;
-        (t <= t_us && t_us - t <= GPS_STALE_US).then_some(columns)
+    fn set_utc(&mut self, i: usize, utc_us: Option<i64>) {
+        self.rows[i].utc_us = utc_us;
+    }
+
+    /// Emitted where it lies: a row is some 200 bytes, and moving each out
+    /// would copy it.
+    fn complete_first(&mut self) {
+        if let Some(row) = self.rows.front() {
+            (self.emit)(row);
+        }
+        self.rows.pop_front();
     }
 }

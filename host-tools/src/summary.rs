@@ -210,12 +210,12 @@ pub struct SummaryBuilder {
 /// What the summary takes from the decoded rows: GPS coverage and the UTC
 /// span. Given every row of the log in order (whatever part of it an
 /// output keeps).
-#[derive(Default)]
+#[derive(Debug, Default, PartialEq, Eq)]
 pub struct RowStats {
-    with_gps: u64,
+    pub(crate) with_gps: u64,
     /// The `utc` of the first and last row that has one, µs since 1970.
-    first_utc_us: Option<i64>,
-    last_utc_us: Option<i64>,
+    pub(crate) first_utc_us: Option<i64>,
+    pub(crate) last_utc_us: Option<i64>,
 }
 
 impl RowStats {

@@ -7,15 +7,14 @@ use std::path::Path;
 use pyo3::prelude::*;
 use wobble_core::format::{DecodeStats, Event, Record};
 use wobblog::export::columns::Column;
+use wobblog::export::frame_columns::FrameColumns;
 use wobblog::losses::Losses;
 use wobblog::reader::read_log_until;
-use wobblog::rows::{Row, RowAssembler};
 use wobblog::summary::RowStats;
 use wobblog::time::TimeWindow;
 use wobblog::CliError;
 
 use crate::stream::Table;
-use crate::table::TableBuilder;
 
 /// Records between two looks for a pending `KeyboardInterrupt`.
 const RECORDS_PER_SIGNAL_CHECK: usize = 1 << 14;
@@ -40,17 +39,14 @@ const RECORDS_PER_HANDOVER: usize = 1024;
 
 /// What the thread building the columns gives back.
 struct Built {
-    table: TableBuilder<Row>,
-    kept: u64,
-    span_s: Option<(f64, f64)>,
-    row_stats: RowStats,
-    failure: Option<arrow_schema::ArrowError>,
+    frames: FrameColumns,
     /// Ctrl-C, which stopped the building (and so the decoding).
     interrupted: Option<PyErr>,
 }
 
 /// The records the rows are made of (frames, fixes, sync pairs; see
-/// [`RowAssembler::push`]), owned, so they can go to another thread.
+/// [`wobblog::rows::Assembly::push`]), owned, so they can go to another
+/// thread.
 fn row_record(record: &Record<'_>) -> Option<Record<'static>> {
     match *record {
         Record::Frame(f) => Some(Record::Frame(f)),
@@ -60,38 +56,16 @@ fn row_record(record: &Record<'_>) -> Option<Record<'static>> {
     }
 }
 
-/// Turns records into rows, and the rows inside `window` into columns.
-fn build(
-    records: std::sync::mpsc::Receiver<Vec<Record<'static>>>,
-    columns: &[Column],
-    window: TimeWindow,
-) -> Built {
+/// Turns records into the columns of every row.
+fn build(records: std::sync::mpsc::Receiver<Vec<Record<'static>>>) -> Built {
     let mut built = Built {
-        table: TableBuilder::frames(columns),
-        kept: 0,
-        span_s: None,
-        row_stats: RowStats::default(),
-        failure: None,
+        frames: FrameColumns::new(),
         interrupted: None,
     };
-    let mut keep = |row: &Row| {
-        built.span_s = Some(built.span_s.map_or((row.t_s, row.t_s), |(a, b)| {
-            (a.min(row.t_s), b.max(row.t_s))
-        }));
-        built.row_stats.take(row);
-        // As `wobblog decode`: a row is in when its boot time or UTC (ms) is.
-        if window.is_all() || window.contains(row.t_s, row.utc_us.map(|u| u / 1000)) {
-            built.kept += 1;
-            if built.failure.is_none() {
-                built.failure = built.table.push(row).err();
-            }
-        }
-    };
-    let mut rows = RowAssembler::new();
     let mut since_check = 0;
     for batch in &records {
         for record in &batch {
-            rows.push(record, &mut keep);
+            built.frames.push(record);
         }
         // Python runs signal handlers on its main thread only: the one that
         // called, this one.
@@ -105,7 +79,7 @@ fn build(
             }
         }
     }
-    rows.finish(&mut keep);
+    built.frames.finish();
     built
 }
 
@@ -155,7 +129,7 @@ pub fn walk(
         });
         // The rows are built on this thread, the caller's, where Python
         // looks for Ctrl-C.
-        let built = build(records, columns, window);
+        let built = build(records);
         let (walked, has_utc) = match decoder.join() {
             Ok(done) => done,
             Err(panic) => std::panic::resume_unwind(panic),
@@ -163,26 +137,26 @@ pub fn walk(
         (walked, has_utc, built)
     });
     let Built {
-        table,
-        kept,
-        span_s,
-        row_stats,
-        failure,
+        mut frames,
         interrupted,
     } = built;
     if let Some(e) = interrupted {
         return Err(e);
     }
     let stats = walked.map_err(fail)?;
-    if let Some(e) = failure {
-        return Err(arrow_error(path, &e));
+    // Of every row, inside the window or not.
+    let span_s = frames.span_s();
+    let row_stats = frames.row_stats();
+    if !window.is_all() {
+        frames.retain(&window);
+        if frames.is_empty() {
+            return Err(fail(
+                window.selects_nothing(path, "frames", span_s, has_utc),
+            ));
+        }
     }
-    if kept == 0 && !window.is_all() {
-        return Err(fail(
-            window.selects_nothing(path, "frames", span_s, has_utc),
-        ));
-    }
-    let (schema, batches) = table.finish().map_err(|e| arrow_error(path, &e))?;
+    let (schema, batches) =
+        crate::table::frames(&frames, columns).map_err(|e| arrow_error(path, &e))?;
     Ok(Decoded {
         table: Table::new(schema, batches),
         stats,

@@ -12,8 +12,9 @@ use arrow_array::{
 };
 use arrow_buffer::{NullBuffer, OffsetBuffer};
 use arrow_schema::{ArrowError, DataType, Field, Schema, SchemaRef, TimeUnit};
-use wobblog::export::columnar::{buffers, row_buffers, ColumnBuffers, Values};
+use wobblog::export::columnar::{buffers, ColumnBuffers, Values};
 use wobblog::export::columns::{Column, Kind};
+use wobblog::export::frame_columns::FrameColumns;
 use wobblog::rows::Row;
 
 /// Rows per record batch: large enough that per-batch costs vanish, small
@@ -83,13 +84,49 @@ pub struct TableBuilder<R: 'static> {
     batches: Vec<RecordBatch>,
 }
 
-impl TableBuilder<Row> {
-    /// A table of decoded frames in `columns`, each field stored straight
-    /// into its column.
-    #[must_use]
-    pub fn frames(columns: &[Column<Row>]) -> Self {
-        Self::with_buffers(schema(columns), row_buffers(columns, BATCH_ROWS))
-    }
+/// Decoded frames in `columns` as record batches of [`BATCH_ROWS`] rows,
+/// every other batch converted on a second thread.
+///
+/// # Errors
+/// A column is not one of the frame columns.
+pub fn frames(
+    frames: &FrameColumns,
+    columns: &[Column<Row>],
+) -> Result<(SchemaRef, Vec<RecordBatch>), ArrowError> {
+    let schema = schema(columns);
+    let rows = frames.len();
+    let batch = |start: usize| {
+        let range = start..rows.min(start + BATCH_ROWS);
+        let arrays = columns
+            .iter()
+            .map(|c| frames.values(c, range.clone()).map(array))
+            .collect::<Result<Vec<_>, _>>()
+            .map_err(ArrowError::InvalidArgumentError)?;
+        RecordBatch::try_new(schema.clone(), arrays)
+    };
+    // At least one batch, empty for no rows, so every consumer sees the
+    // columns.
+    let starts: Vec<usize> = (0..rows.max(1)).step_by(BATCH_ROWS).collect();
+    let (even, odd) = std::thread::scope(|scope| {
+        let odd = scope.spawn(|| {
+            starts
+                .iter()
+                .skip(1)
+                .step_by(2)
+                .map(|&s| batch(s))
+                .collect::<Vec<_>>()
+        });
+        let even: Vec<_> = starts.iter().step_by(2).map(|&s| batch(s)).collect();
+        (
+            even,
+            odd.join().unwrap_or_else(|p| std::panic::resume_unwind(p)),
+        )
+    });
+    let (mut even, mut odd) = (even.into_iter(), odd.into_iter());
+    let batches = (0..starts.len())
+        .filter_map(|i| if i % 2 == 0 { even.next() } else { odd.next() })
+        .collect::<Result<Vec<_>, _>>()?;
+    Ok((schema, batches))
 }
 
 impl<R: 'static> TableBuilder<R> {

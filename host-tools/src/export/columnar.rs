@@ -194,7 +194,7 @@ pub fn row_buffers(columns: &[Column<Row>], rows: usize) -> Box<dyn ColumnBuffer
 
 /// A field of [`Row`] that is a column of [`COLUMNS`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Field {
+pub(crate) enum Field {
     T,
     Accel(usize),
     Gyro(usize),
@@ -230,6 +230,15 @@ impl Field {
             "run" => Self::Run,
             _ => return None,
         })
+    }
+
+    /// The field `column` is, if it is one of [`COLUMNS`] (or the run).
+    pub(crate) fn of_column(column: &Column<Row>) -> Option<Self> {
+        let known = COLUMNS
+            .iter()
+            .chain([&RUN_COLUMN])
+            .any(|k| k.name == column.name && k.kind == column.kind);
+        Self::of(column.name).filter(|_| known)
     }
 }
 
@@ -269,13 +278,7 @@ impl RowColumns {
     pub fn new(columns: &[Column<Row>], rows: usize) -> Option<Self> {
         let fields = columns
             .iter()
-            .map(|c| {
-                let known = COLUMNS
-                    .iter()
-                    .chain([&RUN_COLUMN])
-                    .any(|k| k.name == c.name && k.kind == c.kind);
-                Field::of(c.name).filter(|_| known)
-            })
+            .map(Field::of_column)
             .collect::<Option<Vec<Field>>>()?;
         let mut new = Self {
             fields,

@@ -4,6 +4,7 @@
 pub mod columnar;
 pub mod columns;
 pub mod derived;
+pub mod frame_columns;
 mod lines;
 pub mod mcap;
 mod mcap_file;

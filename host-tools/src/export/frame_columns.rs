@@ -1,0 +1,358 @@
+//! Decoded frames kept as columns from the start: each frame's counts go
+//! into a vector per channel as the frame comes, and are converted to
+//! physical units a whole column at a time once the log is read. Which
+//! fix and UTC fill a row is decided by the same [`Assembly`] that builds
+//! [`Row`]s, and the units by the same functions, so the columns hold the
+//! values `wobblog decode` writes (a test holds them to its rows); only no
+//! 200-byte row is built per frame (the Python package opens hour-long
+//! logs this way).
+
+use std::ops::Range;
+
+use wobble_core::format::{Frame, Record};
+
+use super::columnar::{Field, Values};
+use super::columns::Column;
+use crate::rows::{self, Assembly, GpsColumns, PendingRows, Row};
+use crate::summary::RowStats;
+use crate::time::TimeWindow;
+
+/// A row without GPS columns, in [`Counts::gps`].
+const NO_FIX: u32 = u32::MAX;
+
+/// Frames as columns of counts, filled record by record.
+#[derive(Default)]
+pub struct FrameColumns {
+    assembly: Assembly,
+    columns: Counts,
+}
+
+impl FrameColumns {
+    /// No rows yet.
+    #[must_use]
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Takes the log's next record.
+    pub fn push(&mut self, record: &Record<'_>) {
+        self.assembly.push(record, &mut self.columns);
+    }
+
+    /// Completes the rows still waiting; call once every record is in.
+    pub fn finish(&mut self) {
+        self.assembly.finish(&mut self.columns);
+    }
+
+    /// Rows so far.
+    #[must_use]
+    pub fn len(&self) -> usize {
+        self.columns.len()
+    }
+
+    /// Whether there is no row.
+    #[must_use]
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// First and last boot time of the rows, s.
+    #[must_use]
+    pub fn span_s(&self) -> Option<(f64, f64)> {
+        self.columns.span_s()
+    }
+
+    /// What a summary takes from the rows.
+    #[must_use]
+    pub fn row_stats(&self) -> RowStats {
+        self.columns.row_stats()
+    }
+
+    /// Keeps the rows inside `window` (as `wobblog decode`: a row is in
+    /// when its boot time or UTC, ms, is); call after [`Self::finish`].
+    pub fn retain(&mut self, window: &TimeWindow) {
+        self.columns.retain(window);
+    }
+
+    /// The values of `column` (one of [`super::columns::COLUMNS`]) in
+    /// `rows`, in physical units.
+    ///
+    /// # Errors
+    /// `column` is not one of the frame columns.
+    ///
+    /// # Panics
+    /// `rows` reaches past the last row.
+    pub fn values(&self, column: &Column<Row>, rows: Range<usize>) -> Result<Values, String> {
+        self.columns.values(column, rows)
+    }
+}
+
+/// The rows' frames and what fills them.
+#[derive(Default)]
+struct Counts {
+    /// Every row's frame as read: one store per frame (a vector per
+    /// channel took fourteen).
+    frames: Vec<Frame>,
+    /// Per row, its GPS columns in `fixes` (or [`NO_FIX`]).
+    gps: Vec<u32>,
+    fixes: Vec<GpsColumns>,
+    /// UTC, µs since 1970 (0 where `has_utc` says none).
+    utc_us: Vec<i64>,
+    has_utc: Vec<bool>,
+    /// The first row still waiting for a late fix or pair.
+    first_pending: usize,
+}
+
+impl Counts {
+    fn len(&self) -> usize {
+        self.frames.len()
+    }
+
+    fn span_s(&self) -> Option<(f64, f64)> {
+        let times = || self.frames.iter().map(|f| f.t_us);
+        Some((rows::seconds(times().min()?), rows::seconds(times().max()?)))
+    }
+
+    fn row_stats(&self) -> RowStats {
+        let utc = || {
+            self.utc_us
+                .iter()
+                .zip(&self.has_utc)
+                .filter_map(|(&us, &has)| has.then_some(us))
+        };
+        RowStats {
+            with_gps: self.gps.iter().filter(|&&g| g != NO_FIX).count() as u64,
+            first_utc_us: utc().next(),
+            last_utc_us: utc().next_back(),
+        }
+    }
+
+    fn retain(&mut self, window: &TimeWindow) {
+        let keep: Vec<bool> = (0..self.len())
+            .map(|i| {
+                let utc_ms = self.has_utc[i].then(|| self.utc_us[i] / 1000);
+                window.contains(rows::seconds(self.frames[i].t_us), utc_ms)
+            })
+            .collect();
+        fn retain<T>(v: &mut Vec<T>, keep: &[bool]) {
+            let mut kept = keep.iter();
+            v.retain(|_| kept.next().copied().unwrap_or(false));
+        }
+        retain(&mut self.frames, &keep);
+        retain(&mut self.gps, &keep);
+        retain(&mut self.utc_us, &keep);
+        retain(&mut self.has_utc, &keep);
+        self.first_pending = self.len();
+    }
+
+    fn values(&self, column: &Column<Row>, rows: Range<usize>) -> Result<Values, String> {
+        let frames = &self.frames[rows.clone()];
+        let numbers =
+            |unit: &dyn Fn(&Frame) -> f64| Values::Number(frames.iter().map(unit).collect());
+        let fixes = || {
+            self.gps[rows.clone()]
+                .iter()
+                .map(|&g| self.fixes.get(g as usize))
+        };
+        let gps = |value: fn(&GpsColumns) -> Option<f64>| {
+            let (v, present) = fixes()
+                .map(|fix| match fix.and_then(value) {
+                    Some(v) => (v, true),
+                    None => (0.0, false),
+                })
+                .unzip();
+            Values::OptNumber(v, present)
+        };
+        Ok(match Field::of_column(column) {
+            Some(Field::T) => numbers(&|f| rows::seconds(f.t_us)),
+            Some(Field::Accel(i)) => numbers(&|f| rows::accel_g(f.accel[i])),
+            Some(Field::Gyro(i)) => numbers(&|f| rows::gyro_dps(f.gyro[i])),
+            Some(Field::Steer) => numbers(&|f| rows::steer_deg(f.steer_cdeg)),
+            Some(Field::Speed) => numbers(&|f| rows::speed_mps(f.speed_mm_s)),
+            Some(Field::GpsLat) => gps(|g| Some(g.lat_deg)),
+            Some(Field::GpsLon) => gps(|g| Some(g.lon_deg)),
+            Some(Field::GpsSpeed) => gps(|g| g.speed_mps),
+            Some(Field::GpsFix) => {
+                Values::Label(fixes().map(|f| f.map(|f| f.fix.as_str())).collect())
+            }
+            Some(Field::Utc) => Values::Utc(
+                self.utc_us[rows.clone()].to_vec(),
+                self.has_utc[rows].to_vec(),
+            ),
+            Some(Field::Run) | None => {
+                return Err(format!("{} is not a column of the frames", column.name))
+            }
+        })
+    }
+}
+
+impl PendingRows for Counts {
+    fn push(&mut self, frame: &Frame, gps: Option<GpsColumns>, utc_us: Option<i64>) {
+        self.frames.push(*frame);
+        self.gps.push(NO_FIX);
+        self.utc_us.push(0);
+        self.has_utc.push(false);
+        let i = self.len() - 1 - self.first_pending;
+        self.set_gps(i, gps);
+        self.set_utc(i, utc_us);
+    }
+
+    fn set_gps(&mut self, i: usize, gps: Option<GpsColumns>) {
+        let index = match gps {
+            None => NO_FIX,
+            Some(g) => {
+                // A fix fills some fifty rows: kept once.
+                if self.fixes.last() != Some(&g) {
+                    self.fixes.push(g);
+                }
+                u32::try_from(self.fixes.len() - 1).unwrap_or(NO_FIX)
+            }
+        };
+        self.gps[self.first_pending + i] = index;
+    }
+
+    fn set_utc(&mut self, i: usize, utc_us: Option<i64>) {
+        let row = self.first_pending + i;
+        self.utc_us[row] = utc_us.unwrap_or_default();
+        self.has_utc[row] = utc_us.is_some();
+    }
+
+    fn complete_first(&mut self) {
+        self.first_pending += 1;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::export::columns::{Value, COLUMNS};
+    use crate::rows::RowAssembler;
+    use crate::time::TimeBound;
+    use proptest::prelude::*;
+    use wobble_core::format::{FixMode, GpsFix, UtcSync};
+
+    /// Records as a log holds them: frames 10 ms apart with now and then a
+    /// step back or a long step forward, fixes and sync pairs stamped up to
+    /// 0.8 s before the frame they follow (late) or after it, some fixes
+    /// without a position.
+    fn records() -> impl Strategy<Value = Vec<Record<'static>>> {
+        let step = prop_oneof![8 => Just(10_000i64), 1 => -3_000_000i64..3_000_000];
+        let item = (step, 0u8..10, -800_000i64..200_000, any::<i16>(), 0u8..4);
+        prop::collection::vec(item, 1..600).prop_map(|items| {
+            let mut t: i64 = 5_000_000;
+            let mut out = Vec::new();
+            for (step, kind, stamp, value, mode) in items {
+                t = (t + step).max(0);
+                let t_us = t as u64;
+                out.push(Record::Frame(Frame {
+                    t_us,
+                    accel: [value, value / 2, value.wrapping_neg()],
+                    gyro: [value / 3, value, 7],
+                    steer_cdeg: value,
+                    speed_mm_s: value.unsigned_abs(),
+                    ..Frame::default()
+                }));
+                let at = (t + stamp).max(0) as u64;
+                match kind {
+                    0 | 1 => out.push(Record::Gps(GpsFix {
+                        t_us: at,
+                        lat_e7: (value % 5 != 0).then_some(i32::from(value) * 1000),
+                        lon_e7: Some(-i32::from(value)),
+                        speed_cm_s: (mode > 1).then_some(value.unsigned_abs()),
+                        fix: [
+                            FixMode::None,
+                            FixMode::Fix3d,
+                            FixMode::Fix3d,
+                            FixMode::Fix2d,
+                        ][usize::from(mode)],
+                        ..GpsFix::default()
+                    })),
+                    2 => out.push(Record::UtcSync(UtcSync {
+                        t_us: at,
+                        unix_ms: 1_700_000_000_000 + u64::from(value.unsigned_abs()),
+                    })),
+                    _ => {}
+                }
+            }
+            out
+        })
+    }
+
+    /// Every column's cells as the column table's value functions give them.
+    fn cells(values: Values) -> Vec<Value> {
+        match values {
+            Values::Number(v) => v.into_iter().map(|x| Value::Number(Some(x))).collect(),
+            Values::OptNumber(v, p) => v
+                .into_iter()
+                .zip(p)
+                .map(|(x, has)| Value::Number(has.then_some(x)))
+                .collect(),
+            Values::Label(v) => v.into_iter().map(Value::Label).collect(),
+            Values::Utc(v, p) => v
+                .into_iter()
+                .zip(p)
+                .map(|(x, has)| Value::Utc(has.then_some(x)))
+                .collect(),
+            other => panic!("not a frame column: {other:?}"),
+        }
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig {
+            cases: 256,
+            rng_seed: proptest::test_runner::RngSeed::Fixed(35),
+            failure_persistence: None,
+            ..ProptestConfig::default()
+        })]
+
+        /// The columns hold, row for row, what the rows of `wobblog decode`
+        /// hold, and the summary's figures agree with those rows'.
+        #[test]
+        fn the_columns_are_the_rows_of_decode(records in records()) {
+            let mut rows = Vec::new();
+            let mut assembler = RowAssembler::new();
+            let mut stats = RowStats::default();
+            let mut keep = |row: &Row| {
+                stats.take(row);
+                rows.push(*row);
+            };
+            let mut columns = FrameColumns::new();
+            for record in &records {
+                assembler.push(record, &mut keep);
+                columns.push(record);
+            }
+            assembler.finish(&mut keep);
+            columns.finish();
+            prop_assert_eq!(columns.len(), rows.len());
+            for column in &COLUMNS {
+                let expected: Vec<Value> = rows.iter().map(|r| (column.value)(r)).collect();
+                let split = rows.len() / 3;
+                let mut got = cells(columns.values(column, 0..split).unwrap());
+                got.extend(cells(columns.values(column, split..rows.len()).unwrap()));
+                prop_assert_eq!(got, expected, "column {}", column.name);
+            }
+            prop_assert_eq!(columns.row_stats(), stats);
+            let times = rows.iter().map(|r| r.t_s);
+            let span = times.clone().reduce(f64::min).zip(times.reduce(f64::max));
+            prop_assert_eq!(columns.span_s(), span);
+
+            // A window keeps the rows `decode` keeps.
+            let from = rows[rows.len() / 2].t_s;
+            let utc_to = rows.iter().find_map(|r| r.utc_us).map(|u| u / 1000 + 2_000);
+            let window = TimeWindow {
+                from: Some(TimeBound::Boot(from)),
+                to: utc_to.map(TimeBound::Utc),
+            };
+            let inside: Vec<&Row> = rows
+                .iter()
+                .filter(|r| window.contains(r.t_s, r.utc_us.map(|u| u / 1000)))
+                .collect();
+            columns.retain(&window);
+            prop_assert_eq!(columns.len(), inside.len());
+            let t = cells(columns.values(&COLUMNS[0], 0..inside.len()).unwrap());
+            let utc = cells(columns.values(&COLUMNS[13], 0..inside.len()).unwrap());
+            prop_assert_eq!(t, inside.iter().map(|r| Value::Number(Some(r.t_s))).collect::<Vec<_>>());
+            prop_assert_eq!(utc, inside.iter().map(|r| Value::Utc(r.utc_us)).collect::<Vec<_>>());
+        }
+    }
+}
