@@ -76,10 +76,49 @@ pub fn read_log_until(
     });
     let stats = if scan.in_order {
         file.seek(SeekFrom::Start(0)).map_err(io)?;
-        stream(&mut file, len, first_len, &mut visit).map_err(io)?
+        *stream(&mut file, len, first_len, &mut visit)
+            .map_err(io)?
+            .stats()
     } else {
         in_sequence_order(&mut file, scan, &mut visit).map_err(io)?
     };
+    some_blocks(path, len, stats, other_version)
+}
+
+/// Decodes the log at `path` like [`read_log_until`] (from the usual
+/// chunks), but in one pass when its blocks are in sequence order, as
+/// a log written once is: the blocks are decoded in file order as they
+/// are found. When the pass shows blocks out of order (or none valid),
+/// `restart` is called and the log is decoded again as
+/// [`read_log_until`] decodes it: `visit` gets that decode's events from
+/// its start. Either way `visit` ends up with the events
+/// [`read_log_until`] gives.
+///
+/// # Errors
+/// As [`read_log_until`].
+pub fn read_log_restarting(
+    path: &Path,
+    mut visit: impl FnMut(Event<'_>) -> ControlFlow<()>,
+    restart: impl FnOnce(),
+) -> Result<DecodeStats, CliError> {
+    let (mut file, len) = crate::spool::open_seekable(path)?;
+    let decoder =
+        stream(&mut file, len, CHUNK_LEN, &mut visit).map_err(|e| CliError::file(path, e))?;
+    if decoder.in_sequence_order() && decoder.stats().blocks > 0 {
+        return Ok(*decoder.stats());
+    }
+    restart();
+    read_log_until(path, CHUNK_LEN, visit)
+}
+
+/// `stats`, or the error for a log of `len` bytes without a valid block
+/// (one of another format version, if the first pass found one).
+fn some_blocks(
+    path: &Path,
+    len: u64,
+    stats: DecodeStats,
+    other_version: Option<u8>,
+) -> Result<DecodeStats, CliError> {
     if stats.blocks == 0 {
         if let Some(v) = other_version {
             return Err(CliError::file(
@@ -110,7 +149,7 @@ fn stream(
     len: u64,
     first_len: usize,
     visit: &mut impl FnMut(Event<'_>) -> ControlFlow<()>,
-) -> std::io::Result<DecodeStats> {
+) -> std::io::Result<Decoder> {
     let progress = progress_bar(len, "decoding");
     let mut decoder = Decoder::new();
     let mut buf = vec![0u8; CHUNK_LEN];
@@ -134,7 +173,7 @@ fn stream(
         limit = (2 * limit).min(CHUNK_LEN);
     }
     progress.finish_and_clear();
-    Ok(*decoder.stats())
+    Ok(decoder)
 }
 
 /// What the first pass over a file found.
@@ -155,7 +194,6 @@ fn scan(file: &mut File, len: u64) -> std::io::Result<Scan> {
     let mut decoder = Decoder::new();
     let mut skipped = Vec::new();
     let mut blocks: Vec<(u32, u64)> = Vec::new();
-    let mut in_order = true;
     let mut buf = vec![0u8; CHUNK_LEN];
     let mut filled = 0;
     loop {
@@ -169,10 +207,7 @@ fn scan(file: &mut File, len: u64) -> std::io::Result<Scan> {
                     skipped.push((offset, len, cause));
                 }
             },
-            &mut |offset, header| {
-                in_order &= blocks.last().is_none_or(|&(seq, _)| seq < header.seq);
-                blocks.push((header.seq, offset));
-            },
+            &mut |offset, header| blocks.push((header.seq, offset)),
         );
         progress.inc(consumed as u64);
         buf.copy_within(consumed..filled, 0);
@@ -183,10 +218,10 @@ fn scan(file: &mut File, len: u64) -> std::io::Result<Scan> {
     }
     progress.finish_and_clear();
     Ok(Scan {
+        in_order: decoder.in_sequence_order(),
         decoder,
         skipped,
         blocks,
-        in_order,
     })
 }
 
@@ -463,5 +498,47 @@ pub(crate) mod tests {
         .unwrap();
         assert_eq!(events, 1);
         assert_eq!(stats.blocks, 2);
+    }
+
+    /// Every event of the log at `path` (as text), its totals, and how
+    /// often the one-pass reader started again.
+    fn restarting(path: &Path) -> (Vec<String>, DecodeStats, u32) {
+        let events = std::cell::RefCell::new(Vec::new());
+        let mut restarts = 0;
+        let stats = read_log_restarting(
+            path,
+            |e| {
+                events.borrow_mut().push(format!("{e:?}"));
+                ControlFlow::Continue(())
+            },
+            || {
+                restarts += 1;
+                events.borrow_mut().clear();
+            },
+        )
+        .unwrap();
+        (events.into_inner(), stats, restarts)
+    }
+
+    #[test]
+    fn one_pass_gives_the_events_of_two_and_starts_again_only_for_blocks_out_of_order() {
+        let (in_order, _) = log(3000, 700);
+        let swapped = reordered(3000, |n| {
+            (0..n).map(|i| i ^ 1).map(|i| i.min(n - 1)).collect()
+        });
+        let copied = reordered(3000, |n| (0..n).chain([4, 5]).collect());
+        for (what, path, restarts) in [
+            ("in order", in_order.path(), 0),
+            ("neighbours swapped", swapped.path(), 1),
+            ("copies at the end", copied.path(), 1),
+        ] {
+            let mut expected = Vec::new();
+            let stats = read_log(path, |e| expected.push(format!("{e:?}"))).unwrap();
+            assert_eq!(restarting(path), (expected, stats, restarts), "{what}");
+        }
+        // No valid block: the usual error.
+        let empty = tempfile::NamedTempFile::new().unwrap();
+        let e = read_log_restarting(empty.path(), |_| ControlFlow::Continue(()), || {});
+        assert!(e.unwrap_err().to_string().contains("empty file"));
     }
 }

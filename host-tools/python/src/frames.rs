@@ -1,6 +1,7 @@
 //! A log's frames as a [`Table`]: the rows `wobblog decode` writes, in its
 //! columns and time window, decoded without the GIL.
 
+use std::cell::RefCell;
 use std::ops::ControlFlow;
 use std::path::Path;
 
@@ -9,8 +10,9 @@ use wobble_core::format::{DecodeStats, Event, Record};
 use wobblog::export::columns::Column;
 use wobblog::export::frame_columns::FrameColumns;
 use wobblog::losses::Losses;
-use wobblog::reader::read_log_until;
+use wobblog::reader::read_log_restarting;
 use wobblog::summary::RowStats;
+use wobblog::summary::SummaryBuilder;
 use wobblog::time::TimeWindow;
 use wobblog::CliError;
 
@@ -56,14 +58,95 @@ fn row_record(record: &Record<'_>) -> Option<Record<'static>> {
     }
 }
 
+/// What goes from the decoding thread to the one building the columns.
+enum Handed {
+    /// The next records.
+    Records(Vec<Record<'static>>),
+    /// The decode starts again from the log's start.
+    Restart,
+}
+
+/// What a log's events are handed to while it is decoded.
+pub trait Observer: Send {
+    /// Takes the log's next event.
+    fn observe(&mut self, event: &Event<'_>);
+    /// The decode starts again from the start of the log (its blocks were
+    /// not in order): what was observed is to be forgotten.
+    fn restart(&mut self);
+}
+
+impl Observer for SummaryBuilder {
+    fn observe(&mut self, event: &Event<'_>) {
+        SummaryBuilder::observe(self, event);
+    }
+    fn restart(&mut self) {
+        *self = SummaryBuilder::rows_elsewhere();
+    }
+}
+
+impl Observer for Losses {
+    fn observe(&mut self, event: &Event<'_>) {
+        Losses::observe(self, event);
+    }
+    fn restart(&mut self) {
+        *self = Losses::default();
+    }
+}
+
+/// The decoding thread's side: the observer, and the records on their way
+/// to the thread building the columns.
+struct Handover<'o, O> {
+    observer: &'o mut O,
+    send: std::sync::mpsc::SyncSender<Handed>,
+    batch: Vec<Record<'static>>,
+    has_utc: bool,
+}
+
+impl<O: Observer> Handover<'_, O> {
+    fn take(&mut self, event: &Event<'_>) -> ControlFlow<()> {
+        self.observer.observe(event);
+        let Event::Record(record) = event else {
+            return ControlFlow::Continue(());
+        };
+        self.has_utc |= matches!(record, Record::UtcSync(_));
+        if let Some(owned) = row_record(record) {
+            self.batch.push(owned);
+            if self.batch.len() == RECORDS_PER_HANDOVER {
+                let full =
+                    std::mem::replace(&mut self.batch, Vec::with_capacity(RECORDS_PER_HANDOVER));
+                if self.send.send(Handed::Records(full)).is_err() {
+                    // The builder stopped (Ctrl-C).
+                    return ControlFlow::Break(());
+                }
+            }
+        }
+        ControlFlow::Continue(())
+    }
+
+    fn restart(&mut self) {
+        self.observer.restart();
+        self.batch.clear();
+        self.has_utc = false;
+        // A builder that stopped (Ctrl-C) stops the decoding by itself.
+        let _ = self.send.send(Handed::Restart);
+    }
+}
+
 /// Turns records into the columns of every row.
-fn build(records: std::sync::mpsc::Receiver<Vec<Record<'static>>>) -> Built {
+fn build(records: std::sync::mpsc::Receiver<Handed>) -> Built {
     let mut built = Built {
         frames: FrameColumns::new(),
         interrupted: None,
     };
     let mut since_check = 0;
-    for batch in &records {
+    for handed in &records {
+        let batch = match handed {
+            Handed::Records(batch) => batch,
+            Handed::Restart => {
+                built.frames = FrameColumns::new();
+                continue;
+            }
+        };
         for record in &batch {
             built.frames.push(record);
         }
@@ -84,48 +167,38 @@ fn build(records: std::sync::mpsc::Receiver<Vec<Record<'static>>>) -> Built {
 }
 
 /// Decodes the log at `path` once: its rows inside `window`, in `columns`,
-/// and every decoder event passed to `observe` as well (a summary, the
+/// and every decoder event passed to `observer` as well (a summary, the
 /// losses). The log is decoded on a second thread while this one builds
-/// the rows and their columns. Called without the GIL; it is taken briefly now and
+/// the rows and their columns, in one pass when its blocks are in order
+/// ([`read_log_restarting`]). Called without the GIL; it is taken briefly now and
 /// then to see whether Ctrl-C was pressed, which ends the decoding with
 /// `KeyboardInterrupt`.
 pub fn walk(
     path: &Path,
     columns: &[Column],
     window: TimeWindow,
-    mut observe: impl FnMut(&Event<'_>) + Send,
+    observer: &mut impl Observer,
 ) -> PyResult<Decoded> {
     let fail = |e: CliError| crate::errors::to_py(e);
     window.check_order(path).map_err(fail)?;
     let (walked, has_utc, built) = std::thread::scope(|scope| {
         let (send, records) = std::sync::mpsc::sync_channel(8);
         let decoder = scope.spawn(move || {
-            let mut has_utc = false;
-            let mut batch = Vec::with_capacity(RECORDS_PER_HANDOVER);
-            // The reader's usual chunks from the start (the first is clamped
-            // to them).
-            let walked = read_log_until(path, usize::MAX, |event| {
-                observe(&event);
-                if let Event::Record(record) = &event {
-                    has_utc |= matches!(record, Record::UtcSync(_));
-                    if let Some(owned) = row_record(record) {
-                        batch.push(owned);
-                        if batch.len() == RECORDS_PER_HANDOVER {
-                            let full = std::mem::replace(
-                                &mut batch,
-                                Vec::with_capacity(RECORDS_PER_HANDOVER),
-                            );
-                            if send.send(full).is_err() {
-                                // The builder stopped (Ctrl-C).
-                                return ControlFlow::Break(());
-                            }
-                        }
-                    }
-                }
-                ControlFlow::Continue(())
+            let handover = RefCell::new(Handover {
+                observer,
+                send,
+                batch: Vec::with_capacity(RECORDS_PER_HANDOVER),
+                has_utc: false,
             });
-            let _ = send.send(batch);
-            (walked, has_utc)
+            let walked = read_log_restarting(
+                path,
+                |event| handover.borrow_mut().take(&event),
+                || handover.borrow_mut().restart(),
+            );
+            let mut handover = handover.into_inner();
+            let batch = std::mem::take(&mut handover.batch);
+            let _ = handover.send.send(Handed::Records(batch));
+            (walked, handover.has_utc)
         });
         // The rows are built on this thread, the caller's, where Python
         // looks for Ctrl-C.
@@ -170,7 +243,7 @@ pub fn walk(
 /// the log lost (see [`walk`]).
 pub fn decode(path: &Path, columns: &[Column], window: TimeWindow) -> PyResult<(Table, Losses)> {
     let mut losses = Losses::default();
-    let decoded = walk(path, columns, window, |event| losses.observe(event))?;
+    let decoded = walk(path, columns, window, &mut losses)?;
     Ok((decoded.table, losses))
 }
 

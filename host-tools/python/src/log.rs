@@ -78,10 +78,12 @@ impl Log {
         // summary's row totals taken from the frames' rows.
         let (summary, decoded) = py.detach(|| {
             let mut builder = SummaryBuilder::rows_elsewhere();
-            let mut decoded =
-                crate::frames::walk(&path, &columns::COLUMNS, TimeWindow::default(), |event| {
-                    builder.observe(event)
-                })?;
+            let mut decoded = crate::frames::walk(
+                &path,
+                &columns::COLUMNS,
+                TimeWindow::default(),
+                &mut builder,
+            )?;
             let rows = std::mem::take(&mut decoded.row_stats);
             PyResult::Ok((builder.finish_with_rows(&decoded.stats, rows), decoded))
         })?;

@@ -208,6 +208,10 @@ pub struct Decoder {
     spacing: (u32, u32, u64, bool),
     /// The sample rate the log info states (0: none yet).
     stated_hz: u16,
+    /// The sequence number of the last valid block walked over, and whether
+    /// one of them did not follow the one before it.
+    walked_seq: Option<u32>,
+    disordered: bool,
 }
 
 /// What [`Decoder::decode_block`] did with a block.
@@ -233,6 +237,14 @@ impl Decoder {
     #[must_use]
     pub fn stats(&self) -> &DecodeStats {
         &self.stats
+    }
+
+    /// Whether the sequence numbers of the valid blocks walked over so far
+    /// (by [`Self::feed`] or [`Self::scan`]) strictly increase: then a
+    /// decode in file order is a decode in sequence order.
+    #[must_use]
+    pub fn in_sequence_order(&self) -> bool {
+        !self.disordered
     }
 
     /// Decodes what it can of `chunk`, the bytes of the stream from the first
@@ -339,6 +351,8 @@ impl Decoder {
             };
             match parsed {
                 Ok(header) => {
+                    self.disordered |= self.walked_seq.is_some_and(|seq| header.seq <= seq);
+                    self.walked_seq = Some(header.seq);
                     let seen = on_block(self, at(pos), &header, block);
                     if seen == Some(Seen::Repeat) {
                         if skip.is_some_and(|(_, c)| c != SkipCause::Repeated) {
