@@ -130,7 +130,9 @@ pub fn speed_mps(mm_s: u16) -> f64 {
 #[derive(Default)]
 pub struct RowAssembler {
     assembly: Assembly,
-    pending: VecDeque<Row>,
+    /// The pending rows and their frame times, µs.
+    pending: VecDeque<(u64, Row)>,
+    fix: Option<GpsColumns>,
 }
 
 impl RowAssembler {
@@ -146,6 +148,7 @@ impl RowAssembler {
             record,
             &mut Queue {
                 rows: &mut self.pending,
+                fix: &mut self.fix,
                 emit,
             },
         );
@@ -155,6 +158,7 @@ impl RowAssembler {
     pub fn finish(&mut self, emit: &mut impl FnMut(&Row)) {
         self.assembly.finish(&mut Queue {
             rows: &mut self.pending,
+            fix: &mut self.fix,
             emit,
         });
     }
@@ -162,27 +166,39 @@ impl RowAssembler {
 
 /// Pending rows as rows, emitted once complete.
 struct Queue<'a, F> {
-    rows: &'a mut VecDeque<Row>,
+    rows: &'a mut VecDeque<(u64, Row)>,
+    /// The fix in force.
+    fix: &'a mut Option<GpsColumns>,
     emit: &'a mut F,
 }
 
 impl<F: FnMut(&Row)> PendingRows for Queue<'_, F> {
-    fn push(&mut self, frame: &Frame, gps: Option<GpsColumns>, utc_us: Option<i64>) {
-        self.rows.push_back(Row::new(frame, gps, utc_us));
+    fn fix(&mut self, gps: GpsColumns) {
+        *self.fix = Some(gps);
     }
 
-    fn set_gps(&mut self, i: usize, gps: Option<GpsColumns>) {
-        self.rows[i].gps = gps;
+    fn push(&mut self, frame: &Frame, gps: bool, utc_us: Option<i64>) {
+        let gps = self.fix.filter(|_| gps);
+        self.rows
+            .push_back((frame.t_us, Row::new(frame, gps, utc_us)));
+    }
+
+    fn set_gps(&mut self, i: usize, gps: bool) {
+        self.rows[i].1.gps = self.fix.filter(|_| gps);
     }
 
     fn set_utc(&mut self, i: usize, utc_us: Option<i64>) {
-        self.rows[i].utc_us = utc_us;
+        self.rows[i].1.utc_us = utc_us;
+    }
+
+    fn time_us(&self, i: usize) -> u64 {
+        self.rows[i].0
     }
 
     /// Emitted where it lies: a row is some 200 bytes, and moving each out
     /// would copy it.
     fn complete_first(&mut self) {
-        if let Some(row) = self.rows.front() {
+        if let Some((_, row)) = self.rows.front() {
             (self.emit)(row);
         }
         self.rows.pop_front();

@@ -201,10 +201,33 @@ pub struct SummaryBuilder {
     closed_us: u64,
     /// Frames of the current segment.
     segment_frames: u64,
+    /// The frames' times, in µs until the summary is finished.
+    frame_times: FrameTimes,
     /// The rows, assembled here unless the caller assembles them
     /// ([`SummaryBuilder::rows_elsewhere`]).
     rows: Option<RowAssembler>,
     row_stats: RowStats,
+}
+
+/// The first, last, earliest and latest frame time, µs.
+#[derive(Default)]
+struct FrameTimes(Option<[u64; 4]>);
+
+impl FrameTimes {
+    fn take(&mut self, t_us: u64) {
+        let [first, _, min, max] = self.0.unwrap_or([t_us; 4]);
+        self.0 = Some([first, t_us, min.min(t_us), max.max(t_us)]);
+    }
+
+    /// Sets the summary's start, end and range of frame times, s.
+    fn fill(&self, s: &mut Summary) {
+        let seconds = |t_us: u64| t_us as f64 / 1e6;
+        if let Some([first, last, min, max]) = self.0 {
+            s.start_s = Some(seconds(first));
+            s.end_s = Some(seconds(last));
+            s.frame_range_s = Some((seconds(min), seconds(max)));
+        }
+    }
 }
 
 /// What the summary takes from the decoded rows: GPS coverage and the UTC
@@ -250,21 +273,20 @@ impl SummaryBuilder {
 
     /// Takes one decoder event.
     pub fn observe(&mut self, event: &Event<'_>) {
-        self.summary.losses.observe(event);
-        if let Event::TimeJump { .. } = event {
-            self.close_segment();
-        }
-        let Event::Record(record) = event else { return };
+        let Event::Record(record) = event else {
+            self.summary.losses.observe(event);
+            if let Event::TimeJump { .. } = event {
+                self.close_segment();
+            }
+            return;
+        };
         let s = &mut self.summary;
         let t_s = record.t_us() as f64 / 1e6;
         self.kinds[kind_index(record)] += 1;
         match record {
             Record::Frame(f) => {
                 s.samples += 1;
-                s.start_s.get_or_insert(t_s);
-                s.end_s = Some(t_s);
-                let (lo, hi) = s.frame_range_s.unwrap_or((t_s, t_s));
-                s.frame_range_s = Some((lo.min(t_s), hi.max(t_s)));
+                self.frame_times.take(f.t_us);
                 self.segment_frames += 1;
                 let first = self.span_us.map_or(f.t_us, |(first, _)| first);
                 self.span_us = Some((first, f.t_us));
@@ -371,6 +393,7 @@ impl SummaryBuilder {
     fn finish_rows_taken(mut self, stats: &DecodeStats) -> Summary {
         self.close_segment();
         let mut s = self.summary;
+        self.frame_times.fill(&mut s);
         let utc_text = |us: Option<i64>| us.and_then(iso8601_unix_us);
         s.first_utc = utc_text(self.row_stats.first_utc_us);
         s.first_utc_us = self.row_stats.first_utc_us;

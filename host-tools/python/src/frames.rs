@@ -6,6 +6,7 @@ use std::ops::ControlFlow;
 use std::path::Path;
 
 use pyo3::prelude::*;
+use wobble_core::format::codec::FRAME_MIN_LEN;
 use wobble_core::format::{DecodeStats, Event, Record};
 use wobblog::export::columns::Column;
 use wobblog::export::frame_columns::FrameColumns;
@@ -17,6 +18,7 @@ use wobblog::time::TimeWindow;
 use wobblog::CliError;
 
 use crate::stream::Table;
+use crate::table::FrameBatches;
 
 /// Records between two looks for a pending `KeyboardInterrupt`.
 const RECORDS_PER_SIGNAL_CHECK: usize = 1 << 14;
@@ -37,11 +39,15 @@ pub struct Decoded {
 
 /// Records handed from the decoding thread to the one building the
 /// columns at a time.
-const RECORDS_PER_HANDOVER: usize = 1024;
+const RECORDS_PER_HANDOVER: usize = 4096;
 
 /// What the thread building the columns gives back.
-struct Built {
+struct Built<'c> {
     frames: FrameColumns,
+    /// The record batches converted so far (whole-log decodes only: a
+    /// window is applied once every row is in).
+    batches: FrameBatches<'c>,
+    failure: Option<arrow_schema::ArrowError>,
     /// Ctrl-C, which stopped the building (and so the decoding).
     interrupted: Option<PyErr>,
 }
@@ -133,9 +139,16 @@ impl<O: Observer> Handover<'_, O> {
 }
 
 /// Turns records into the columns of every row.
-fn build(records: std::sync::mpsc::Receiver<Handed>) -> Built {
+fn build<'c>(
+    records: std::sync::mpsc::Receiver<Handed>,
+    columns: &'c [Column],
+    window: TimeWindow,
+    room: usize,
+) -> Built<'c> {
     let mut built = Built {
-        frames: FrameColumns::new(),
+        frames: FrameColumns::with_room(room),
+        batches: FrameBatches::new(columns),
+        failure: None,
         interrupted: None,
     };
     let mut since_check = 0;
@@ -143,12 +156,16 @@ fn build(records: std::sync::mpsc::Receiver<Handed>) -> Built {
         let batch = match handed {
             Handed::Records(batch) => batch,
             Handed::Restart => {
-                built.frames = FrameColumns::new();
+                built.frames = FrameColumns::with_room(room);
+                built.batches = FrameBatches::new(columns);
                 continue;
             }
         };
         for record in &batch {
             built.frames.push(record);
+        }
+        if window.is_all() && built.failure.is_none() {
+            built.failure = built.batches.convert_complete(&built.frames).err();
         }
         // Python runs signal handlers on its main thread only: the one that
         // called, this one.
@@ -166,11 +183,20 @@ fn build(records: std::sync::mpsc::Receiver<Handed>) -> Built {
     built
 }
 
+/// The most frames the log at `path` can hold, up to a day of them (a card
+/// image given as a log reserves no more); 0 if its size is unknown.
+fn room_for_frames(path: &Path) -> usize {
+    const DAY_OF_FRAMES: u64 = 100 * 86_400;
+    let len = std::fs::metadata(path).map_or(0, |m| m.len());
+    usize::try_from((len / FRAME_MIN_LEN as u64).min(DAY_OF_FRAMES)).unwrap_or(0)
+}
+
 /// Decodes the log at `path` once: its rows inside `window`, in `columns`,
 /// and every decoder event passed to `observer` as well (a summary, the
 /// losses). The log is decoded on a second thread while this one builds
 /// the rows and their columns, in one pass when its blocks are in order
-/// ([`read_log_restarting`]). Called without the GIL; it is taken briefly now and
+/// ([`read_log_restarting`]); a record batch is converted as soon as its
+/// rows are complete. Called without the GIL; it is taken briefly now and
 /// then to see whether Ctrl-C was pressed, which ends the decoding with
 /// `KeyboardInterrupt`.
 pub fn walk(
@@ -202,7 +228,7 @@ pub fn walk(
         });
         // The rows are built on this thread, the caller's, where Python
         // looks for Ctrl-C.
-        let built = build(records);
+        let built = build(records, columns, window, room_for_frames(path));
         let (walked, has_utc) = match decoder.join() {
             Ok(done) => done,
             Err(panic) => std::panic::resume_unwind(panic),
@@ -211,25 +237,30 @@ pub fn walk(
     });
     let Built {
         mut frames,
+        mut batches,
+        failure,
         interrupted,
     } = built;
     if let Some(e) = interrupted {
         return Err(e);
     }
     let stats = walked.map_err(fail)?;
+    if let Some(e) = failure {
+        return Err(arrow_error(path, &e));
+    }
     // Of every row, inside the window or not.
     let span_s = frames.span_s();
     let row_stats = frames.row_stats();
     if !window.is_all() {
         frames.retain(&window);
+        batches = FrameBatches::new(columns);
         if frames.is_empty() {
             return Err(fail(
                 window.selects_nothing(path, "frames", span_s, has_utc),
             ));
         }
     }
-    let (schema, batches) =
-        crate::table::frames(&frames, columns).map_err(|e| arrow_error(path, &e))?;
+    let (schema, batches) = batches.finish(&frames).map_err(|e| arrow_error(path, &e))?;
     Ok(Decoded {
         table: Table::new(schema, batches),
         stats,

@@ -85,48 +85,97 @@ pub struct TableBuilder<R: 'static> {
 }
 
 /// Decoded frames in `columns` as record batches of [`BATCH_ROWS`] rows,
-/// every other batch converted on a second thread.
-///
-/// # Errors
-/// A column is not one of the frame columns.
-pub fn frames(
-    frames: &FrameColumns,
-    columns: &[Column<Row>],
-) -> Result<(SchemaRef, Vec<RecordBatch>), ArrowError> {
-    let schema = schema(columns);
-    let rows = frames.len();
-    let batch = |start: usize| {
-        let range = start..rows.min(start + BATCH_ROWS);
-        let arrays = columns
+/// each converted once its rows are complete (while the log is still
+/// being decoded), the last ones on two threads.
+pub struct FrameBatches<'c> {
+    schema: SchemaRef,
+    columns: &'c [Column<Row>],
+    batches: Vec<RecordBatch>,
+    /// Rows converted.
+    done: usize,
+}
+
+impl<'c> FrameBatches<'c> {
+    /// No batch yet.
+    #[must_use]
+    pub fn new(columns: &'c [Column<Row>]) -> Self {
+        Self {
+            schema: schema(columns),
+            columns,
+            batches: Vec::new(),
+            done: 0,
+        }
+    }
+
+    fn batch(&self, frames: &FrameColumns, start: usize) -> Result<RecordBatch, ArrowError> {
+        let range = start..frames.len().min(start + BATCH_ROWS);
+        let arrays = self
+            .columns
             .iter()
             .map(|c| frames.values(c, range.clone()).map(array))
             .collect::<Result<Vec<_>, _>>()
             .map_err(ArrowError::InvalidArgumentError)?;
-        RecordBatch::try_new(schema.clone(), arrays)
-    };
-    // At least one batch, empty for no rows, so every consumer sees the
-    // columns.
-    let starts: Vec<usize> = (0..rows.max(1)).step_by(BATCH_ROWS).collect();
-    let (even, odd) = std::thread::scope(|scope| {
-        let odd = scope.spawn(|| {
-            starts
+        RecordBatch::try_new(self.schema.clone(), arrays)
+    }
+
+    /// Converts the whole batches of `frames`' complete rows not converted
+    /// yet.
+    ///
+    /// # Errors
+    /// A column is not one of the frame columns.
+    pub fn convert_complete(&mut self, frames: &FrameColumns) -> Result<(), ArrowError> {
+        while frames.complete() >= self.done + BATCH_ROWS {
+            let batch = self.batch(frames, self.done)?;
+            self.batches.push(batch);
+            self.done += BATCH_ROWS;
+        }
+        Ok(())
+    }
+
+    /// The schema and every batch, the rows not converted yet converted
+    /// now (every other batch on a second thread): at least one batch,
+    /// empty for no rows, so every consumer sees the columns.
+    ///
+    /// # Errors
+    /// A column is not one of the frame columns.
+    pub fn finish(
+        mut self,
+        frames: &FrameColumns,
+    ) -> Result<(SchemaRef, Vec<RecordBatch>), ArrowError> {
+        let rows = frames.len();
+        let mut starts = (self.done..rows).step_by(BATCH_ROWS).collect::<Vec<_>>();
+        if rows == 0 {
+            starts.push(0);
+        }
+        let this = &self;
+        let (even, odd) = std::thread::scope(|scope| {
+            let odd = scope.spawn(|| {
+                starts
+                    .iter()
+                    .skip(1)
+                    .step_by(2)
+                    .map(|&s| this.batch(frames, s))
+                    .collect::<Vec<_>>()
+            });
+            let even: Vec<_> = starts
                 .iter()
-                .skip(1)
                 .step_by(2)
-                .map(|&s| batch(s))
-                .collect::<Vec<_>>()
+                .map(|&s| this.batch(frames, s))
+                .collect();
+            (
+                even,
+                odd.join().unwrap_or_else(|p| std::panic::resume_unwind(p)),
+            )
         });
-        let even: Vec<_> = starts.iter().step_by(2).map(|&s| batch(s)).collect();
-        (
-            even,
-            odd.join().unwrap_or_else(|p| std::panic::resume_unwind(p)),
-        )
-    });
-    let (mut even, mut odd) = (even.into_iter(), odd.into_iter());
-    let batches = (0..starts.len())
-        .filter_map(|i| if i % 2 == 0 { even.next() } else { odd.next() })
-        .collect::<Result<Vec<_>, _>>()?;
-    Ok((schema, batches))
+        let (mut even, mut odd) = (even.into_iter(), odd.into_iter());
+        for i in 0..starts.len() {
+            let batch = if i % 2 == 0 { even.next() } else { odd.next() };
+            if let Some(batch) = batch {
+                self.batches.push(batch?);
+            }
+        }
+        Ok((self.schema, self.batches))
+    }
 }
 
 impl<R: 'static> TableBuilder<R> {

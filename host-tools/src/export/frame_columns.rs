@@ -17,7 +17,7 @@ use crate::rows::{self, Assembly, GpsColumns, PendingRows, Row};
 use crate::summary::RowStats;
 use crate::time::TimeWindow;
 
-/// A row without GPS columns, in [`Counts::gps`].
+/// A row without GPS columns, in [`Slot::gps`].
 const NO_FIX: u32 = u32::MAX;
 
 /// Frames as columns of counts, filled record by record.
@@ -34,6 +34,16 @@ impl FrameColumns {
         Self::default()
     }
 
+    /// No rows yet, with room for `rows` if it can be had (an estimate,
+    /// so a long log's rows are not copied each time their vector grows).
+    #[must_use]
+    pub fn with_room(rows: usize) -> Self {
+        let mut new = Self::default();
+        // Without the room, the vector grows as rows come.
+        let _ = new.columns.rows.try_reserve_exact(rows);
+        new
+    }
+
     /// Takes the log's next record.
     pub fn push(&mut self, record: &Record<'_>) {
         self.assembly.push(record, &mut self.columns);
@@ -48,6 +58,12 @@ impl FrameColumns {
     #[must_use]
     pub fn len(&self) -> usize {
         self.columns.len()
+    }
+
+    /// Rows complete: no fix or sync pair read later changes them.
+    #[must_use]
+    pub fn complete(&self) -> usize {
+        self.columns.first_pending
     }
 
     /// Whether there is no row.
@@ -90,73 +106,59 @@ impl FrameColumns {
 /// The rows' frames and what fills them.
 #[derive(Default)]
 struct Counts {
-    /// Every row's frame as read: one store per frame (a vector per
-    /// channel took fourteen).
-    frames: Vec<Frame>,
-    /// Per row, its GPS columns in `fixes` (or [`NO_FIX`]).
-    gps: Vec<u32>,
+    /// Every row as read: one store per frame.
+    rows: Vec<Slot>,
+    /// Every fix that was in force, in order.
     fixes: Vec<GpsColumns>,
-    /// UTC, µs since 1970 (0 where `has_utc` says none).
-    utc_us: Vec<i64>,
-    has_utc: Vec<bool>,
     /// The first row still waiting for a late fix or pair.
     first_pending: usize,
 }
 
+/// A row: its frame, its GPS columns in [`Counts::fixes`] (or
+/// [`NO_FIX`]), its UTC.
+#[derive(Clone, Copy)]
+struct Slot {
+    frame: Frame,
+    gps: u32,
+    utc_us: Option<i64>,
+}
+
 impl Counts {
     fn len(&self) -> usize {
-        self.frames.len()
+        self.rows.len()
     }
 
     fn span_s(&self) -> Option<(f64, f64)> {
-        let times = || self.frames.iter().map(|f| f.t_us);
+        let times = || self.rows.iter().map(|r| r.frame.t_us);
         Some((rows::seconds(times().min()?), rows::seconds(times().max()?)))
     }
 
     fn row_stats(&self) -> RowStats {
-        let utc = || {
-            self.utc_us
-                .iter()
-                .zip(&self.has_utc)
-                .filter_map(|(&us, &has)| has.then_some(us))
-        };
+        let utc = || self.rows.iter().filter_map(|r| r.utc_us);
         RowStats {
-            with_gps: self.gps.iter().filter(|&&g| g != NO_FIX).count() as u64,
+            with_gps: self.rows.iter().filter(|r| r.gps != NO_FIX).count() as u64,
             first_utc_us: utc().next(),
             last_utc_us: utc().next_back(),
         }
     }
 
     fn retain(&mut self, window: &TimeWindow) {
-        let keep: Vec<bool> = (0..self.len())
-            .map(|i| {
-                let utc_ms = self.has_utc[i].then(|| self.utc_us[i] / 1000);
-                window.contains(rows::seconds(self.frames[i].t_us), utc_ms)
-            })
-            .collect();
-        fn retain<T>(v: &mut Vec<T>, keep: &[bool]) {
-            let mut kept = keep.iter();
-            v.retain(|_| kept.next().copied().unwrap_or(false));
-        }
-        retain(&mut self.frames, &keep);
-        retain(&mut self.gps, &keep);
-        retain(&mut self.utc_us, &keep);
-        retain(&mut self.has_utc, &keep);
+        self.rows
+            .retain(|r| window.contains(rows::seconds(r.frame.t_us), r.utc_us.map(|u| u / 1000)));
         self.first_pending = self.len();
     }
 
-    fn values(&self, column: &Column<Row>, rows: Range<usize>) -> Result<Values, String> {
-        let frames = &self.frames[rows.clone()];
-        let numbers =
-            |unit: &dyn Fn(&Frame) -> f64| Values::Number(frames.iter().map(unit).collect());
-        let fixes = || {
-            self.gps[rows.clone()]
-                .iter()
-                .map(|&g| self.fixes.get(g as usize))
-        };
+    fn values(&self, column: &Column<Row>, range: Range<usize>) -> Result<Values, String> {
+        let slots = &self.rows[range];
+        // Generic, not `dyn`: each unit is inlined into its column's loop.
+        fn numbers(slots: &[Slot], unit: impl Fn(&Frame) -> f64) -> Values {
+            Values::Number(slots.iter().map(|r| unit(&r.frame)).collect())
+        }
+        let fix = |r: &Slot| self.fixes.get(r.gps as usize);
         let gps = |value: fn(&GpsColumns) -> Option<f64>| {
-            let (v, present) = fixes()
-                .map(|fix| match fix.and_then(value) {
+            let (v, present) = slots
+                .iter()
+                .map(|r| match fix(r).and_then(value) {
                     Some(v) => (v, true),
                     None => (0.0, false),
                 })
@@ -164,57 +166,64 @@ impl Counts {
             Values::OptNumber(v, present)
         };
         Ok(match Field::of_column(column) {
-            Some(Field::T) => numbers(&|f| rows::seconds(f.t_us)),
-            Some(Field::Accel(i)) => numbers(&|f| rows::accel_g(f.accel[i])),
-            Some(Field::Gyro(i)) => numbers(&|f| rows::gyro_dps(f.gyro[i])),
-            Some(Field::Steer) => numbers(&|f| rows::steer_deg(f.steer_cdeg)),
-            Some(Field::Speed) => numbers(&|f| rows::speed_mps(f.speed_mm_s)),
+            Some(Field::T) => numbers(slots, |f| rows::seconds(f.t_us)),
+            Some(Field::Accel(i)) => numbers(slots, |f| rows::accel_g(f.accel[i])),
+            Some(Field::Gyro(i)) => numbers(slots, |f| rows::gyro_dps(f.gyro[i])),
+            Some(Field::Steer) => numbers(slots, |f| rows::steer_deg(f.steer_cdeg)),
+            Some(Field::Speed) => numbers(slots, |f| rows::speed_mps(f.speed_mm_s)),
             Some(Field::GpsLat) => gps(|g| Some(g.lat_deg)),
             Some(Field::GpsLon) => gps(|g| Some(g.lon_deg)),
             Some(Field::GpsSpeed) => gps(|g| g.speed_mps),
-            Some(Field::GpsFix) => {
-                Values::Label(fixes().map(|f| f.map(|f| f.fix.as_str())).collect())
-            }
+            Some(Field::GpsFix) => Values::Label(
+                slots
+                    .iter()
+                    .map(|r| fix(r).map(|f| f.fix.as_str()))
+                    .collect(),
+            ),
             Some(Field::Utc) => Values::Utc(
-                self.utc_us[rows.clone()].to_vec(),
-                self.has_utc[rows].to_vec(),
+                slots.iter().map(|r| r.utc_us.unwrap_or_default()).collect(),
+                slots.iter().map(|r| r.utc_us.is_some()).collect(),
             ),
             Some(Field::Run) | None => {
                 return Err(format!("{} is not a column of the frames", column.name))
             }
         })
     }
+
+    /// The index in `fixes` of the fix in force, or [`NO_FIX`].
+    fn fix_index(&self, gps: bool) -> u32 {
+        match self.fixes.len().checked_sub(1) {
+            // A log holds fewer fixes than 2^32 (at 20 Hz, 6 years).
+            Some(last) if gps => u32::try_from(last).unwrap_or(NO_FIX),
+            _ => NO_FIX,
+        }
+    }
 }
 
 impl PendingRows for Counts {
-    fn push(&mut self, frame: &Frame, gps: Option<GpsColumns>, utc_us: Option<i64>) {
-        self.frames.push(*frame);
-        self.gps.push(NO_FIX);
-        self.utc_us.push(0);
-        self.has_utc.push(false);
-        let i = self.len() - 1 - self.first_pending;
-        self.set_gps(i, gps);
-        self.set_utc(i, utc_us);
+    fn fix(&mut self, gps: GpsColumns) {
+        self.fixes.push(gps);
     }
 
-    fn set_gps(&mut self, i: usize, gps: Option<GpsColumns>) {
-        let index = match gps {
-            None => NO_FIX,
-            Some(g) => {
-                // A fix fills some fifty rows: kept once.
-                if self.fixes.last() != Some(&g) {
-                    self.fixes.push(g);
-                }
-                u32::try_from(self.fixes.len() - 1).unwrap_or(NO_FIX)
-            }
-        };
-        self.gps[self.first_pending + i] = index;
+    fn push(&mut self, frame: &Frame, gps: bool, utc_us: Option<i64>) {
+        let gps = self.fix_index(gps);
+        self.rows.push(Slot {
+            frame: *frame,
+            gps,
+            utc_us,
+        });
+    }
+
+    fn set_gps(&mut self, i: usize, gps: bool) {
+        self.rows[self.first_pending + i].gps = self.fix_index(gps);
     }
 
     fn set_utc(&mut self, i: usize, utc_us: Option<i64>) {
-        let row = self.first_pending + i;
-        self.utc_us[row] = utc_us.unwrap_or_default();
-        self.has_utc[row] = utc_us.is_some();
+        self.rows[self.first_pending + i].utc_us = utc_us;
+    }
+
+    fn time_us(&self, i: usize) -> u64 {
+        self.rows[self.first_pending + i].frame.t_us
     }
 
     fn complete_first(&mut self) {

@@ -7,8 +7,6 @@
 //! [`GPS_WAIT_US`] so such a fix still fills them. A UTC sync pair is
 //! stamped the same way.
 
-use std::collections::VecDeque;
-
 use wobble_core::format::{Frame, Record, UtcSync};
 
 use super::GpsColumns;
@@ -22,13 +20,20 @@ const GPS_WAIT_US: u64 = 500_000;
 const MAX_PENDING_ROWS: usize = 4096;
 
 /// Rows waiting for a late fix or pair, held by the caller, oldest first.
+/// A row's GPS columns are those of the fix in force (the last one passed
+/// to [`PendingRows::fix`]) or none.
 pub trait PendingRows {
-    /// A new row for `frame` at the back, with the fix and UTC known so far.
-    fn push(&mut self, frame: &Frame, gps: Option<GpsColumns>, utc_us: Option<i64>);
-    /// Pending row `i` (0: the oldest) takes these GPS columns.
-    fn set_gps(&mut self, i: usize, gps: Option<GpsColumns>);
+    /// The fix in force from now on.
+    fn fix(&mut self, gps: GpsColumns);
+    /// A new row for `frame` at the back, with the fix in force or none,
+    /// and the UTC known so far.
+    fn push(&mut self, frame: &Frame, gps: bool, utc_us: Option<i64>);
+    /// Pending row `i` (0: the oldest) takes the fix in force, or none.
+    fn set_gps(&mut self, i: usize, gps: bool);
     /// Pending row `i` takes this UTC.
     fn set_utc(&mut self, i: usize, utc_us: Option<i64>);
+    /// The frame time of pending row `i`, µs.
+    fn time_us(&self, i: usize) -> u64;
     /// The oldest pending row is complete and leaves the queue.
     fn complete_first(&mut self);
 }
@@ -37,9 +42,10 @@ pub trait PendingRows {
 /// are complete. Memory is bounded: at most [`MAX_PENDING_ROWS`] wait.
 #[derive(Default)]
 pub struct Assembly {
-    /// The time of every pending row, oldest first (never decreasing:
-    /// time going back completes them all).
-    pending_us: VecDeque<u64>,
+    /// Rows pending (their times never decrease: time going back
+    /// completes them all).
+    pending: usize,
+    /// The fix in force and its time.
     gps: Option<(u64, GpsColumns)>,
     sync: Option<UtcSync>,
 }
@@ -55,9 +61,13 @@ impl Assembly {
                 let newer = self.gps.is_none_or(|(t, _)| fix.t_us >= t);
                 if newer {
                     self.gps = columns.map(|c| (fix.t_us, c));
-                    for (i, &t) in self.pending_us.iter().enumerate() {
+                    if let Some(c) = columns {
+                        rows.fix(c);
+                    }
+                    for i in 0..self.pending {
+                        let t = rows.time_us(i);
                         if t >= fix.t_us {
-                            rows.set_gps(i, columns.filter(|_| t - fix.t_us <= GPS_STALE_US));
+                            rows.set_gps(i, columns.is_some() && t - fix.t_us <= GPS_STALE_US);
                         }
                     }
                 }
@@ -65,7 +75,8 @@ impl Assembly {
             // Like a fix, a pair is stamped before frames written ahead of it.
             Record::UtcSync(sync) if self.sync.is_none_or(|s| sync.t_us >= s.t_us) => {
                 self.sync = Some(*sync);
-                for (i, &t) in self.pending_us.iter().enumerate() {
+                for i in 0..self.pending {
+                    let t = rows.time_us(i);
                     if t >= sync.t_us {
                         rows.set_utc(i, utc_us_at(*sync, t));
                     }
@@ -78,40 +89,36 @@ impl Assembly {
     fn frame(&mut self, frame: &Frame, rows: &mut impl PendingRows) {
         // Time going back starts a new segment: nothing waits across it,
         // and a fix from before it fills no row after it.
-        if self.pending_us.back().is_some_and(|&t| frame.t_us < t) {
+        if self.pending > 0 && frame.t_us < rows.time_us(self.pending - 1) {
             self.finish(rows);
             self.gps = None;
         }
-        if self.pending_us.len() >= MAX_PENDING_ROWS {
+        if self.pending >= MAX_PENDING_ROWS {
             self.complete_first(rows);
         }
-        let gps = self.gps.and_then(|(t, columns)| {
-            (t <= frame.t_us && frame.t_us - t <= GPS_STALE_US).then_some(columns)
-        });
+        let gps = self
+            .gps
+            .is_some_and(|(t, _)| t <= frame.t_us && frame.t_us - t <= GPS_STALE_US);
         let utc_us = self
             .sync
             .filter(|s| s.t_us <= frame.t_us)
             .and_then(|s| utc_us_at(s, frame.t_us));
         rows.push(frame, gps, utc_us);
-        self.pending_us.push_back(frame.t_us);
-        while self
-            .pending_us
-            .front()
-            .is_some_and(|&t| t + GPS_WAIT_US < frame.t_us)
-        {
+        self.pending += 1;
+        while self.pending > 0 && rows.time_us(0) + GPS_WAIT_US < frame.t_us {
             self.complete_first(rows);
         }
     }
 
     /// Completes every row still held back.
     pub fn finish(&mut self, rows: &mut impl PendingRows) {
-        while !self.pending_us.is_empty() {
+        while self.pending > 0 {
             self.complete_first(rows);
         }
     }
 
     fn complete_first(&mut self, rows: &mut impl PendingRows) {
-        self.pending_us.pop_front();
+        self.pending -= 1;
         rows.complete_first();
     }
 }

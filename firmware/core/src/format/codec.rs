@@ -17,6 +17,9 @@ pub const TAG_FRAME: u8 = 0x01;
 /// Bytes of a frame after its time delta: six IMU words, steering, wheel
 /// count, edge age and speed (two bytes each), the status byte.
 const FRAME_FIXED_LEN: usize = 2 * 10 + 1;
+/// The fewest bytes a frame takes on the card (tag, a one-byte time
+/// delta, the fixed part): a log of `n` bytes holds at most `n / 23` frames.
+pub const FRAME_MIN_LEN: usize = 1 + 1 + FRAME_FIXED_LEN;
 /// Tag: GPS fix.
 pub const TAG_GPS: u8 = 0x02;
 /// Tag: UTC sync pair.
@@ -439,32 +442,36 @@ impl<'a> Records<'a> {
         }
     }
 
+    /// A frame record's body, read by `r` (just past its tag).
+    #[inline(always)]
+    fn frame(&mut self, r: &mut Reader<'_>) -> Result<Frame, RecordError> {
+        let t_us = varint::unzigzag(r.uvar()?)
+            .checked_add(FRAME_PERIOD_US)
+            .and_then(|d| u64::try_from(d).ok())
+            .and_then(|d| self.cursor_us.checked_add(d))
+            .ok_or(RecordError::Invalid(TAG_FRAME))?;
+        // The fixed part taken at once: one length check for the
+        // frame, not one per field (the host decodes millions).
+        let b: [u8; FRAME_FIXED_LEN] = r.take()?;
+        let word = |i: usize| [b[2 * i], b[2 * i + 1]];
+        let int = |i: usize| i16::from_le_bytes(word(i));
+        let frame = Frame {
+            t_us,
+            accel: [int(0), int(1), int(2)],
+            gyro: [int(3), int(4), int(5)],
+            steer_cdeg: int(6),
+            wheel_count: u16::from_le_bytes(word(7)),
+            wheel_edge_age_us: u16::from_le_bytes(word(8)),
+            speed_mm_s: u16::from_le_bytes(word(9)),
+            status: FrameStatus(b[20]),
+        };
+        self.cursor_us = t_us;
+        Ok(frame)
+    }
+
     fn fixed_record(&mut self, tag: u8, r: &mut Reader<'a>) -> Result<Record<'a>, RecordError> {
         Ok(match tag {
-            TAG_FRAME => {
-                let t_us = varint::unzigzag(r.uvar()?)
-                    .checked_add(FRAME_PERIOD_US)
-                    .and_then(|d| u64::try_from(d).ok())
-                    .and_then(|d| self.cursor_us.checked_add(d))
-                    .ok_or(RecordError::Invalid(tag))?;
-                // The fixed part taken at once: one length check for the
-                // frame, not one per field (the host decodes millions).
-                let b: [u8; FRAME_FIXED_LEN] = r.take()?;
-                let word = |i: usize| [b[2 * i], b[2 * i + 1]];
-                let int = |i: usize| i16::from_le_bytes(word(i));
-                let frame = Frame {
-                    t_us,
-                    accel: [int(0), int(1), int(2)],
-                    gyro: [int(3), int(4), int(5)],
-                    steer_cdeg: int(6),
-                    wheel_count: u16::from_le_bytes(word(7)),
-                    wheel_edge_age_us: u16::from_le_bytes(word(8)),
-                    speed_mm_s: u16::from_le_bytes(word(9)),
-                    status: FrameStatus(b[20]),
-                };
-                self.cursor_us = t_us;
-                Record::Frame(frame)
-            }
+            TAG_FRAME => Record::Frame(self.frame(r)?),
             TAG_GPS => Record::Gps(self.gps(r)?),
             TAG_UTC_SYNC => {
                 let t_us = self.signed_time(r, tag)?;
@@ -629,11 +636,27 @@ impl<'a> Records<'a> {
 impl<'a> Iterator for Records<'a> {
     type Item = Result<Record<'a>, RecordError>;
 
+    // Inlined into the decoder's loop, a frame needs no record built and
+    // taken apart again.
+    #[inline]
     fn next(&mut self) -> Option<Self::Item> {
         if self.failed {
             return None;
         }
-        match self.next_record() {
+        let next = if self.payload.get(self.pos) == Some(&TAG_FRAME) {
+            // Nearly every record is a frame: read without the dispatch.
+            let mut r = Reader {
+                bytes: self.payload,
+                pos: self.pos + 1,
+            };
+            self.frame(&mut r).map(|frame| {
+                self.pos = r.pos;
+                Some(Record::Frame(frame))
+            })
+        } else {
+            self.next_record()
+        };
+        match next {
             Ok(rec) => rec.map(Ok),
             Err(e) => {
                 self.failed = true;

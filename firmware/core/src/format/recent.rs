@@ -65,6 +65,9 @@ pub struct Recent {
     len: usize,
     /// The entry the next new block replaces once all are in use.
     next: usize,
+    /// The highest sequence number among the entries: a block numbered
+    /// above it (each block of a log read in order) matches none.
+    highest: Option<u32>,
 }
 
 impl Default for Recent {
@@ -73,6 +76,7 @@ impl Default for Recent {
             entries: [Entry::EMPTY; RECENT_BLOCKS],
             len: 0,
             next: 0,
+            highest: None,
         }
     }
 }
@@ -82,7 +86,13 @@ impl Recent {
     /// decoded, and remembers it (a fuller version replaces the shorter).
     pub fn see(&mut self, header: &BlockHeader, payload: &[u8]) -> Seen {
         let mut fuller: Option<usize> = None;
-        for (i, e) in self.entries[..self.len].iter().enumerate() {
+        let known = self.highest.is_some_and(|seq| header.seq <= seq);
+        let candidates = if known {
+            &self.entries[..self.len]
+        } else {
+            &[]
+        };
+        for (i, e) in candidates.iter().enumerate() {
             if !e.same_block(header) {
                 continue;
             }
@@ -109,6 +119,7 @@ impl Recent {
         let seen = fuller.map_or(Seen::New, |i| Seen::Fuller {
             decoded_len: self.entries[i].len,
         });
+        self.highest = self.highest.max(Some(header.seq));
         let e = &mut self.entries[slot];
         e.seq = header.seq;
         e.first_frame = header.first_frame;
