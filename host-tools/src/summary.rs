@@ -233,7 +233,7 @@ impl FrameTimes {
 /// What the summary takes from the decoded rows: GPS coverage and the UTC
 /// span. Given every row of the log in order (whatever part of it an
 /// output keeps).
-#[derive(Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct RowStats {
     pub(crate) with_gps: u64,
     /// The `utc` of the first and last row that has one, µs since 1970.
@@ -244,8 +244,14 @@ pub struct RowStats {
 impl RowStats {
     /// Takes the log's next row.
     pub fn take(&mut self, row: &Row) {
-        self.with_gps += u64::from(row.gps.is_some());
-        if let Some(us) = row.utc_us {
+        self.take_parts(row.gps.is_some(), row.utc_us);
+    }
+
+    /// Takes the log's next row, given whether it has GPS columns and its
+    /// UTC.
+    pub(crate) fn take_parts(&mut self, has_gps: bool, utc_us: Option<i64>) {
+        self.with_gps += u64::from(has_gps);
+        if let Some(us) = utc_us {
             self.first_utc_us.get_or_insert(us);
             self.last_utc_us = Some(us);
         }

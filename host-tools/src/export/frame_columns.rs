@@ -72,13 +72,14 @@ impl FrameColumns {
         self.len() == 0
     }
 
-    /// First and last boot time of the rows, s.
+    /// Earliest and latest boot time of the complete rows (every row once
+    /// [`Self::finish`]ed), s.
     #[must_use]
     pub fn span_s(&self) -> Option<(f64, f64)> {
         self.columns.span_s()
     }
 
-    /// What a summary takes from the rows.
+    /// What a summary takes from the complete rows.
     #[must_use]
     pub fn row_stats(&self) -> RowStats {
         self.columns.row_stats()
@@ -112,6 +113,11 @@ struct Counts {
     fixes: Vec<GpsColumns>,
     /// The first row still waiting for a late fix or pair.
     first_pending: usize,
+    /// Of the complete rows: the earliest and latest frame time, µs, and
+    /// what a summary takes from them (kept as they complete: a pass over
+    /// a long log's rows afterwards costs more than the rows).
+    span_us: Option<(u64, u64)>,
+    stats: RowStats,
 }
 
 /// A row: its frame, its GPS columns in [`Counts::fixes`] (or
@@ -129,17 +135,12 @@ impl Counts {
     }
 
     fn span_s(&self) -> Option<(f64, f64)> {
-        let times = || self.rows.iter().map(|r| r.frame.t_us);
-        Some((rows::seconds(times().min()?), rows::seconds(times().max()?)))
+        let (first, last) = self.span_us?;
+        Some((rows::seconds(first), rows::seconds(last)))
     }
 
     fn row_stats(&self) -> RowStats {
-        let utc = || self.rows.iter().filter_map(|r| r.utc_us);
-        RowStats {
-            with_gps: self.rows.iter().filter(|r| r.gps != NO_FIX).count() as u64,
-            first_utc_us: utc().next(),
-            last_utc_us: utc().next_back(),
-        }
+        self.stats.clone()
     }
 
     fn retain(&mut self, window: &TimeWindow) {
@@ -227,6 +228,12 @@ impl PendingRows for Counts {
     }
 
     fn complete_first(&mut self) {
+        let Some(row) = self.rows.get(self.first_pending) else {
+            return;
+        };
+        let t = row.frame.t_us;
+        self.span_us = Some(self.span_us.map_or((t, t), |(a, b)| (a.min(t), b.max(t))));
+        self.stats.take_parts(row.gps != NO_FIX, row.utc_us);
         self.first_pending += 1;
     }
 }
