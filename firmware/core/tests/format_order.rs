@@ -200,3 +200,71 @@ fn a_copy_is_skipped_and_counted_once_whatever_its_place() {
     assert_eq!(stats.repeated_blocks, 2);
     assert_eq!(stats.bytes_skipped, 2 * BLOCK_LEN as u64);
 }
+
+/// Whether a decoder that walked `file` (by `feed`, or by `scan` in
+/// chunks) says its valid blocks were in sequence order.
+fn walked_in_order(file: &[u8]) -> (bool, bool) {
+    let mut fed = Decoder::new();
+    fed.feed(file, true, &mut |_| {});
+    // A scan in chunks, what it leaves of one passed again with the next.
+    let mut scanned = Decoder::new();
+    let mut rest = file;
+    while !rest.is_empty() {
+        let take = rest.len().min(3 * BLOCK_LEN + 100);
+        let used = scanned.scan(
+            &rest[..take],
+            take == rest.len(),
+            &mut |_| {},
+            &mut |_, _| {},
+        );
+        assert!(used > 0, "three blocks make progress");
+        rest = &rest[used..];
+    }
+    (fed.in_sequence_order(), scanned.in_sequence_order())
+}
+
+#[test]
+fn the_decoder_says_whether_the_blocks_it_walked_were_in_order() {
+    let blocks = ride(400);
+    assert!(blocks.len() >= 4);
+    let file = |order: &[usize]| -> Vec<u8> {
+        order
+            .iter()
+            .flat_map(|&i| blocks[i].iter().copied())
+            .collect()
+    };
+    let n = blocks.len();
+    let in_order: Vec<usize> = (0..n).collect();
+    // A gap (a block lost) and garbage between blocks leave the order.
+    let with_gap: Vec<usize> = (0..n).filter(|&i| i != 2).collect();
+    let mut damaged = file(&in_order);
+    damaged.splice(BLOCK_LEN..BLOCK_LEN, [0x5a; 300]);
+    assert_eq!(walked_in_order(&file(&in_order)), (true, true));
+    assert_eq!(walked_in_order(&file(&with_gap)), (true, true));
+    assert_eq!(walked_in_order(&damaged), (true, true));
+    // Two neighbours swapped, a copy, the last block first: not in order.
+    let mut swapped = in_order.clone();
+    swapped.swap(1, 2);
+    let copied: Vec<usize> = (0..n).chain([n - 1]).collect();
+    let last_first: Vec<usize> = std::iter::once(n - 1).chain(0..n - 1).collect();
+    for order in [swapped, copied, last_first] {
+        assert_eq!(walked_in_order(&file(&order)), (false, false), "{order:?}");
+    }
+}
+
+#[test]
+fn a_frame_takes_at_least_its_stated_fewest_bytes() {
+    use wobble_core::format::codec::{encode, FRAME_MIN_LEN};
+    let cursor_us = 1_000_000;
+    for step_us in [0u64, 10_000, 10_050, 9_950, 700_000, 3_000_000_000] {
+        let mut out = [0u8; 64];
+        let len = encode(&frame(cursor_us + step_us), cursor_us, &mut out)
+            .unwrap()
+            .unwrap();
+        assert!(len >= FRAME_MIN_LEN, "{step_us}: {len}");
+        // At the nominal period the step is stored in one byte.
+        if step_us == 10_000 {
+            assert_eq!(len, FRAME_MIN_LEN);
+        }
+    }
+}
