@@ -332,14 +332,30 @@ mod tests {
                 stats.take(row);
                 rows.push(*row);
             };
-            let mut columns = FrameColumns::new();
-            for record in &records {
+            let mut columns = FrameColumns::with_room(records.len() / 2);
+            // What the complete rows hold half way through the records.
+            let mut half_way = None;
+            for (k, record) in records.iter().enumerate() {
                 assembler.push(record, &mut keep);
                 columns.push(record);
+                if k == records.len() / 2 {
+                    let complete = columns.complete();
+                    let values: Vec<Values> =
+                        COLUMNS.iter().map(|c| columns.values(c, 0..complete).unwrap()).collect();
+                    half_way = Some((complete, values));
+                }
             }
             assembler.finish(&mut keep);
             columns.finish();
             prop_assert_eq!(columns.len(), rows.len());
+            prop_assert!(!columns.is_empty());
+            prop_assert_eq!(columns.complete(), rows.len());
+            // Complete rows do not change.
+            if let Some((complete, values)) = half_way {
+                for (column, before) in COLUMNS.iter().zip(values) {
+                    prop_assert_eq!(&before, &columns.values(column, 0..complete).unwrap());
+                }
+            }
             for column in &COLUMNS {
                 let expected: Vec<Value> = rows.iter().map(|r| (column.value)(r)).collect();
                 let split = rows.len() / 3;
@@ -365,10 +381,28 @@ mod tests {
                 .collect();
             columns.retain(&window);
             prop_assert_eq!(columns.len(), inside.len());
+            prop_assert_eq!(columns.is_empty(), inside.is_empty());
             let t = cells(columns.values(&COLUMNS[0], 0..inside.len()).unwrap());
             let utc = cells(columns.values(&COLUMNS[13], 0..inside.len()).unwrap());
             prop_assert_eq!(t, inside.iter().map(|r| Value::Number(Some(r.t_s))).collect::<Vec<_>>());
             prop_assert_eq!(utc, inside.iter().map(|r| Value::Utc(r.utc_us)).collect::<Vec<_>>());
         }
+    }
+
+    #[test]
+    fn rows_are_complete_once_half_a_second_older_than_the_last_frame() {
+        let mut columns = FrameColumns::new();
+        for i in 0..200u64 {
+            columns.push(&Record::Frame(Frame {
+                t_us: i * 10_000,
+                ..Frame::default()
+            }));
+        }
+        // The last frame at 1.99 s: rows up to 1.48 s wait no longer.
+        assert_eq!(columns.complete(), 149);
+        let mut nothing = FrameColumns::new();
+        nothing.finish();
+        assert!(nothing.is_empty());
+        assert_eq!(nothing.span_s(), None);
     }
 }

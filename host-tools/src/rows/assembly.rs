@@ -131,3 +131,154 @@ fn utc_us_at(sync: UtcSync, t_us: u64) -> Option<i64> {
         .checked_mul(1000)?
         .checked_add(offset_us)
 }
+
+#[cfg(test)]
+mod tests {
+    //! The rules by hand: frames every 10 ms, fixes and sync pairs placed
+    //! where a logger writes them (stamped before frames already written).
+    use super::*;
+    use crate::rows::{Row, RowAssembler};
+    use wobble_core::format::{FixMode, GpsFix};
+
+    fn frame(ms: u64) -> Record<'static> {
+        Record::Frame(Frame {
+            t_us: ms * 1000,
+            ..Frame::default()
+        })
+    }
+
+    /// A fix stamped at `ms` at latitude `lat` degrees (none: no position).
+    fn fix(ms: u64, lat: Option<i32>) -> Record<'static> {
+        Record::Gps(GpsFix {
+            t_us: ms * 1000,
+            lat_e7: lat.map(|d| d * 10_000_000),
+            lon_e7: Some(0),
+            fix: FixMode::Fix3d,
+            ..GpsFix::default()
+        })
+    }
+
+    fn sync(ms: u64, unix_ms: u64) -> Record<'static> {
+        Record::UtcSync(UtcSync {
+            t_us: ms * 1000,
+            unix_ms,
+        })
+    }
+
+    /// The rows of `records`: (ms since boot, latitude, UTC in ms).
+    fn rows_of(records: &[Record<'static>]) -> Vec<(u64, Option<f64>, Option<i64>)> {
+        let mut out = Vec::new();
+        let mut keep = |r: &Row| {
+            out.push((
+                (r.t_s * 1000.0).round() as u64,
+                r.gps.map(|g| g.lat_deg),
+                r.utc_us.map(|u| u / 1000),
+            ));
+        };
+        let mut assembler = RowAssembler::new();
+        for r in records {
+            assembler.push(r, &mut keep);
+        }
+        assembler.finish(&mut keep);
+        out
+    }
+
+    fn frames(from_ms: u64, to_ms: u64) -> impl Iterator<Item = Record<'static>> {
+        (from_ms..=to_ms).step_by(10).map(frame)
+    }
+
+    #[test]
+    fn a_late_fix_fills_the_rows_from_its_stamp_for_a_second() {
+        // Stamped at 50 ms, written after the frame of 200 ms.
+        let mut records: Vec<_> = frames(0, 200).collect();
+        records.push(fix(50, Some(45)));
+        records.extend(frames(210, 1200));
+        for (t, lat, _) in rows_of(&records) {
+            // From 50 ms to 1.05 s (a second old at most), not before, not after.
+            let expected = (50..=1050).contains(&t).then_some(45.0);
+            assert_eq!(lat, expected, "row at {t} ms");
+        }
+    }
+
+    #[test]
+    fn rows_half_a_second_old_are_complete_before_a_later_fix() {
+        // Stamped at 100 ms but written after the frame of 700 ms: the
+        // rows before 200 ms waited 0.5 s and were complete.
+        let mut records: Vec<_> = frames(0, 700).collect();
+        records.push(fix(100, Some(45)));
+        let filled: Vec<u64> = rows_of(&records)
+            .into_iter()
+            .filter_map(|(t, lat, _)| lat.map(|_| t))
+            .collect();
+        assert_eq!(filled.first(), Some(&200));
+        assert_eq!(filled.last(), Some(&700));
+    }
+
+    #[test]
+    fn an_older_fix_read_later_and_a_fix_without_position_change_nothing_or_stop_it() {
+        let mut records: Vec<_> = frames(0, 100).collect();
+        records.push(fix(100, Some(45)));
+        records.extend(frames(110, 300));
+        // Older than the fix in force: ignored.
+        records.push(fix(90, Some(10)));
+        records.extend(frames(310, 400));
+        // No position from 400 ms on.
+        records.push(fix(400, None));
+        records.extend(frames(410, 500));
+        for (t, lat, _) in rows_of(&records) {
+            let expected = (100..400).contains(&t).then_some(45.0);
+            assert_eq!(lat, expected, "row at {t} ms");
+        }
+    }
+
+    #[test]
+    fn time_going_back_leaves_the_fix_behind() {
+        let mut records: Vec<_> = frames(1000, 1100).collect();
+        records.push(fix(1000, Some(45)));
+        // A new segment from 0 (a restarted clock): the fix of 1 s is
+        // not in force there, though within a second of its rows.
+        records.extend(frames(0, 100));
+        let rows = rows_of(&records);
+        assert!(rows[..11].iter().all(|r| r.1 == Some(45.0)));
+        assert!(rows[11..].iter().all(|r| r.1.is_none()));
+        assert_eq!(rows[11].0, 0);
+    }
+
+    #[test]
+    fn time_going_back_even_a_little_starts_afresh_and_a_repeated_time_does_not() {
+        // Back from 600 to 550 ms: the fix of 500 ms, though older than
+        // the new rows, fills none of them.
+        let mut records: Vec<_> = frames(500, 600).collect();
+        records.push(fix(500, Some(45)));
+        records.extend(frames(550, 650));
+        let rows = rows_of(&records);
+        assert_eq!(rows.len(), 22);
+        assert!(rows[..11].iter().all(|r| r.1 == Some(45.0)));
+        assert!(rows[11..].iter().all(|r| r.1.is_none()));
+        // A frame at the time of the one before is no step back.
+        let mut records: Vec<_> = frames(0, 100).collect();
+        records.push(fix(0, Some(45)));
+        records.extend([frame(100), frame(110)]);
+        assert!(rows_of(&records).iter().all(|r| r.1 == Some(45.0)));
+    }
+
+    #[test]
+    fn utc_runs_from_the_latest_pair_at_or_before_each_row() {
+        let mut records: Vec<_> = frames(0, 300).collect();
+        // Stamped at 150 ms, written after the frame of 300 ms.
+        records.push(sync(150, 1_700_000_000_000));
+        records.extend(frames(310, 600));
+        // An older pair read later changes nothing; a newer one rules
+        // from its stamp on.
+        records.push(sync(100, 1_600_000_000_000));
+        records.push(sync(500, 1_700_000_001_000));
+        for (t, _, utc) in rows_of(&records) {
+            let expected = match t {
+                0..150 => None,
+                150..500 => Some(1_700_000_000_000 + (t as i64 - 150)),
+                _ => Some(1_700_000_001_000 + (t as i64 - 500)),
+            };
+            assert_eq!(utc, expected, "row at {t} ms");
+        }
+    }
+}
