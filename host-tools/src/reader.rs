@@ -92,7 +92,8 @@ pub fn read_log_until(
 /// `restart` is called and the log is decoded again as
 /// [`read_log_until`] decodes it: `visit` gets that decode's events from
 /// its start. Either way `visit` ends up with the events
-/// [`read_log_until`] gives.
+/// [`read_log_until`] gives. A `visit` that breaks ends the reading, as
+/// there; the log is not read again.
 ///
 /// # Errors
 /// As [`read_log_until`].
@@ -102,9 +103,16 @@ pub fn read_log_restarting(
     restart: impl FnOnce(),
 ) -> Result<DecodeStats, CliError> {
     let (mut file, len) = crate::spool::open_seekable(path)?;
+    let mut stopped = false;
+    let mut watched = |event: Event<'_>| {
+        let flow = visit(event);
+        stopped |= flow.is_break();
+        flow
+    };
     let decoder =
-        stream(&mut file, len, CHUNK_LEN, &mut visit).map_err(|e| CliError::file(path, e))?;
-    if decoder.in_sequence_order() && decoder.stats().blocks > 0 {
+        stream(&mut file, len, CHUNK_LEN, &mut watched).map_err(|e| CliError::file(path, e))?;
+    // A visitor that stopped the pass (Ctrl-C) wants no second one.
+    if stopped || (decoder.in_sequence_order() && decoder.stats().blocks > 0) {
         return Ok(*decoder.stats());
     }
     restart();
@@ -536,6 +544,15 @@ pub(crate) mod tests {
             let stats = read_log(path, |e| expected.push(format!("{e:?}"))).unwrap();
             assert_eq!(restarting(path), (expected, stats, restarts), "{what}");
         }
+        // A visitor that stops is not made to start again.
+        let mut restarted = false;
+        read_log_restarting(
+            swapped.path(),
+            |_| ControlFlow::Break(()),
+            || restarted = true,
+        )
+        .unwrap();
+        assert!(!restarted);
         // No valid block: the usual error.
         let empty = tempfile::NamedTempFile::new().unwrap();
         let e = read_log_restarting(empty.path(), |_| ControlFlow::Continue(()), || {});
