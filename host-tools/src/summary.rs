@@ -287,7 +287,8 @@ impl SummaryBuilder {
             return;
         };
         let s = &mut self.summary;
-        let t_s = record.t_us() as f64 / 1e6;
+        // Not for frames, nearly every record, which keep integer times.
+        let t_s = || record.t_us() as f64 / 1e6;
         self.kinds[kind_index(record)] += 1;
         match record {
             Record::Frame(f) => {
@@ -300,21 +301,21 @@ impl SummaryBuilder {
             Record::Gps(_) => s.gps_fixes += 1,
             Record::UtcSync(sync) => {
                 if let Ok(ms) = i64::try_from(sync.unix_ms) {
-                    s.utc_syncs.push((t_s, ms));
+                    s.utc_syncs.push((t_s(), ms));
                 }
             }
             Record::Alert(a) if a.on => s.alerts.push(AlertSpan {
-                on_s: t_s,
+                on_s: t_s(),
                 off_s: None,
                 freq_hz: f32::from(a.freq_chz) / 100.0,
                 amp_deg: f32::from(a.amp_cdeg) / 100.0,
             }),
             Record::Alert(_) => {
                 if let Some(open) = s.alerts.last_mut().filter(|a| a.off_s.is_none()) {
-                    open.off_s = Some(t_s);
+                    open.off_s = Some(t_s());
                 }
             }
-            Record::Marker(_) => s.markers.push(t_s),
+            Record::Marker(_) => s.markers.push(t_s()),
             Record::Dropout(d) => {
                 *s.dropouts.entry(d.reason.as_str()).or_default() += 1;
                 s.frames_dropped += u64::from(d.frames_lost);

@@ -12,8 +12,7 @@ use wobblog::export::columns::Column;
 use wobblog::export::frame_columns::FrameColumns;
 use wobblog::losses::Losses;
 use wobblog::reader::read_log_restarting;
-use wobblog::summary::RowStats;
-use wobblog::summary::SummaryBuilder;
+use wobblog::summary::{RowStats, SummaryBuilder};
 use wobblog::time::TimeWindow;
 use wobblog::CliError;
 

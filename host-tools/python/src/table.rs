@@ -182,13 +182,9 @@ impl<R: 'static> TableBuilder<R> {
     /// A table of `columns`.
     #[must_use]
     pub fn new(columns: &[Column<R>]) -> Self {
-        Self::with_buffers(schema(columns), buffers(columns, BATCH_ROWS))
-    }
-
-    fn with_buffers(schema: SchemaRef, buffers: Box<dyn ColumnBuffers<R>>) -> Self {
         Self {
-            schema,
-            buffers,
+            schema: schema(columns),
+            buffers: buffers(columns, BATCH_ROWS),
             batches: Vec::new(),
         }
     }

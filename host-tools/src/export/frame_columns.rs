@@ -1,6 +1,7 @@
-//! Decoded frames kept as columns from the start: each frame's counts go
-//! into a vector per channel as the frame comes, and are converted to
-//! physical units a whole column at a time once the log is read. Which
+//! Decoded frames kept for columns from the start: each frame is stored
+//! once as it comes (its counts, its fix, its UTC), and any range of rows
+//! is converted to physical units a column at a time, as soon as those
+//! rows are complete (no fix or UTC pair read later changes them). Which
 //! fix and UTC fill a row is decided by the same [`Assembly`] that builds
 //! [`Row`]s, and the units by the same functions, so the columns hold the
 //! values `wobblog decode` writes (a test holds them to its rows); only no

@@ -45,8 +45,9 @@ pub struct Assembly {
     /// Rows pending (their times never decrease: time going back
     /// completes them all).
     pending: usize,
-    /// The fix in force and its time.
-    gps: Option<(u64, GpsColumns)>,
+    /// The time of the fix in force (its columns are the rows' holder's:
+    /// [`PendingRows::fix`]).
+    gps_us: Option<u64>,
     sync: Option<UtcSync>,
 }
 
@@ -58,9 +59,9 @@ impl Assembly {
             Record::Frame(frame) => self.frame(frame, rows),
             Record::Gps(fix) => {
                 let columns = GpsColumns::from_fix(fix);
-                let newer = self.gps.is_none_or(|(t, _)| fix.t_us >= t);
+                let newer = self.gps_us.is_none_or(|t| fix.t_us >= t);
                 if newer {
-                    self.gps = columns.map(|c| (fix.t_us, c));
+                    self.gps_us = columns.map(|_| fix.t_us);
                     if let Some(c) = columns {
                         rows.fix(c);
                     }
@@ -91,14 +92,14 @@ impl Assembly {
         // and a fix from before it fills no row after it.
         if self.pending > 0 && frame.t_us < rows.time_us(self.pending - 1) {
             self.finish(rows);
-            self.gps = None;
+            self.gps_us = None;
         }
         if self.pending >= MAX_PENDING_ROWS {
             self.complete_first(rows);
         }
         let gps = self
-            .gps
-            .is_some_and(|(t, _)| t <= frame.t_us && frame.t_us - t <= GPS_STALE_US);
+            .gps_us
+            .is_some_and(|t| t <= frame.t_us && frame.t_us - t <= GPS_STALE_US);
         let utc_us = self
             .sync
             .filter(|s| s.t_us <= frame.t_us)
@@ -231,14 +232,21 @@ mod tests {
         }
     }
 
+    /// The rows of frames `first` (ms), a fix stamped at their start read
+    /// after them, then frames `then`, whose start is earlier than the end
+    /// of `first`.
+    fn fix_then_back(first: (u64, u64), then: (u64, u64)) -> Vec<(u64, Option<f64>, Option<i64>)> {
+        let mut records: Vec<_> = frames(first.0, first.1).collect();
+        records.push(fix(first.0, Some(45)));
+        records.extend(frames(then.0, then.1));
+        rows_of(&records)
+    }
+
     #[test]
     fn time_going_back_leaves_the_fix_behind() {
-        let mut records: Vec<_> = frames(1000, 1100).collect();
-        records.push(fix(1000, Some(45)));
         // A new segment from 0 (a restarted clock): the fix of 1 s is
         // not in force there, though within a second of its rows.
-        records.extend(frames(0, 100));
-        let rows = rows_of(&records);
+        let rows = fix_then_back((1000, 1100), (0, 100));
         assert!(rows[..11].iter().all(|r| r.1 == Some(45.0)));
         assert!(rows[11..].iter().all(|r| r.1.is_none()));
         assert_eq!(rows[11].0, 0);
@@ -248,10 +256,7 @@ mod tests {
     fn time_going_back_even_a_little_starts_afresh_and_a_repeated_time_does_not() {
         // Back from 600 to 550 ms: the fix of 500 ms, though older than
         // the new rows, fills none of them.
-        let mut records: Vec<_> = frames(500, 600).collect();
-        records.push(fix(500, Some(45)));
-        records.extend(frames(550, 650));
-        let rows = rows_of(&records);
+        let rows = fix_then_back((500, 600), (550, 650));
         assert_eq!(rows.len(), 22);
         assert!(rows[..11].iter().all(|r| r.1 == Some(45.0)));
         assert!(rows[11..].iter().all(|r| r.1.is_none()));

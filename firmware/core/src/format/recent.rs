@@ -65,8 +65,9 @@ pub struct Recent {
     len: usize,
     /// The entry the next new block replaces once all are in use.
     next: usize,
-    /// The highest sequence number among the entries: a block numbered
-    /// above it (each block of a log read in order) matches none.
+    /// The highest sequence number of any block remembered so far (ones
+    /// since replaced too): a block numbered above it (each block of a log
+    /// read in order) matches no entry.
     highest: Option<u32>,
 }
 
