@@ -109,12 +109,12 @@ impl<'c> FrameBatches<'c> {
 
     fn batch(&self, frames: &FrameColumns, start: usize) -> Result<RecordBatch, ArrowError> {
         let range = start..frames.len().min(start + BATCH_ROWS);
-        let arrays = self
-            .columns
-            .iter()
-            .map(|c| frames.values(c, range.clone()).map(array))
-            .collect::<Result<Vec<_>, _>>()
-            .map_err(ArrowError::InvalidArgumentError)?;
+        let arrays = frames
+            .values(self.columns, range)
+            .map_err(ArrowError::InvalidArgumentError)?
+            .into_iter()
+            .map(array)
+            .collect();
         RecordBatch::try_new(self.schema.clone(), arrays)
     }
 

@@ -9,7 +9,7 @@
 //! through its columns' value functions ([`ValueColumns`]).
 
 use super::columns::{Column, Kind, Value, COLUMNS, RUN_COLUMN};
-use crate::rows::Row;
+use crate::rows::{GpsColumns, Row};
 
 /// One column's values for a batch of rows: a slot per row (absent values
 /// hold a default, `0.0` or `0`, so numbers are laid out as Arrow lays them
@@ -326,36 +326,112 @@ impl RowColumns {
     }
 }
 
+/// A frame's row as the frame columns read it: a [`Row`], or a frame kept
+/// as counts with what fills it (`super::frame_columns`), converted as it
+/// is read.
+pub(crate) trait FrameFields {
+    fn t_s(&self) -> f64;
+    fn accel_g(&self, axis: usize) -> f64;
+    fn gyro_dps(&self, axis: usize) -> f64;
+    fn steer_deg(&self) -> f64;
+    fn speed_mps(&self) -> f64;
+    fn gps(&self) -> Option<&GpsColumns>;
+    fn utc_us(&self) -> Option<i64>;
+    fn run(&self) -> Option<u32>;
+}
+
+impl FrameFields for &Row {
+    fn t_s(&self) -> f64 {
+        self.t_s
+    }
+    fn accel_g(&self, axis: usize) -> f64 {
+        self.accel_g[axis]
+    }
+    fn gyro_dps(&self, axis: usize) -> f64 {
+        self.gyro_dps[axis]
+    }
+    fn steer_deg(&self) -> f64 {
+        self.steer_deg
+    }
+    fn speed_mps(&self) -> f64 {
+        self.speed_mps
+    }
+    fn gps(&self) -> Option<&GpsColumns> {
+        self.gps.as_ref()
+    }
+    fn utc_us(&self) -> Option<i64> {
+        self.utc_us
+    }
+    fn run(&self) -> Option<u32> {
+        self.run
+    }
+}
+
 impl RowColumns {
     /// Stores the staged rows in the columns.
     fn store_staged(&mut self) {
-        let rows = &self.staged;
-        let gps_speed = |r: &Row| r.gps.and_then(|g| g.speed_mps);
-        self.t_s.extend(rows.iter().map(|r| r.t_s));
+        let staged = std::mem::take(&mut self.staged);
+        self.store(staged.iter());
+        self.staged = staged;
+        self.staged.clear();
+    }
+
+    /// Stores `rows` (a few hundred: they are read once per column, so
+    /// they should sit in the nearest cache) in the columns.
+    pub(crate) fn store<R: FrameFields>(&mut self, rows: impl Iterator<Item = R> + Clone) {
+        let gps_speed = |r: &R| r.gps().and_then(|g| g.speed_mps);
+        self.t_s.extend(rows.clone().map(|r| r.t_s()));
         for (i, v) in self.accel_g.iter_mut().enumerate() {
-            v.extend(rows.iter().map(|r| r.accel_g[i]));
+            v.extend(rows.clone().map(|r| r.accel_g(i)));
         }
         for (i, v) in self.gyro_dps.iter_mut().enumerate() {
-            v.extend(rows.iter().map(|r| r.gyro_dps[i]));
+            v.extend(rows.clone().map(|r| r.gyro_dps(i)));
         }
-        self.steer_deg.extend(rows.iter().map(|r| r.steer_deg));
-        self.speed_mps.extend(rows.iter().map(|r| r.speed_mps));
+        self.steer_deg.extend(rows.clone().map(|r| r.steer_deg()));
+        self.speed_mps.extend(rows.clone().map(|r| r.speed_mps()));
         let [lat, lon, speed] = &mut self.gps;
-        lat.extend(rows.iter().map(|r| r.gps.map_or(0.0, |g| g.lat_deg)));
-        lon.extend(rows.iter().map(|r| r.gps.map_or(0.0, |g| g.lon_deg)));
-        speed.extend(rows.iter().map(|r| gps_speed(r).unwrap_or_default()));
-        self.has_gps.extend(rows.iter().map(|r| r.gps.is_some()));
+        lat.extend(rows.clone().map(|r| r.gps().map_or(0.0, |g| g.lat_deg)));
+        lon.extend(rows.clone().map(|r| r.gps().map_or(0.0, |g| g.lon_deg)));
+        speed.extend(rows.clone().map(|r| gps_speed(&r).unwrap_or_default()));
+        self.has_gps.extend(rows.clone().map(|r| r.gps().is_some()));
         self.has_gps_speed
-            .extend(rows.iter().map(|r| gps_speed(r).is_some()));
+            .extend(rows.clone().map(|r| gps_speed(&r).is_some()));
         self.gps_fix
-            .extend(rows.iter().map(|r| r.gps.map(|g| g.fix.as_str())));
+            .extend(rows.clone().map(|r| r.gps().map(|g| g.fix.as_str())));
         self.utc_us
-            .extend(rows.iter().map(|r| r.utc_us.unwrap_or_default()));
-        self.has_utc.extend(rows.iter().map(|r| r.utc_us.is_some()));
+            .extend(rows.clone().map(|r| r.utc_us().unwrap_or_default()));
+        self.has_utc
+            .extend(rows.clone().map(|r| r.utc_us().is_some()));
         self.run
-            .extend(rows.iter().map(|r| r.run.map_or(0, i64::from)));
-        self.has_run.extend(rows.iter().map(|r| r.run.is_some()));
-        self.staged.clear();
+            .extend(rows.clone().map(|r| r.run().map_or(0, i64::from)));
+        self.has_run.extend(rows.map(|r| r.run().is_some()));
+    }
+
+    /// The chosen columns' values, the buffers left empty.
+    pub(crate) fn into_values(mut self) -> Vec<Values> {
+        self.take_chosen()
+    }
+
+    fn take_chosen(&mut self) -> Vec<Values> {
+        use std::mem::take;
+        self.store_staged();
+        let [lat, lon, speed] = &mut self.gps;
+        self.fields
+            .iter()
+            .map(|field| match *field {
+                Field::T => Values::Number(take(&mut self.t_s)),
+                Field::Accel(i) => Values::Number(take(&mut self.accel_g[i])),
+                Field::Gyro(i) => Values::Number(take(&mut self.gyro_dps[i])),
+                Field::Steer => Values::Number(take(&mut self.steer_deg)),
+                Field::Speed => Values::Number(take(&mut self.speed_mps)),
+                Field::GpsLat => Values::OptNumber(take(lat), self.has_gps.clone()),
+                Field::GpsLon => Values::OptNumber(take(lon), self.has_gps.clone()),
+                Field::GpsSpeed => Values::OptNumber(take(speed), take(&mut self.has_gps_speed)),
+                Field::GpsFix => Values::Label(take(&mut self.gps_fix)),
+                Field::Utc => Values::Utc(take(&mut self.utc_us), take(&mut self.has_utc)),
+                Field::Run => Values::Integer(take(&mut self.run), take(&mut self.has_run)),
+            })
+            .collect()
     }
 }
 
@@ -373,26 +449,7 @@ impl ColumnBuffers<Row> for RowColumns {
     }
 
     fn take(&mut self) -> Vec<Values> {
-        use std::mem::take;
-        self.store_staged();
-        let [lat, lon, speed] = &mut self.gps;
-        let chosen = self
-            .fields
-            .iter()
-            .map(|field| match *field {
-                Field::T => Values::Number(take(&mut self.t_s)),
-                Field::Accel(i) => Values::Number(take(&mut self.accel_g[i])),
-                Field::Gyro(i) => Values::Number(take(&mut self.gyro_dps[i])),
-                Field::Steer => Values::Number(take(&mut self.steer_deg)),
-                Field::Speed => Values::Number(take(&mut self.speed_mps)),
-                Field::GpsLat => Values::OptNumber(take(lat), self.has_gps.clone()),
-                Field::GpsLon => Values::OptNumber(take(lon), self.has_gps.clone()),
-                Field::GpsSpeed => Values::OptNumber(take(speed), take(&mut self.has_gps_speed)),
-                Field::GpsFix => Values::Label(take(&mut self.gps_fix)),
-                Field::Utc => Values::Utc(take(&mut self.utc_us), take(&mut self.has_utc)),
-                Field::Run => Values::Integer(take(&mut self.run), take(&mut self.has_run)),
-            })
-            .collect();
+        let chosen = self.take_chosen();
         // What no column took starts the next batch empty too.
         for v in self.numbers() {
             v.clear();
@@ -412,7 +469,6 @@ impl ColumnBuffers<Row> for RowColumns {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::rows::GpsColumns;
     use wobble_core::format::{FixMode, FrameStatus};
 
     fn rows() -> Vec<Row> {

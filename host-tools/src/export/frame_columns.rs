@@ -12,7 +12,7 @@ use std::ops::Range;
 
 use wobble_core::format::{Frame, Record};
 
-use super::columnar::{Field, Values};
+use super::columnar::{Field, FrameFields, RowColumns, Values};
 use super::columns::Column;
 use crate::rows::{self, Assembly, GpsColumns, PendingRows, Row};
 use crate::summary::RowStats;
@@ -20,6 +20,8 @@ use crate::time::TimeWindow;
 
 /// A row without GPS columns, in [`Slot::gps`].
 const NO_FIX: u32 = u32::MAX;
+/// Rows converted a column at a time (14 KiB of them).
+const ROWS_PER_PASS: usize = 256;
 
 /// Frames as columns of counts, filled record by record.
 #[derive(Default)]
@@ -92,16 +94,20 @@ impl FrameColumns {
         self.columns.retain(window);
     }
 
-    /// The values of `column` (one of [`super::columns::COLUMNS`]) in
-    /// `rows`, in physical units.
+    /// The values of `columns` (of [`super::columns::COLUMNS`]) in `rows`,
+    /// in physical units, one entry per column.
     ///
     /// # Errors
-    /// `column` is not one of the frame columns.
+    /// A column is not one of the frame columns.
     ///
     /// # Panics
     /// `rows` reaches past the last row.
-    pub fn values(&self, column: &Column<Row>, rows: Range<usize>) -> Result<Values, String> {
-        self.columns.values(column, rows)
+    pub fn values(
+        &self,
+        columns: &[Column<Row>],
+        rows: Range<usize>,
+    ) -> Result<Vec<Values>, String> {
+        self.columns.values(columns, rows)
     }
 }
 
@@ -150,46 +156,24 @@ impl Counts {
         self.first_pending = self.len();
     }
 
-    fn values(&self, column: &Column<Row>, range: Range<usize>) -> Result<Values, String> {
-        let slots = &self.rows[range];
-        // Generic, not `dyn`: each unit is inlined into its column's loop.
-        fn numbers(slots: &[Slot], unit: impl Fn(&Frame) -> f64) -> Values {
-            Values::Number(slots.iter().map(|r| unit(&r.frame)).collect())
+    fn values(&self, columns: &[Column<Row>], range: Range<usize>) -> Result<Vec<Values>, String> {
+        // Frames belong to no run in particular.
+        let not_frames = |c: &&Column<Row>| matches!(Field::of_column(c), None | Some(Field::Run));
+        let mut out = RowColumns::new(columns, range.len())
+            .filter(|_| !columns.iter().any(|c| not_frames(&c)))
+            .ok_or_else(|| {
+                let name = columns.iter().find(not_frames).map_or("", |c| c.name);
+                format!("{name} is not a column of the frames")
+            })?;
+        // A few hundred rows at a time: they stay in the nearest cache while
+        // each column reads them.
+        for slots in self.rows[range].chunks(ROWS_PER_PASS) {
+            out.store(slots.iter().map(|slot| Fields {
+                slot,
+                fixes: &self.fixes,
+            }));
         }
-        let fix = |r: &Slot| self.fixes.get(r.gps as usize);
-        let gps = |value: fn(&GpsColumns) -> Option<f64>| {
-            let (v, present) = slots
-                .iter()
-                .map(|r| match fix(r).and_then(value) {
-                    Some(v) => (v, true),
-                    None => (0.0, false),
-                })
-                .unzip();
-            Values::OptNumber(v, present)
-        };
-        Ok(match Field::of_column(column) {
-            Some(Field::T) => numbers(slots, |f| rows::seconds(f.t_us)),
-            Some(Field::Accel(i)) => numbers(slots, |f| rows::accel_g(f.accel[i])),
-            Some(Field::Gyro(i)) => numbers(slots, |f| rows::gyro_dps(f.gyro[i])),
-            Some(Field::Steer) => numbers(slots, |f| rows::steer_deg(f.steer_cdeg)),
-            Some(Field::Speed) => numbers(slots, |f| rows::speed_mps(f.speed_mm_s)),
-            Some(Field::GpsLat) => gps(|g| Some(g.lat_deg)),
-            Some(Field::GpsLon) => gps(|g| Some(g.lon_deg)),
-            Some(Field::GpsSpeed) => gps(|g| g.speed_mps),
-            Some(Field::GpsFix) => Values::Label(
-                slots
-                    .iter()
-                    .map(|r| fix(r).map(|f| f.fix.as_str()))
-                    .collect(),
-            ),
-            Some(Field::Utc) => Values::Utc(
-                slots.iter().map(|r| r.utc_us.unwrap_or_default()).collect(),
-                slots.iter().map(|r| r.utc_us.is_some()).collect(),
-            ),
-            Some(Field::Run) | None => {
-                return Err(format!("{} is not a column of the frames", column.name))
-            }
-        })
+        Ok(out.into_values())
     }
 
     /// The index in `fixes` of the fix in force, or [`NO_FIX`].
@@ -199,6 +183,40 @@ impl Counts {
             Some(last) if gps => u32::try_from(last).unwrap_or(NO_FIX),
             _ => NO_FIX,
         }
+    }
+}
+
+/// A row's fields, read from its slot and the fixes.
+#[derive(Clone, Copy)]
+struct Fields<'a> {
+    slot: &'a Slot,
+    fixes: &'a [GpsColumns],
+}
+
+impl FrameFields for Fields<'_> {
+    fn t_s(&self) -> f64 {
+        rows::seconds(self.slot.frame.t_us)
+    }
+    fn accel_g(&self, axis: usize) -> f64 {
+        rows::accel_g(self.slot.frame.accel[axis])
+    }
+    fn gyro_dps(&self, axis: usize) -> f64 {
+        rows::gyro_dps(self.slot.frame.gyro[axis])
+    }
+    fn steer_deg(&self) -> f64 {
+        rows::steer_deg(self.slot.frame.steer_cdeg)
+    }
+    fn speed_mps(&self) -> f64 {
+        rows::speed_mps(self.slot.frame.speed_mm_s)
+    }
+    fn gps(&self) -> Option<&GpsColumns> {
+        self.fixes.get(self.slot.gps as usize)
+    }
+    fn utc_us(&self) -> Option<i64> {
+        self.slot.utc_us
+    }
+    fn run(&self) -> Option<u32> {
+        None
     }
 }
 
@@ -341,8 +359,7 @@ mod tests {
                 columns.push(record);
                 if k == records.len() / 2 {
                     let complete = columns.complete();
-                    let values: Vec<Values> =
-                        COLUMNS.iter().map(|c| columns.values(c, 0..complete).unwrap()).collect();
+                    let values = columns.values(&COLUMNS, 0..complete).unwrap();
                     half_way = Some((complete, values));
                 }
             }
@@ -353,15 +370,15 @@ mod tests {
             prop_assert_eq!(columns.complete(), rows.len());
             // Complete rows do not change.
             if let Some((complete, values)) = half_way {
-                for (column, before) in COLUMNS.iter().zip(values) {
-                    prop_assert_eq!(&before, &columns.values(column, 0..complete).unwrap());
-                }
+                prop_assert_eq!(values, columns.values(&COLUMNS, 0..complete).unwrap());
             }
-            for column in &COLUMNS {
+            let split = rows.len() / 3;
+            let head = columns.values(&COLUMNS, 0..split).unwrap();
+            let tail = columns.values(&COLUMNS, split..rows.len()).unwrap();
+            for ((column, head), tail) in COLUMNS.iter().zip(head).zip(tail) {
                 let expected: Vec<Value> = rows.iter().map(|r| (column.value)(r)).collect();
-                let split = rows.len() / 3;
-                let mut got = cells(columns.values(column, 0..split).unwrap());
-                got.extend(cells(columns.values(column, split..rows.len()).unwrap()));
+                let mut got = cells(head);
+                got.extend(cells(tail));
                 prop_assert_eq!(got, expected, "column {}", column.name);
             }
             prop_assert_eq!(columns.row_stats(), stats);
@@ -383,8 +400,9 @@ mod tests {
             columns.retain(&window);
             prop_assert_eq!(columns.len(), inside.len());
             prop_assert_eq!(columns.is_empty(), inside.is_empty());
-            let t = cells(columns.values(&COLUMNS[0], 0..inside.len()).unwrap());
-            let utc = cells(columns.values(&COLUMNS[13], 0..inside.len()).unwrap());
+            let [t, utc] = [0, 13].map(|c| {
+                cells(columns.values(&COLUMNS[c..=c], 0..inside.len()).unwrap().remove(0))
+            });
             prop_assert_eq!(t, inside.iter().map(|r| Value::Number(Some(r.t_s))).collect::<Vec<_>>());
             prop_assert_eq!(utc, inside.iter().map(|r| Value::Utc(r.utc_us)).collect::<Vec<_>>());
         }

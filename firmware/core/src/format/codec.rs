@@ -392,6 +392,25 @@ impl<'a> Records<'a> {
         self.pos
     }
 
+    /// The next record if it is a frame that reads whole; otherwise
+    /// nothing is read, and [`Iterator::next`] gives the record or its
+    /// error. Nearly every record is a frame: inlined into a caller's loop,
+    /// it is read without the dispatch on the tag and without a record
+    /// built and taken apart again.
+    #[inline(always)]
+    pub fn next_frame(&mut self) -> Option<Frame> {
+        if self.failed || self.payload.get(self.pos) != Some(&TAG_FRAME) {
+            return None;
+        }
+        let mut r = Reader {
+            bytes: self.payload,
+            pos: self.pos + 1,
+        };
+        let frame = self.frame(&mut r).ok()?;
+        self.pos = r.pos;
+        Some(frame)
+    }
+
     /// Length-prefixed records of unknown kinds skipped so far.
     #[must_use]
     pub fn skipped_unknown(&self) -> u32 {
@@ -636,27 +655,15 @@ impl<'a> Records<'a> {
 impl<'a> Iterator for Records<'a> {
     type Item = Result<Record<'a>, RecordError>;
 
-    // Inlined into the decoder's loop, a frame needs no record built and
-    // taken apart again.
     #[inline]
     fn next(&mut self) -> Option<Self::Item> {
+        if let Some(frame) = self.next_frame() {
+            return Some(Ok(Record::Frame(frame)));
+        }
         if self.failed {
             return None;
         }
-        let next = if self.payload.get(self.pos) == Some(&TAG_FRAME) {
-            // Nearly every record is a frame: read without the dispatch.
-            let mut r = Reader {
-                bytes: self.payload,
-                pos: self.pos + 1,
-            };
-            self.frame(&mut r).map(|frame| {
-                self.pos = r.pos;
-                Some(Record::Frame(frame))
-            })
-        } else {
-            self.next_record()
-        };
-        match next {
+        match self.next_record() {
             Ok(rec) => rec.map(Ok),
             Err(e) => {
                 self.failed = true;

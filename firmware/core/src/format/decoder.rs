@@ -21,7 +21,7 @@ use super::codec::{RecordError, Records};
 use super::crc_window::CrcWindow;
 use super::limits::DEFAULT_SAMPLE_RATE_HZ;
 use super::recent::{Recent, Seen};
-use super::record::Record;
+use super::record::{Frame, Record};
 
 /// A forward step between frames longer than the frames known to be
 /// missing explain, by more than this, is a time jump (µs).
@@ -450,20 +450,22 @@ impl Decoder {
         let mut records = Records::new(payload, header.t0_us);
         loop {
             let old = records.offset() < decoded_len;
-            let Some(item) = records.next() else { break };
-            if let Ok(Record::Frame(_)) = item {
+            if let Some(frame) = records.next_frame() {
                 frames += 1;
+                if !old {
+                    self.frame(header.seq, frame, visit);
+                }
+                continue;
             }
+            // Any other record, or a record that cannot be read (frames
+            // that read whole never come here).
+            let Some(item) = records.next() else { break };
             if old {
                 continue;
             }
             match item {
                 Ok(mut record) => {
                     self.stats.records += 1;
-                    if let Record::Frame(f) = &record {
-                        self.stats.frames += 1;
-                        self.check_time(header.seq, f.t_us, visit);
-                    }
                     if !self.check_values(header.seq, &mut record, visit) {
                         continue;
                     }
@@ -491,6 +493,16 @@ impl Decoder {
                 frames_end: header.first_frame.wrapping_add(frames),
             });
         }
+    }
+
+    /// Passes on a new frame of block `seq`, checking its time (a frame
+    /// holds no value the firmware cannot have written).
+    #[inline(always)]
+    fn frame<'c>(&mut self, seq: u32, frame: Frame, visit: &mut impl FnMut(Event<'c>)) {
+        self.stats.records += 1;
+        self.stats.frames += 1;
+        self.check_time(seq, frame.t_us, visit);
+        visit(Event::Record(Record::Frame(frame)));
     }
 
     /// Reports a frame at `t_us` that jumps back, or forward by more than
