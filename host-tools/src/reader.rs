@@ -11,7 +11,7 @@ use wobble_core::format::{Block, DecodeStats, Decoder, Event, Outcome, SkipCause
 use crate::CliError;
 
 /// Bytes read from the file at a time.
-const CHUNK_LEN: usize = 1 << 20;
+const CHUNK_LEN: usize = 1 << 17;
 /// Files larger than this get a progress bar (when stderr is a terminal).
 const PROGRESS_MIN_LEN: u64 = 64 << 20;
 

@@ -2,16 +2,15 @@
 //! shape of `wobblog decode` output and of every analysis.
 
 use crate::export::derived::Derived;
-use std::collections::VecDeque;
 
 use wobble_core::format::{
-    FixMode, Frame, FrameStatus, GpsFix, Record, ACCEL_COUNTS_PER_G, GYRO_COUNTS_PER_DPS,
+    FixMode, FrameStatus, GpsFix, Record, ACCEL_COUNTS_PER_G, GYRO_COUNTS_PER_DPS,
     STEER_COUNTS_PER_DEG,
 };
 
 mod assembly;
 
-pub use assembly::{Assembly, PendingRows, GPS_STALE_US};
+pub use assembly::{Assembly, RowParts, GPS_STALE_US};
 
 /// The GPS columns of a row.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -72,8 +71,8 @@ pub struct Row {
     pub run: Option<u32>,
 }
 
-impl Row {
-    fn new(frame: &Frame, gps: Option<GpsColumns>, utc_us: Option<i64>) -> Self {
+impl From<&RowParts> for Row {
+    fn from(&RowParts { frame, gps, utc_us }: &RowParts) -> Self {
         Self {
             t_s: seconds(frame.t_us),
             accel_g: frame.accel.map(accel_g),
@@ -130,9 +129,6 @@ pub fn speed_mps(mm_s: u16) -> f64 {
 #[derive(Default)]
 pub struct RowAssembler {
     assembly: Assembly,
-    /// The pending rows and their frame times, µs.
-    pending: VecDeque<(u64, Row)>,
-    fix: Option<GpsColumns>,
 }
 
 impl RowAssembler {
@@ -144,63 +140,12 @@ impl RowAssembler {
 
     /// Takes one record; calls `emit` for every row that is complete.
     pub fn push(&mut self, record: &Record<'_>, emit: &mut impl FnMut(&Row)) {
-        self.assembly.push(
-            record,
-            &mut Queue {
-                rows: &mut self.pending,
-                fix: &mut self.fix,
-                emit,
-            },
-        );
+        self.assembly
+            .push(record, &mut |parts| emit(&Row::from(parts)));
     }
 
     /// Emits the rows still held back.
     pub fn finish(&mut self, emit: &mut impl FnMut(&Row)) {
-        self.assembly.finish(&mut Queue {
-            rows: &mut self.pending,
-            fix: &mut self.fix,
-            emit,
-        });
-    }
-}
-
-/// Pending rows as rows, emitted once complete.
-struct Queue<'a, F> {
-    rows: &'a mut VecDeque<(u64, Row)>,
-    /// The fix in force.
-    fix: &'a mut Option<GpsColumns>,
-    emit: &'a mut F,
-}
-
-impl<F: FnMut(&Row)> PendingRows for Queue<'_, F> {
-    fn fix(&mut self, gps: GpsColumns) {
-        *self.fix = Some(gps);
-    }
-
-    fn push(&mut self, frame: &Frame, gps: bool, utc_us: Option<i64>) {
-        let gps = self.fix.filter(|_| gps);
-        self.rows
-            .push_back((frame.t_us, Row::new(frame, gps, utc_us)));
-    }
-
-    fn set_gps(&mut self, i: usize, gps: bool) {
-        self.rows[i].1.gps = self.fix.filter(|_| gps);
-    }
-
-    fn set_utc(&mut self, i: usize, utc_us: Option<i64>) {
-        self.rows[i].1.utc_us = utc_us;
-    }
-
-    fn time_us(&self, i: usize) -> u64 {
-        self.rows[i].0
-    }
-
-    /// Emitted where it lies: a row is some 200 bytes, and moving each out
-    /// would copy it.
-    fn complete_first(&mut self) {
-        if let Some((_, row)) = self.rows.front() {
-            (self.emit)(row);
-        }
-        self.rows.pop_front();
+        self.assembly.finish(&mut |parts| emit(&Row::from(parts)));
     }
 }

@@ -5,8 +5,9 @@ use std::cell::RefCell;
 use std::ops::ControlFlow;
 use std::path::Path;
 
+use arrow_array::RecordBatch;
+use arrow_schema::SchemaRef;
 use pyo3::prelude::*;
-use wobble_core::format::codec::FRAME_MIN_LEN;
 use wobble_core::format::{DecodeStats, Event, Record};
 use wobblog::export::columns::Column;
 use wobblog::export::frame_columns::FrameColumns;
@@ -17,7 +18,7 @@ use wobblog::time::TimeWindow;
 use wobblog::CliError;
 
 use crate::stream::Table;
-use crate::table::FrameBatches;
+use crate::table::{record_batch, schema, BATCH_ROWS};
 
 /// Records between two looks for a pending `KeyboardInterrupt`.
 const RECORDS_PER_SIGNAL_CHECK: usize = 1 << 14;
@@ -41,11 +42,11 @@ pub struct Decoded {
 const RECORDS_PER_HANDOVER: usize = 4096;
 
 /// What the thread building the columns gives back.
-struct Built<'c> {
+struct Built {
+    /// The rows not converted yet.
     frames: FrameColumns,
-    /// The record batches converted so far (whole-log decodes only: a
-    /// window is applied once every row is in).
-    batches: FrameBatches<'c>,
+    /// The record batches converted so far.
+    batches: Vec<RecordBatch>,
     failure: Option<arrow_schema::ArrowError>,
     /// Ctrl-C, which stopped the building (and so the decoding).
     interrupted: Option<PyErr>,
@@ -137,16 +138,16 @@ impl<O: Observer> Handover<'_, O> {
     }
 }
 
-/// Turns records into the columns of every row.
-fn build<'c>(
+/// Turns records into the columns of the rows inside `window`, a record
+/// batch as soon as [`BATCH_ROWS`] rows are complete.
+fn build(
     records: std::sync::mpsc::Receiver<Handed>,
-    columns: &'c [Column],
-    window: TimeWindow,
-    room: usize,
-) -> Built<'c> {
+    frames: FrameColumns,
+    schema: &SchemaRef,
+) -> Built {
     let mut built = Built {
-        frames: FrameColumns::with_room(room),
-        batches: FrameBatches::new(columns),
+        frames,
+        batches: Vec::new(),
         failure: None,
         interrupted: None,
     };
@@ -155,16 +156,19 @@ fn build<'c>(
         let batch = match handed {
             Handed::Records(batch) => batch,
             Handed::Restart => {
-                built.frames = FrameColumns::with_room(room);
-                built.batches = FrameBatches::new(columns);
+                built.frames.restart();
+                built.batches.clear();
                 continue;
             }
         };
         for record in &batch {
             built.frames.push(record);
         }
-        if window.is_all() && built.failure.is_none() {
-            built.failure = built.batches.convert_complete(&built.frames).err();
+        for values in built.frames.take_full() {
+            match record_batch(schema, values) {
+                Ok(b) => built.batches.push(b),
+                Err(e) => built.failure = Some(e),
+            }
         }
         // Python runs signal handlers on its main thread only: the one that
         // called, this one.
@@ -178,24 +182,15 @@ fn build<'c>(
             }
         }
     }
-    built.frames.finish();
     built
-}
-
-/// The most frames the log at `path` can hold, up to a day of them (a card
-/// image given as a log reserves no more); 0 if its size is unknown.
-fn room_for_frames(path: &Path) -> usize {
-    const DAY_OF_FRAMES: u64 = 100 * 86_400;
-    let len = std::fs::metadata(path).map_or(0, |m| m.len());
-    usize::try_from((len / FRAME_MIN_LEN as u64).min(DAY_OF_FRAMES)).unwrap_or(0)
 }
 
 /// Decodes the log at `path` once: its rows inside `window`, in `columns`,
 /// and every decoder event passed to `observer` as well (a summary, the
 /// losses). The log is decoded on a second thread while this one builds
 /// the rows and their columns, in one pass when its blocks are in order
-/// ([`read_log_restarting`]); a record batch is converted as soon as its
-/// rows are complete. Called without the GIL; it is taken briefly now and
+/// ([`read_log_restarting`]); rows are converted as soon as they are
+/// complete. Called without the GIL; it is taken briefly now and
 /// then to see whether Ctrl-C was pressed, which ends the decoding with
 /// `KeyboardInterrupt`.
 pub fn walk(
@@ -206,6 +201,9 @@ pub fn walk(
 ) -> PyResult<Decoded> {
     let fail = |e: CliError| crate::errors::to_py(e);
     window.check_order(path).map_err(fail)?;
+    let frames = FrameColumns::new(columns, window, BATCH_ROWS)
+        .map_err(|e| fail(CliError::file(path, e)))?;
+    let schema = schema(columns);
     let (walked, has_utc, built) = std::thread::scope(|scope| {
         let (send, records) = std::sync::mpsc::sync_channel(8);
         let decoder = scope.spawn(move || {
@@ -227,7 +225,7 @@ pub fn walk(
         });
         // The rows are built on this thread, the caller's, where Python
         // looks for Ctrl-C.
-        let built = build(records, columns, window, room_for_frames(path));
+        let built = build(records, frames, &schema);
         let (walked, has_utc) = match decoder.join() {
             Ok(done) => done,
             Err(panic) => std::panic::resume_unwind(panic),
@@ -235,7 +233,7 @@ pub fn walk(
         (walked, has_utc, built)
     });
     let Built {
-        mut frames,
+        frames,
         mut batches,
         failure,
         interrupted,
@@ -247,24 +245,23 @@ pub fn walk(
     if let Some(e) = failure {
         return Err(arrow_error(path, &e));
     }
-    // Of every row, inside the window or not.
-    let span_s = frames.span_s();
-    let row_stats = frames.row_stats();
-    if !window.is_all() {
-        frames.retain(&window);
-        batches = FrameBatches::new(columns);
-        if frames.is_empty() {
-            return Err(fail(
-                window.selects_nothing(path, "frames", span_s, has_utc),
-            ));
-        }
+    let finished = frames.finish();
+    if finished.rows == 0 && !window.is_all() {
+        return Err(fail(window.selects_nothing(
+            path,
+            "frames",
+            finished.span_s,
+            has_utc,
+        )));
     }
-    let (schema, batches) = batches.finish(&frames).map_err(|e| arrow_error(path, &e))?;
+    for values in finished.batches {
+        batches.push(record_batch(&schema, values).map_err(|e| arrow_error(path, &e))?);
+    }
     Ok(Decoded {
         table: Table::new(schema, batches),
         stats,
-        span_s,
-        row_stats,
+        span_s: finished.span_s,
+        row_stats: finished.row_stats,
         has_utc,
     })
 }

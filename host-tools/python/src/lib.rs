@@ -2,6 +2,9 @@
 //! tables, and the analyses of the `wobblog` library crate (the CLI's own
 //! functions, so the numbers are the CLI's).
 
+#[global_allocator]
+static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
+
 mod arrays;
 mod campaign;
 mod errors;

@@ -14,8 +14,6 @@ use arrow_buffer::{NullBuffer, OffsetBuffer};
 use arrow_schema::{ArrowError, DataType, Field, Schema, SchemaRef, TimeUnit};
 use wobblog::export::columnar::{buffers, ColumnBuffers, Values};
 use wobblog::export::columns::{Column, Kind};
-use wobblog::export::frame_columns::FrameColumns;
-use wobblog::rows::Row;
 
 /// Rows per record batch: large enough that per-batch costs vanish, small
 /// enough that a consumer can start before a long log is converted.
@@ -84,98 +82,12 @@ pub struct TableBuilder<R: 'static> {
     batches: Vec<RecordBatch>,
 }
 
-/// Decoded frames in `columns` as record batches of [`BATCH_ROWS`] rows,
-/// each converted once its rows are complete (while the log is still
-/// being decoded), the last ones on two threads.
-pub struct FrameBatches<'c> {
-    schema: SchemaRef,
-    columns: &'c [Column<Row>],
-    batches: Vec<RecordBatch>,
-    /// Rows converted.
-    done: usize,
-}
-
-impl<'c> FrameBatches<'c> {
-    /// No batch yet.
-    #[must_use]
-    pub fn new(columns: &'c [Column<Row>]) -> Self {
-        Self {
-            schema: schema(columns),
-            columns,
-            batches: Vec::new(),
-            done: 0,
-        }
-    }
-
-    fn batch(&self, frames: &FrameColumns, start: usize) -> Result<RecordBatch, ArrowError> {
-        let range = start..frames.len().min(start + BATCH_ROWS);
-        let arrays = frames
-            .values(self.columns, range)
-            .map_err(ArrowError::InvalidArgumentError)?
-            .into_iter()
-            .map(array)
-            .collect();
-        RecordBatch::try_new(self.schema.clone(), arrays)
-    }
-
-    /// Converts the whole batches of `frames`' complete rows not converted
-    /// yet.
-    ///
-    /// # Errors
-    /// A column is not one of the frame columns.
-    pub fn convert_complete(&mut self, frames: &FrameColumns) -> Result<(), ArrowError> {
-        while frames.complete() >= self.done + BATCH_ROWS {
-            let batch = self.batch(frames, self.done)?;
-            self.batches.push(batch);
-            self.done += BATCH_ROWS;
-        }
-        Ok(())
-    }
-
-    /// The schema and every batch, the rows not converted yet converted
-    /// now (every other batch on a second thread): at least one batch,
-    /// empty for no rows, so every consumer sees the columns.
-    ///
-    /// # Errors
-    /// A column is not one of the frame columns.
-    pub fn finish(
-        mut self,
-        frames: &FrameColumns,
-    ) -> Result<(SchemaRef, Vec<RecordBatch>), ArrowError> {
-        let rows = frames.len();
-        let mut starts = (self.done..rows).step_by(BATCH_ROWS).collect::<Vec<_>>();
-        if rows == 0 {
-            starts.push(0);
-        }
-        let this = &self;
-        let (even, odd) = std::thread::scope(|scope| {
-            let odd = scope.spawn(|| {
-                starts
-                    .iter()
-                    .skip(1)
-                    .step_by(2)
-                    .map(|&s| this.batch(frames, s))
-                    .collect::<Vec<_>>()
-            });
-            let even: Vec<_> = starts
-                .iter()
-                .step_by(2)
-                .map(|&s| this.batch(frames, s))
-                .collect();
-            (
-                even,
-                odd.join().unwrap_or_else(|p| std::panic::resume_unwind(p)),
-            )
-        });
-        let (mut even, mut odd) = (even.into_iter(), odd.into_iter());
-        for i in 0..starts.len() {
-            let batch = if i % 2 == 0 { even.next() } else { odd.next() };
-            if let Some(batch) = batch {
-                self.batches.push(batch?);
-            }
-        }
-        Ok((self.schema, self.batches))
-    }
+/// One batch of `schema`'s columns from their values.
+///
+/// # Errors
+/// Arrow refuses the batch (cannot happen for the columns' own types).
+pub fn record_batch(schema: &SchemaRef, values: Vec<Values>) -> Result<RecordBatch, ArrowError> {
+    RecordBatch::try_new(schema.clone(), values.into_iter().map(array).collect())
 }
 
 impl<R: 'static> TableBuilder<R> {
@@ -205,9 +117,8 @@ impl<R: 'static> TableBuilder<R> {
     }
 
     fn flush(&mut self) -> Result<(), ArrowError> {
-        let arrays = self.buffers.take().into_iter().map(array).collect();
-        self.batches
-            .push(RecordBatch::try_new(self.schema.clone(), arrays)?);
+        let batch = record_batch(&self.schema, self.buffers.take())?;
+        self.batches.push(batch);
         Ok(())
     }
 

@@ -1,259 +1,201 @@
-//! Decoded frames kept for columns from the start: each frame is stored
-//! once as it comes (its counts, its fix, its UTC), and any range of rows
-//! is converted to physical units a column at a time, as soon as those
-//! rows are complete (no fix or UTC pair read later changes them). Which
+//! Decoded frames turned into columns as their rows complete: once no fix
+//! or UTC pair read later can change a row, it is converted to physical
+//! units straight into the columns of the batch being filled, a few hundred
+//! rows at a time, and a batch is handed out as soon as it is full. Which
 //! fix and UTC fill a row is decided by the same [`Assembly`] that builds
 //! [`Row`]s, and the units by the same functions, so the columns hold the
 //! values `wobblog decode` writes (a test holds them to its rows); only no
-//! 200-byte row is built per frame (the Python package opens hour-long
-//! logs this way).
+//! 200-byte row is built per frame, and no row is kept once converted (the
+//! Python package opens hour-long logs this way).
 
-use std::ops::Range;
+use wobble_core::format::Record;
 
-use wobble_core::format::{Frame, Record};
-
-use super::columnar::{Field, FrameFields, RowColumns, Values};
+use super::columnar::{ColumnBuffers, Field, FrameFields, RowColumns, Values};
 use super::columns::Column;
-use crate::rows::{self, Assembly, GpsColumns, PendingRows, Row};
+use crate::rows::{self, Assembly, GpsColumns, Row, RowParts};
 use crate::summary::RowStats;
 use crate::time::TimeWindow;
 
-/// A row without GPS columns, in [`Slot::gps`].
-const NO_FIX: u32 = u32::MAX;
-/// Rows converted a column at a time (14 KiB of them).
+/// Rows converted a column at a time (some 20 KiB of them).
 const ROWS_PER_PASS: usize = 256;
 
-/// Frames as columns of counts, filled record by record.
-#[derive(Default)]
+/// A log's frames as batches of columns, filled record by record.
 pub struct FrameColumns {
     assembly: Assembly,
-    columns: Counts,
+    complete: Complete,
 }
 
-impl FrameColumns {
-    /// No rows yet.
-    #[must_use]
-    pub fn new() -> Self {
-        Self::default()
-    }
-
-    /// No rows yet, with room for `rows` if it can be had (an estimate,
-    /// so a long log's rows are not copied each time their vector grows).
-    #[must_use]
-    pub fn with_room(rows: usize) -> Self {
-        let mut new = Self::default();
-        // Without the room, the vector grows as rows come.
-        let _ = new.columns.rows.try_reserve_exact(rows);
-        new
-    }
-
-    /// Takes the log's next record.
-    pub fn push(&mut self, record: &Record<'_>) {
-        self.assembly.push(record, &mut self.columns);
-    }
-
-    /// Completes the rows still waiting; call once every record is in.
-    pub fn finish(&mut self) {
-        self.assembly.finish(&mut self.columns);
-    }
-
-    /// Rows so far.
-    #[must_use]
-    pub fn len(&self) -> usize {
-        self.columns.len()
-    }
-
-    /// Rows complete: no fix or sync pair read later changes them.
-    #[must_use]
-    pub fn complete(&self) -> usize {
-        self.columns.first_pending
-    }
-
-    /// Whether there is no row.
-    #[must_use]
-    pub fn is_empty(&self) -> bool {
-        self.len() == 0
-    }
-
-    /// Earliest and latest boot time of the complete rows (every row once
-    /// [`Self::finish`]ed), s.
-    #[must_use]
-    pub fn span_s(&self) -> Option<(f64, f64)> {
-        self.columns.span_s()
-    }
-
-    /// What a summary takes from the complete rows.
-    #[must_use]
-    pub fn row_stats(&self) -> RowStats {
-        self.columns.row_stats()
-    }
-
-    /// Keeps the rows inside `window` (as `wobblog decode`: a row is in
-    /// when its boot time or UTC, ms, is); call after [`Self::finish`].
-    pub fn retain(&mut self, window: &TimeWindow) {
-        self.columns.retain(window);
-    }
-
-    /// The values of `columns` (of [`super::columns::COLUMNS`]) in `rows`,
-    /// in physical units, one entry per column.
-    ///
-    /// # Errors
-    /// A column is not one of the frame columns.
-    ///
-    /// # Panics
-    /// `rows` reaches past the last row.
-    pub fn values(
-        &self,
-        columns: &[Column<Row>],
-        rows: Range<usize>,
-    ) -> Result<Vec<Values>, String> {
-        self.columns.values(columns, rows)
-    }
-}
-
-/// The rows' frames and what fills them.
-#[derive(Default)]
-struct Counts {
-    /// Every row as read: one store per frame.
-    rows: Vec<Slot>,
-    /// Every fix that was in force, in order.
-    fixes: Vec<GpsColumns>,
-    /// The first row still waiting for a late fix or pair.
-    first_pending: usize,
-    /// Of the complete rows: the earliest and latest frame time, µs, and
-    /// what a summary takes from them (kept as they complete: a pass over
-    /// a long log's rows afterwards costs more than the rows).
+/// What becomes of the complete rows.
+struct Complete {
+    /// Which rows are kept.
+    window: TimeWindow,
+    /// Rows kept, not yet converted.
+    staged: Vec<RowParts>,
+    /// The batch being filled, and how many rows make one.
+    batch: RowColumns,
+    batch_rows: usize,
+    /// Full batches not yet taken.
+    full: Vec<Vec<Values>>,
+    /// Rows kept so far, and batches handed out.
+    kept: usize,
+    batches: usize,
+    /// Of every complete row, kept or not: the earliest and latest frame
+    /// time, µs, and what a summary takes from them.
     span_us: Option<(u64, u64)>,
     stats: RowStats,
 }
 
-/// A row: its frame, its GPS columns in [`Counts::fixes`] (or
-/// [`NO_FIX`]), its UTC.
-#[derive(Clone, Copy)]
-struct Slot {
-    frame: Frame,
-    gps: u32,
-    utc_us: Option<i64>,
+/// What is left once every record is in.
+pub struct Finished {
+    /// The last batches: at least one over the whole log (empty for no
+    /// rows), so every consumer sees the columns.
+    pub batches: Vec<Vec<Values>>,
+    /// Rows kept.
+    pub rows: usize,
+    /// Earliest and latest boot time of every row (inside the window or
+    /// not), s.
+    pub span_s: Option<(f64, f64)>,
+    /// What a summary takes from every row (inside the window or not).
+    pub row_stats: RowStats,
 }
 
-impl Counts {
-    fn len(&self) -> usize {
-        self.rows.len()
-    }
-
-    fn span_s(&self) -> Option<(f64, f64)> {
-        let (first, last) = self.span_us?;
-        Some((rows::seconds(first), rows::seconds(last)))
-    }
-
-    fn row_stats(&self) -> RowStats {
-        self.stats.clone()
-    }
-
-    fn retain(&mut self, window: &TimeWindow) {
-        self.rows
-            .retain(|r| window.contains(rows::seconds(r.frame.t_us), r.utc_us.map(|u| u / 1000)));
-        self.first_pending = self.len();
-    }
-
-    fn values(&self, columns: &[Column<Row>], range: Range<usize>) -> Result<Vec<Values>, String> {
+impl FrameColumns {
+    /// No rows yet. The rows inside `window` (as `wobblog decode`: a row
+    /// is in when its boot time or UTC, ms, is) will be kept, in `columns`
+    /// (of [`super::columns::COLUMNS`]), `batch_rows` to a batch.
+    ///
+    /// # Errors
+    /// A column is not one of the frame columns.
+    pub fn new(
+        columns: &[Column<Row>],
+        window: TimeWindow,
+        batch_rows: usize,
+    ) -> Result<Self, String> {
         // Frames belong to no run in particular.
         let not_frames = |c: &&Column<Row>| matches!(Field::of_column(c), None | Some(Field::Run));
-        let mut out = RowColumns::new(columns, range.len())
+        let batch = RowColumns::new(columns, batch_rows)
             .filter(|_| !columns.iter().any(|c| not_frames(&c)))
             .ok_or_else(|| {
                 let name = columns.iter().find(not_frames).map_or("", |c| c.name);
                 format!("{name} is not a column of the frames")
             })?;
-        // A few hundred rows at a time: they stay in the nearest cache while
-        // each column reads them.
-        for slots in self.rows[range].chunks(ROWS_PER_PASS) {
-            out.store(slots.iter().map(|slot| Fields {
-                slot,
-                fixes: &self.fixes,
-            }));
-        }
-        Ok(out.into_values())
+        Ok(Self {
+            assembly: Assembly::default(),
+            complete: Complete {
+                window,
+                staged: Vec::with_capacity(ROWS_PER_PASS),
+                batch,
+                batch_rows: batch_rows.max(1),
+                full: Vec::new(),
+                kept: 0,
+                batches: 0,
+                span_us: None,
+                stats: RowStats::default(),
+            },
+        })
     }
 
-    /// The index in `fixes` of the fix in force, or [`NO_FIX`].
-    fn fix_index(&self, gps: bool) -> u32 {
-        match self.fixes.len().checked_sub(1) {
-            // A log holds fewer fixes than 2^32 (at 20 Hz, 6 years).
-            Some(last) if gps => u32::try_from(last).unwrap_or(NO_FIX),
-            _ => NO_FIX,
+    /// Forgets every record taken: no rows again (the log is to be read
+    /// again from its start).
+    pub fn restart(&mut self) {
+        self.assembly = Assembly::default();
+        let c = &mut self.complete;
+        c.staged.clear();
+        c.batch.take();
+        c.full.clear();
+        (c.kept, c.batches, c.span_us) = (0, 0, None);
+        c.stats = RowStats::default();
+    }
+
+    /// Takes the log's next record.
+    pub fn push(&mut self, record: &Record<'_>) {
+        let complete = &mut self.complete;
+        self.assembly.push(record, &mut |row| complete.take(row));
+    }
+
+    /// The batches filled since the last call, each a value per column, in
+    /// physical units.
+    pub fn take_full(&mut self) -> Vec<Vec<Values>> {
+        std::mem::take(&mut self.complete.full)
+    }
+
+    /// Completes the rows still waiting; call once every record is in.
+    #[must_use]
+    pub fn finish(mut self) -> Finished {
+        let complete = &mut self.complete;
+        self.assembly.finish(&mut |row| complete.take(row));
+        let mut c = self.complete;
+        c.store();
+        if c.batch.len() > 0 || c.batches + c.full.len() == 0 {
+            c.full.push(c.batch.into_values());
+        }
+        Finished {
+            batches: c.full,
+            rows: c.kept,
+            span_s: c
+                .span_us
+                .map(|(first, last)| (rows::seconds(first), rows::seconds(last))),
+            row_stats: c.stats,
         }
     }
 }
 
-/// A row's fields, read from its slot and the fixes.
-#[derive(Clone, Copy)]
-struct Fields<'a> {
-    slot: &'a Slot,
-    fixes: &'a [GpsColumns],
+impl Complete {
+    fn take(&mut self, row: &RowParts) {
+        let t = row.frame.t_us;
+        self.span_us = Some(self.span_us.map_or((t, t), |(a, b)| (a.min(t), b.max(t))));
+        self.stats.take_parts(row.gps.is_some(), row.utc_us);
+        if !self
+            .window
+            .contains(rows::seconds(t), row.utc_us.map(|u| u / 1000))
+        {
+            return;
+        }
+        self.staged.push(*row);
+        self.kept += 1;
+        if self.staged.len() == ROWS_PER_PASS
+            || self.batch.len() + self.staged.len() == self.batch_rows
+        {
+            self.store();
+        }
+    }
+
+    /// Converts the staged rows into the batch, which is handed out once
+    /// full.
+    fn store(&mut self) {
+        self.batch.store(self.staged.iter());
+        self.staged.clear();
+        if self.batch.len() == self.batch_rows {
+            self.full.push(self.batch.take());
+            self.batches += 1;
+        }
+    }
 }
 
-impl FrameFields for Fields<'_> {
+impl FrameFields for &RowParts {
     fn t_s(&self) -> f64 {
-        rows::seconds(self.slot.frame.t_us)
+        rows::seconds(self.frame.t_us)
     }
     fn accel_g(&self, axis: usize) -> f64 {
-        rows::accel_g(self.slot.frame.accel[axis])
+        rows::accel_g(self.frame.accel[axis])
     }
     fn gyro_dps(&self, axis: usize) -> f64 {
-        rows::gyro_dps(self.slot.frame.gyro[axis])
+        rows::gyro_dps(self.frame.gyro[axis])
     }
     fn steer_deg(&self) -> f64 {
-        rows::steer_deg(self.slot.frame.steer_cdeg)
+        rows::steer_deg(self.frame.steer_cdeg)
     }
     fn speed_mps(&self) -> f64 {
-        rows::speed_mps(self.slot.frame.speed_mm_s)
+        rows::speed_mps(self.frame.speed_mm_s)
     }
     fn gps(&self) -> Option<&GpsColumns> {
-        self.fixes.get(self.slot.gps as usize)
+        self.gps.as_ref()
     }
     fn utc_us(&self) -> Option<i64> {
-        self.slot.utc_us
+        self.utc_us
     }
     fn run(&self) -> Option<u32> {
         None
-    }
-}
-
-impl PendingRows for Counts {
-    fn fix(&mut self, gps: GpsColumns) {
-        self.fixes.push(gps);
-    }
-
-    fn push(&mut self, frame: &Frame, gps: bool, utc_us: Option<i64>) {
-        let gps = self.fix_index(gps);
-        self.rows.push(Slot {
-            frame: *frame,
-            gps,
-            utc_us,
-        });
-    }
-
-    fn set_gps(&mut self, i: usize, gps: bool) {
-        self.rows[self.first_pending + i].gps = self.fix_index(gps);
-    }
-
-    fn set_utc(&mut self, i: usize, utc_us: Option<i64>) {
-        self.rows[self.first_pending + i].utc_us = utc_us;
-    }
-
-    fn time_us(&self, i: usize) -> u64 {
-        self.rows[self.first_pending + i].frame.t_us
-    }
-
-    fn complete_first(&mut self) {
-        let Some(row) = self.rows.get(self.first_pending) else {
-            return;
-        };
-        let t = row.frame.t_us;
-        self.span_us = Some(self.span_us.map_or((t, t), |(a, b)| (a.min(t), b.max(t))));
-        self.stats.take_parts(row.gps != NO_FIX, row.utc_us);
-        self.first_pending += 1;
     }
 }
 
@@ -264,7 +206,7 @@ mod tests {
     use crate::rows::RowAssembler;
     use crate::time::TimeBound;
     use proptest::prelude::*;
-    use wobble_core::format::{FixMode, GpsFix, UtcSync};
+    use wobble_core::format::{FixMode, Frame, GpsFix, UtcSync};
 
     /// Records as a log holds them: frames 10 ms apart with now and then a
     /// step back or a long step forward, fixes and sync pairs stamped up to
@@ -332,6 +274,35 @@ mod tests {
         }
     }
 
+    /// Every cell of `batches`, column by column.
+    fn columns_of(batches: Vec<Vec<Values>>, columns: usize) -> Vec<Vec<Value>> {
+        let mut out = vec![Vec::new(); columns];
+        for batch in batches {
+            assert_eq!(batch.len(), columns);
+            for (column, values) in out.iter_mut().zip(batch) {
+                column.extend(cells(values));
+            }
+        }
+        out
+    }
+
+    /// The rows `wobblog decode` makes of `records`, and the summary's
+    /// figures of them.
+    fn decoded(records: &[Record<'static>]) -> (Vec<Row>, RowStats) {
+        let mut rows = Vec::new();
+        let mut stats = RowStats::default();
+        let mut keep = |row: &Row| {
+            stats.take(row);
+            rows.push(*row);
+        };
+        let mut assembler = RowAssembler::new();
+        for record in records {
+            assembler.push(record, &mut keep);
+        }
+        assembler.finish(&mut keep);
+        (rows, stats)
+    }
+
     proptest! {
         #![proptest_config(ProptestConfig {
             cases: 256,
@@ -341,87 +312,90 @@ mod tests {
         })]
 
         /// The columns hold, row for row, what the rows of `wobblog decode`
-        /// hold, and the summary's figures agree with those rows'.
+        /// hold, batch after batch, and the summary's figures agree with
+        /// those rows'; a window keeps the rows `decode` keeps.
         #[test]
-        fn the_columns_are_the_rows_of_decode(records in records()) {
-            let mut rows = Vec::new();
-            let mut assembler = RowAssembler::new();
-            let mut stats = RowStats::default();
-            let mut keep = |row: &Row| {
-                stats.take(row);
-                rows.push(*row);
-            };
-            let mut columns = FrameColumns::with_room(records.len() / 2);
-            // What the complete rows hold half way through the records.
-            let mut half_way = None;
-            for (k, record) in records.iter().enumerate() {
-                assembler.push(record, &mut keep);
-                columns.push(record);
-                if k == records.len() / 2 {
-                    let complete = columns.complete();
-                    let values = columns.values(&COLUMNS, 0..complete).unwrap();
-                    half_way = Some((complete, values));
-                }
-            }
-            assembler.finish(&mut keep);
-            columns.finish();
-            prop_assert_eq!(columns.len(), rows.len());
-            prop_assert!(!columns.is_empty());
-            prop_assert_eq!(columns.complete(), rows.len());
-            // Complete rows do not change.
-            if let Some((complete, values)) = half_way {
-                prop_assert_eq!(values, columns.values(&COLUMNS, 0..complete).unwrap());
-            }
-            let split = rows.len() / 3;
-            let head = columns.values(&COLUMNS, 0..split).unwrap();
-            let tail = columns.values(&COLUMNS, split..rows.len()).unwrap();
-            for ((column, head), tail) in COLUMNS.iter().zip(head).zip(tail) {
-                let expected: Vec<Value> = rows.iter().map(|r| (column.value)(r)).collect();
-                let mut got = cells(head);
-                got.extend(cells(tail));
-                prop_assert_eq!(got, expected, "column {}", column.name);
-            }
-            prop_assert_eq!(columns.row_stats(), stats);
-            let times = rows.iter().map(|r| r.t_s);
-            let span = times.clone().reduce(f64::min).zip(times.reduce(f64::max));
-            prop_assert_eq!(columns.span_s(), span);
-
-            // A window keeps the rows `decode` keeps.
+        fn the_columns_are_the_rows_of_decode(records in records(), batch_rows in 1usize..300) {
+            let (rows, stats) = decoded(&records);
             let from = rows[rows.len() / 2].t_s;
             let utc_to = rows.iter().find_map(|r| r.utc_us).map(|u| u / 1000 + 2_000);
             let window = TimeWindow {
                 from: Some(TimeBound::Boot(from)),
                 to: utc_to.map(TimeBound::Utc),
             };
-            let inside: Vec<&Row> = rows
-                .iter()
-                .filter(|r| window.contains(r.t_s, r.utc_us.map(|u| u / 1000)))
-                .collect();
-            columns.retain(&window);
-            prop_assert_eq!(columns.len(), inside.len());
-            prop_assert_eq!(columns.is_empty(), inside.is_empty());
-            let [t, utc] = [0, 13].map(|c| {
-                cells(columns.values(&COLUMNS[c..=c], 0..inside.len()).unwrap().remove(0))
-            });
-            prop_assert_eq!(t, inside.iter().map(|r| Value::Number(Some(r.t_s))).collect::<Vec<_>>());
-            prop_assert_eq!(utc, inside.iter().map(|r| Value::Utc(r.utc_us)).collect::<Vec<_>>());
+            for window in [TimeWindow::default(), window] {
+                let kept: Vec<&Row> = rows
+                    .iter()
+                    .filter(|r| window.contains(r.t_s, r.utc_us.map(|u| u / 1000)))
+                    .collect();
+                let mut columns = FrameColumns::new(&COLUMNS, window, batch_rows).unwrap();
+                if window.is_all() {
+                    // Read in part, then again from the start.
+                    for record in &records[..records.len() / 2] {
+                        columns.push(record);
+                    }
+                    columns.restart();
+                }
+                let mut batches = Vec::new();
+                for record in &records {
+                    columns.push(record);
+                    for batch in columns.take_full() {
+                        // Handed out full, while records still come.
+                        prop_assert_eq!(batch[0].len(), batch_rows);
+                        batches.push(batch);
+                    }
+                }
+                let finished = columns.finish();
+                prop_assert_eq!(finished.rows, kept.len());
+                prop_assert!(finished.batches.iter().all(|b| b[0].len() <= batch_rows));
+                batches.extend(finished.batches);
+                prop_assert!(!batches.is_empty());
+                let got = columns_of(batches, COLUMNS.len());
+                for (column, got) in COLUMNS.iter().zip(got) {
+                    let expected: Vec<Value> = kept.iter().map(|r| (column.value)(r)).collect();
+                    prop_assert_eq!(got, expected, "column {}", column.name);
+                }
+                // Of every row, whatever the window.
+                prop_assert_eq!(&finished.row_stats, &stats);
+                let times = rows.iter().map(|r| r.t_s);
+                let span = times.clone().reduce(f64::min).zip(times.reduce(f64::max));
+                prop_assert_eq!(finished.span_s, span);
+            }
         }
     }
 
     #[test]
-    fn rows_are_complete_once_half_a_second_older_than_the_last_frame() {
-        let mut columns = FrameColumns::new();
+    fn rows_are_converted_once_half_a_second_older_than_the_last_frame() {
+        let mut columns = FrameColumns::new(&COLUMNS, TimeWindow::default(), 149).unwrap();
         for i in 0..200u64 {
             columns.push(&Record::Frame(Frame {
                 t_us: i * 10_000,
                 ..Frame::default()
             }));
+            // The frame at 1.99 s completes the rows up to 1.48 s: 149.
+            assert_eq!(
+                columns.take_full().len(),
+                usize::from(i == 199),
+                "frame {i}"
+            );
         }
-        // The last frame at 1.99 s: rows up to 1.48 s wait no longer.
-        assert_eq!(columns.complete(), 149);
-        let mut nothing = FrameColumns::new();
-        nothing.finish();
-        assert!(nothing.is_empty());
-        assert_eq!(nothing.span_s(), None);
+        let finished = columns.finish();
+        assert_eq!(finished.rows, 200);
+        assert_eq!(finished.batches.len(), 1);
+        assert_eq!(finished.batches[0][0].len(), 51);
+    }
+
+    #[test]
+    fn no_rows_make_one_empty_batch_and_the_run_is_no_frame_column() {
+        let finished = FrameColumns::new(&COLUMNS, TimeWindow::default(), 10)
+            .unwrap()
+            .finish();
+        assert_eq!(finished.rows, 0);
+        assert_eq!(finished.span_s, None);
+        assert_eq!(finished.batches.len(), 1);
+        assert!(finished.batches[0].iter().all(Values::is_empty));
+        let run = crate::export::columns::RUN_COLUMN;
+        let err = FrameColumns::new(&[COLUMNS[0], run], TimeWindow::default(), 10).err();
+        assert_eq!(err.as_deref(), Some("run is not a column of the frames"));
     }
 }

@@ -1,11 +1,13 @@
 //! Which GPS fix and which UTC sync pair fill each frame's row, and when a
-//! row is complete: the logic every reader of rows shares, whatever holds
-//! the rows meanwhile (a queue of [`super::Row`]s, or columns).
+//! row is complete: the logic every reader of rows shares, whatever it
+//! makes of a complete row (a [`super::Row`], or cells of columns).
 //!
 //! A GPS fix is stamped when its first sentence began, so it reaches the
 //! card after frames that come later than it; rows are held back for
 //! [`GPS_WAIT_US`] so such a fix still fills them. A UTC sync pair is
 //! stamped the same way.
+
+use std::collections::VecDeque;
 
 use wobble_core::format::{Frame, Record, UtcSync};
 
@@ -19,56 +21,46 @@ const GPS_WAIT_US: u64 = 500_000;
 /// 50): times that stand still cannot make the assembler hoard memory.
 const MAX_PENDING_ROWS: usize = 4096;
 
-/// Rows waiting for a late fix or pair, held by the caller, oldest first.
-/// A row's GPS columns are those of the fix in force (the last one passed
-/// to [`PendingRows::fix`]) or none.
-pub trait PendingRows {
-    /// The fix in force from now on.
-    fn fix(&mut self, gps: GpsColumns);
-    /// A new row for `frame` at the back, with the fix in force or none,
-    /// and the UTC known so far.
-    fn push(&mut self, frame: &Frame, gps: bool, utc_us: Option<i64>);
-    /// Pending row `i` (0: the oldest) takes the fix in force, or none.
-    fn set_gps(&mut self, i: usize, gps: bool);
-    /// Pending row `i` takes this UTC.
-    fn set_utc(&mut self, i: usize, utc_us: Option<i64>);
-    /// The frame time of pending row `i`, µs.
-    fn time_us(&self, i: usize) -> u64;
-    /// The oldest pending row is complete and leaves the queue.
-    fn complete_first(&mut self);
+/// A row as assembled: its frame, and what fills it.
+#[derive(Clone, Copy, Debug)]
+pub struct RowParts {
+    /// The frame, as decoded.
+    pub frame: Frame,
+    /// The GPS fix in force, if any.
+    pub gps: Option<GpsColumns>,
+    /// UTC, µs since 1970, from the latest sync pair at or before the frame.
+    pub utc_us: Option<i64>,
 }
 
-/// Decides, record by record, what fills the pending rows and when they
-/// are complete. Memory is bounded: at most [`MAX_PENDING_ROWS`] wait.
+/// Decides, record by record, what fills each row and when it is complete;
+/// the rows wait here meanwhile. Memory is bounded: at most
+/// [`MAX_PENDING_ROWS`] wait.
 #[derive(Default)]
 pub struct Assembly {
-    /// Rows pending (their times never decrease: time going back
-    /// completes them all).
-    pending: usize,
-    /// The time of the fix in force (its columns are the rows' holder's:
-    /// [`PendingRows::fix`]).
-    gps_us: Option<u64>,
+    /// Rows pending, oldest first (their times never decrease: time going
+    /// back completes them all).
+    pending: VecDeque<RowParts>,
+    /// The fix in force: its time and columns.
+    fix: Option<(u64, GpsColumns)>,
     sync: Option<UtcSync>,
 }
 
 impl Assembly {
     /// Takes one record (frames, fixes and sync pairs matter; the others
-    /// are passed over).
-    pub fn push(&mut self, record: &Record<'_>, rows: &mut impl PendingRows) {
+    /// are passed over); hands every row now complete to `complete`, in
+    /// order.
+    pub fn push(&mut self, record: &Record<'_>, complete: &mut impl FnMut(&RowParts)) {
         match record {
-            Record::Frame(frame) => self.frame(frame, rows),
+            Record::Frame(frame) => self.frame(frame, complete),
             Record::Gps(fix) => {
-                let columns = GpsColumns::from_fix(fix);
-                let newer = self.gps_us.is_none_or(|t| fix.t_us >= t);
+                let newer = self.fix.is_none_or(|(t, _)| fix.t_us >= t);
                 if newer {
-                    self.gps_us = columns.map(|_| fix.t_us);
-                    if let Some(c) = columns {
-                        rows.fix(c);
-                    }
-                    for i in 0..self.pending {
-                        let t = rows.time_us(i);
+                    let columns = GpsColumns::from_fix(fix);
+                    self.fix = columns.map(|c| (fix.t_us, c));
+                    for row in &mut self.pending {
+                        let t = row.frame.t_us;
                         if t >= fix.t_us {
-                            rows.set_gps(i, columns.is_some() && t - fix.t_us <= GPS_STALE_US);
+                            row.gps = columns.filter(|_| t - fix.t_us <= GPS_STALE_US);
                         }
                     }
                 }
@@ -76,10 +68,10 @@ impl Assembly {
             // Like a fix, a pair is stamped before frames written ahead of it.
             Record::UtcSync(sync) if self.sync.is_none_or(|s| sync.t_us >= s.t_us) => {
                 self.sync = Some(*sync);
-                for i in 0..self.pending {
-                    let t = rows.time_us(i);
+                for row in &mut self.pending {
+                    let t = row.frame.t_us;
                     if t >= sync.t_us {
-                        rows.set_utc(i, utc_us_at(*sync, t));
+                        row.utc_us = utc_us_at(*sync, t);
                     }
                 }
             }
@@ -87,40 +79,53 @@ impl Assembly {
         }
     }
 
-    fn frame(&mut self, frame: &Frame, rows: &mut impl PendingRows) {
+    fn frame(&mut self, frame: &Frame, complete: &mut impl FnMut(&RowParts)) {
         // Time going back starts a new segment: nothing waits across it,
         // and a fix from before it fills no row after it.
-        if self.pending > 0 && frame.t_us < rows.time_us(self.pending - 1) {
-            self.finish(rows);
-            self.gps_us = None;
+        if self
+            .pending
+            .back()
+            .is_some_and(|r| frame.t_us < r.frame.t_us)
+        {
+            self.finish(complete);
+            self.fix = None;
         }
-        if self.pending >= MAX_PENDING_ROWS {
-            self.complete_first(rows);
+        if self.pending.len() >= MAX_PENDING_ROWS {
+            self.complete_first(complete);
         }
         let gps = self
-            .gps_us
-            .is_some_and(|t| t <= frame.t_us && frame.t_us - t <= GPS_STALE_US);
+            .fix
+            .filter(|&(t, _)| t <= frame.t_us && frame.t_us - t <= GPS_STALE_US)
+            .map(|(_, columns)| columns);
         let utc_us = self
             .sync
             .filter(|s| s.t_us <= frame.t_us)
             .and_then(|s| utc_us_at(s, frame.t_us));
-        rows.push(frame, gps, utc_us);
-        self.pending += 1;
-        while self.pending > 0 && rows.time_us(0) + GPS_WAIT_US < frame.t_us {
-            self.complete_first(rows);
+        self.pending.push_back(RowParts {
+            frame: *frame,
+            gps,
+            utc_us,
+        });
+        while self
+            .pending
+            .front()
+            .is_some_and(|r| r.frame.t_us + GPS_WAIT_US < frame.t_us)
+        {
+            self.complete_first(complete);
         }
     }
 
     /// Completes every row still held back.
-    pub fn finish(&mut self, rows: &mut impl PendingRows) {
-        while self.pending > 0 {
-            self.complete_first(rows);
+    pub fn finish(&mut self, complete: &mut impl FnMut(&RowParts)) {
+        while !self.pending.is_empty() {
+            self.complete_first(complete);
         }
     }
 
-    fn complete_first(&mut self, rows: &mut impl PendingRows) {
-        self.pending -= 1;
-        rows.complete_first();
+    fn complete_first(&mut self, complete: &mut impl FnMut(&RowParts)) {
+        if let Some(row) = self.pending.pop_front() {
+            complete(&row);
+        }
     }
 }
 
