@@ -138,14 +138,21 @@ impl RowAssembler {
         Self::default()
     }
 
-    /// Takes one record; calls `emit` for every row that is complete.
+    /// Takes one record; calls `emit` for every row that is complete (a
+    /// few hundred at a time).
     pub fn push(&mut self, record: &Record<'_>, emit: &mut impl FnMut(&Row)) {
         self.assembly
-            .push(record, &mut |parts| emit(&Row::from(parts)));
+            .push(record, &mut |rows| emit_each(rows, emit));
     }
 
     /// Emits the rows still held back.
     pub fn finish(&mut self, emit: &mut impl FnMut(&Row)) {
-        self.assembly.finish(&mut |parts| emit(&Row::from(parts)));
+        self.assembly.finish(&mut |rows| emit_each(rows, emit));
+    }
+}
+
+fn emit_each(rows: &[RowParts], emit: &mut impl FnMut(&Row)) {
+    for parts in rows {
+        emit(&Row::from(parts));
     }
 }

@@ -16,9 +16,6 @@ use crate::rows::{self, Assembly, GpsColumns, Row, RowParts};
 use crate::summary::RowStats;
 use crate::time::TimeWindow;
 
-/// Rows converted a column at a time (some 20 KiB of them).
-const ROWS_PER_PASS: usize = 256;
-
 /// A log's frames as batches of columns, filled record by record.
 pub struct FrameColumns {
     assembly: Assembly,
@@ -29,8 +26,6 @@ pub struct FrameColumns {
 struct Complete {
     /// Which rows are kept.
     window: TimeWindow,
-    /// Rows kept, not yet converted.
-    staged: Vec<RowParts>,
     /// The batch being filled, and how many rows make one.
     batch: RowColumns,
     batch_rows: usize,
@@ -83,7 +78,6 @@ impl FrameColumns {
             assembly: Assembly::default(),
             complete: Complete {
                 window,
-                staged: Vec::with_capacity(ROWS_PER_PASS),
                 batch,
                 batch_rows: batch_rows.max(1),
                 full: Vec::new(),
@@ -100,7 +94,6 @@ impl FrameColumns {
     pub fn restart(&mut self) {
         self.assembly = Assembly::default();
         let c = &mut self.complete;
-        c.staged.clear();
         c.batch.take();
         c.full.clear();
         (c.kept, c.batches, c.span_us) = (0, 0, None);
@@ -110,7 +103,7 @@ impl FrameColumns {
     /// Takes the log's next record.
     pub fn push(&mut self, record: &Record<'_>) {
         let complete = &mut self.complete;
-        self.assembly.push(record, &mut |row| complete.take(row));
+        self.assembly.push(record, &mut |rows| complete.take(rows));
     }
 
     /// The batches filled since the last call, each a value per column, in
@@ -123,9 +116,8 @@ impl FrameColumns {
     #[must_use]
     pub fn finish(mut self) -> Finished {
         let complete = &mut self.complete;
-        self.assembly.finish(&mut |row| complete.take(row));
+        self.assembly.finish(&mut |rows| complete.take(rows));
         let mut c = self.complete;
-        c.store();
         if c.batch.len() > 0 || c.batches + c.full.len() == 0 {
             c.full.push(c.batch.into_values());
         }
@@ -141,33 +133,40 @@ impl FrameColumns {
 }
 
 impl Complete {
-    fn take(&mut self, row: &RowParts) {
-        let t = row.frame.t_us;
-        self.span_us = Some(self.span_us.map_or((t, t), |(a, b)| (a.min(t), b.max(t))));
-        self.stats.take_parts(row.gps.is_some(), row.utc_us);
-        if !self
-            .window
-            .contains(rows::seconds(t), row.utc_us.map(|u| u / 1000))
-        {
-            return;
+    /// Takes a run of complete rows (a few hundred: the assembly hands
+    /// them out so, and they are read once per column, so they should sit
+    /// in the nearest cache).
+    fn take(&mut self, rows: &[RowParts]) {
+        for row in rows {
+            let t = row.frame.t_us;
+            self.span_us = Some(self.span_us.map_or((t, t), |(a, b)| (a.min(t), b.max(t))));
+            self.stats.take_parts(row.gps.is_some(), row.utc_us);
         }
-        self.staged.push(*row);
-        self.kept += 1;
-        if self.staged.len() == ROWS_PER_PASS
-            || self.batch.len() + self.staged.len() == self.batch_rows
-        {
-            self.store();
-        }
-    }
-
-    /// Converts the staged rows into the batch, which is handed out once
-    /// full.
-    fn store(&mut self) {
-        self.batch.store(self.staged.iter());
-        self.staged.clear();
-        if self.batch.len() == self.batch_rows {
-            self.full.push(self.batch.take());
-            self.batches += 1;
+        let window = self.window;
+        let keeps = move |row: &&RowParts| {
+            window.contains(rows::seconds(row.frame.t_us), row.utc_us.map(|u| u / 1000))
+        };
+        let mut rest = rows;
+        while !rest.is_empty() {
+            // The rows up to the one that fills the batch, or the rest.
+            let room = self.batch_rows - self.batch.len();
+            let (mut n, mut kept) = (0, 0);
+            while n < rest.len() && kept < room {
+                kept += usize::from(keeps(&&rest[n]));
+                n += 1;
+            }
+            let run = &rest[..n];
+            if window.is_all() {
+                self.batch.store(run.iter());
+            } else {
+                self.batch.store(run.iter().filter(keeps));
+            }
+            self.kept += kept;
+            if self.batch.len() == self.batch_rows {
+                self.full.push(self.batch.take());
+                self.batches += 1;
+            }
+            rest = &rest[run.len()..];
         }
     }
 }
@@ -365,24 +364,22 @@ mod tests {
     }
 
     #[test]
-    fn rows_are_converted_once_half_a_second_older_than_the_last_frame() {
-        let mut columns = FrameColumns::new(&COLUMNS, TimeWindow::default(), 149).unwrap();
-        for i in 0..200u64 {
+    fn rows_are_converted_in_runs_once_half_a_second_older_than_the_last_frame() {
+        let mut columns = FrameColumns::new(&COLUMNS, TimeWindow::default(), 100).unwrap();
+        for i in 0..400u64 {
             columns.push(&Record::Frame(Frame {
                 t_us: i * 10_000,
                 ..Frame::default()
             }));
-            // The frame at 1.99 s completes the rows up to 1.48 s: 149.
-            assert_eq!(
-                columns.take_full().len(),
-                usize::from(i == 199),
-                "frame {i}"
-            );
+            // The frame at 3.06 s completes the rows up to 2.55 s: a run of
+            // 256, two batches and some.
+            let expected = if i == 306 { 2 } else { 0 };
+            assert_eq!(columns.take_full().len(), expected, "frame {i}");
         }
         let finished = columns.finish();
-        assert_eq!(finished.rows, 200);
-        assert_eq!(finished.batches.len(), 1);
-        assert_eq!(finished.batches[0][0].len(), 51);
+        assert_eq!(finished.rows, 400);
+        let sizes: Vec<usize> = finished.batches.iter().map(|b| b[0].len()).collect();
+        assert_eq!(sizes, [100, 100]);
     }
 
     #[test]

@@ -20,6 +20,9 @@ const GPS_WAIT_US: u64 = 500_000;
 /// Most rows held back, whatever the frame times say (0.5 s at 100 Hz is
 /// 50): times that stand still cannot make the assembler hoard memory.
 const MAX_PENDING_ROWS: usize = 4096;
+/// Complete rows are handed out this many at a time (or fewer, when every
+/// row is), so that those who take them can work on a few hundred at once.
+const COMPLETE_RUN: usize = 256;
 
 /// A row as assembled: its frame, and what fills it.
 #[derive(Clone, Copy, Debug)]
@@ -33,13 +36,15 @@ pub struct RowParts {
 }
 
 /// Decides, record by record, what fills each row and when it is complete;
-/// the rows wait here meanwhile. Memory is bounded: at most
-/// [`MAX_PENDING_ROWS`] wait.
+/// the rows wait here meanwhile, and complete rows until a run of them is
+/// handed out. Memory is bounded: at most [`MAX_PENDING_ROWS`] wait.
 #[derive(Default)]
 pub struct Assembly {
-    /// Rows pending, oldest first (their times never decrease: time going
-    /// back completes them all).
-    pending: VecDeque<RowParts>,
+    /// The rows, oldest first: `complete` complete ones, then the pending
+    /// ones (whose times never decrease: time going back completes them
+    /// all).
+    rows: VecDeque<RowParts>,
+    complete: usize,
     /// The fix in force: its time and columns.
     fix: Option<(u64, GpsColumns)>,
     sync: Option<UtcSync>,
@@ -47,17 +52,17 @@ pub struct Assembly {
 
 impl Assembly {
     /// Takes one record (frames, fixes and sync pairs matter; the others
-    /// are passed over); hands every row now complete to `complete`, in
-    /// order.
-    pub fn push(&mut self, record: &Record<'_>, complete: &mut impl FnMut(&RowParts)) {
+    /// are passed over); hands complete rows to `out`, in order, a run at a
+    /// time.
+    pub fn push(&mut self, record: &Record<'_>, out: &mut impl FnMut(&[RowParts])) {
         match record {
-            Record::Frame(frame) => self.frame(frame, complete),
+            Record::Frame(frame) => self.frame(frame, out),
             Record::Gps(fix) => {
                 let newer = self.fix.is_none_or(|(t, _)| fix.t_us >= t);
                 if newer {
                     let columns = GpsColumns::from_fix(fix);
                     self.fix = columns.map(|c| (fix.t_us, c));
-                    for row in &mut self.pending {
+                    for row in self.pending() {
                         let t = row.frame.t_us;
                         if t >= fix.t_us {
                             row.gps = columns.filter(|_| t - fix.t_us <= GPS_STALE_US);
@@ -68,7 +73,7 @@ impl Assembly {
             // Like a fix, a pair is stamped before frames written ahead of it.
             Record::UtcSync(sync) if self.sync.is_none_or(|s| sync.t_us >= s.t_us) => {
                 self.sync = Some(*sync);
-                for row in &mut self.pending {
+                for row in self.pending() {
                     let t = row.frame.t_us;
                     if t >= sync.t_us {
                         row.utc_us = utc_us_at(*sync, t);
@@ -79,19 +84,20 @@ impl Assembly {
         }
     }
 
-    fn frame(&mut self, frame: &Frame, complete: &mut impl FnMut(&RowParts)) {
+    /// The rows still pending.
+    fn pending(&mut self) -> impl Iterator<Item = &mut RowParts> {
+        self.rows.iter_mut().skip(self.complete)
+    }
+
+    fn frame(&mut self, frame: &Frame, out: &mut impl FnMut(&[RowParts])) {
         // Time going back starts a new segment: nothing waits across it,
         // and a fix from before it fills no row after it.
-        if self
-            .pending
-            .back()
-            .is_some_and(|r| frame.t_us < r.frame.t_us)
-        {
-            self.finish(complete);
+        if self.rows.back().is_some_and(|r| frame.t_us < r.frame.t_us) {
+            self.finish(out);
             self.fix = None;
         }
-        if self.pending.len() >= MAX_PENDING_ROWS {
-            self.complete_first(complete);
+        if self.rows.len() - self.complete >= MAX_PENDING_ROWS {
+            self.complete += 1;
         }
         let gps = self
             .fix
@@ -101,31 +107,40 @@ impl Assembly {
             .sync
             .filter(|s| s.t_us <= frame.t_us)
             .and_then(|s| utc_us_at(s, frame.t_us));
-        self.pending.push_back(RowParts {
+        self.rows.push_back(RowParts {
             frame: *frame,
             gps,
             utc_us,
         });
         while self
-            .pending
-            .front()
+            .rows
+            .get(self.complete)
             .is_some_and(|r| r.frame.t_us + GPS_WAIT_US < frame.t_us)
         {
-            self.complete_first(complete);
+            self.complete += 1;
+        }
+        if self.complete >= COMPLETE_RUN {
+            self.hand_out(out);
         }
     }
 
-    /// Completes every row still held back.
-    pub fn finish(&mut self, complete: &mut impl FnMut(&RowParts)) {
-        while !self.pending.is_empty() {
-            self.complete_first(complete);
-        }
+    /// Completes every row still held back, and hands out every row.
+    pub fn finish(&mut self, out: &mut impl FnMut(&[RowParts])) {
+        self.complete = self.rows.len();
+        self.hand_out(out);
     }
 
-    fn complete_first(&mut self, complete: &mut impl FnMut(&RowParts)) {
-        if let Some(row) = self.pending.pop_front() {
-            complete(&row);
+    /// Hands out the complete rows (in two slices where the ring wraps).
+    fn hand_out(&mut self, out: &mut impl FnMut(&[RowParts])) {
+        let (first, second) = self.rows.as_slices();
+        let in_first = self.complete.min(first.len());
+        for run in [&first[..in_first], &second[..self.complete - in_first]] {
+            if !run.is_empty() {
+                out(run);
+            }
         }
+        self.rows.drain(..self.complete);
+        self.complete = 0;
     }
 }
 
@@ -270,6 +285,24 @@ mod tests {
         records.push(fix(0, Some(45)));
         records.extend([frame(100), frame(110)]);
         assert!(rows_of(&records).iter().all(|r| r.1 == Some(45.0)));
+    }
+
+    #[test]
+    fn frames_whose_time_stands_still_wait_in_bounded_numbers() {
+        let mut assembler = RowAssembler::new();
+        let mut emitted = 0;
+        for pushed in 1..=10_000 {
+            assembler.push(&frame(5), &mut |_| emitted += 1);
+            // Handed out a run at a time: never more than the bound and a
+            // run held.
+            assert!(
+                pushed - emitted < MAX_PENDING_ROWS + COMPLETE_RUN,
+                "{pushed}"
+            );
+        }
+        assert!(emitted > 0);
+        assembler.finish(&mut |_| emitted += 1);
+        assert_eq!(emitted, 10_000);
     }
 
     #[test]
