@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use std::sync::Arc;
 
 use arrow_array::ffi_stream::FFI_ArrowArrayStream;
-use arrow_array::{ArrayRef, Int64Array, RecordBatch, StringArray};
+use arrow_array::{ArrayRef, Int64Array, RecordBatch, StringViewArray};
 use arrow_schema::{ArrowError, DataType, Field, Schema, SchemaRef};
 use pyo3::prelude::*;
 use pyo3::types::PyCapsule;
@@ -54,7 +54,7 @@ pub fn scan(
         .collect();
     fields.push(Field::new("run", DataType::Int64, false));
     if entries.iter().any(|e| e.card.is_some()) {
-        fields.push(Field::new("card", DataType::Utf8, false));
+        fields.push(Field::new("card", DataType::Utf8View, false));
     }
     Ok(Scan {
         entries,
@@ -195,7 +195,7 @@ impl LogByLog {
                 arrays.push(Arc::new(Int64Array::from(vec![i64::from(entry.run); n])));
                 if self.schema.fields().len() > arrays.len() {
                     let card = entry.card.clone().unwrap_or_default();
-                    arrays.push(Arc::new(StringArray::from(vec![card; n])));
+                    arrays.push(Arc::new(StringViewArray::from(vec![card; n])));
                 }
                 RecordBatch::try_new(self.schema.clone(), arrays)
             })

@@ -7,10 +7,10 @@
 use std::sync::Arc;
 
 use arrow_array::{
-    ArrayRef, BooleanArray, Float64Array, Int64Array, RecordBatch, StringArray,
+    ArrayRef, BooleanArray, Float64Array, Int64Array, RecordBatch, StringViewArray,
     TimestampMicrosecondArray,
 };
-use arrow_buffer::{NullBuffer, OffsetBuffer};
+use arrow_buffer::NullBuffer;
 use arrow_schema::{ArrowError, DataType, Field, Schema, SchemaRef, TimeUnit};
 use wobblog::export::columnar::{buffers, ColumnBuffers, Values};
 use wobblog::export::columns::{Column, Kind};
@@ -23,7 +23,8 @@ pub const BATCH_ROWS: usize = 1 << 16;
 fn data_type(kind: Kind) -> DataType {
     match kind {
         Kind::Number | Kind::OptNumber => DataType::Float64,
-        Kind::Label | Kind::Text => DataType::Utf8,
+        // As Polars holds text: it takes these columns without a copy.
+        Kind::Label | Kind::Text => DataType::Utf8View,
         Kind::Utc => DataType::Timestamp(TimeUnit::Microsecond, Some("UTC".into())),
         Kind::Integer => DataType::Int64,
         Kind::Bool => DataType::Boolean,
@@ -51,28 +52,14 @@ fn array(values: Values) -> ArrayRef {
     match values {
         Values::Number(v) => Arc::new(Float64Array::new(v.into(), None)),
         Values::OptNumber(v, present) => Arc::new(Float64Array::new(v.into(), nulls(present))),
-        Values::Label(v) => Arc::new(labels(&v)),
-        Values::Text(v) => Arc::new(StringArray::from(v)),
+        Values::Label(v) => Arc::new(StringViewArray::from_iter(v)),
+        Values::Text(v) => Arc::new(StringViewArray::from_iter(v)),
         Values::Utc(v, present) => {
             Arc::new(TimestampMicrosecondArray::new(v.into(), nulls(present)).with_timezone("UTC"))
         }
         Values::Integer(v, present) => Arc::new(Int64Array::new(v.into(), nulls(present))),
         Values::Bool(v, present) => Arc::new(BooleanArray::new(v.into(), nulls(present))),
     }
-}
-
-/// Names from a small set (a few bytes each) as a string array, laid out
-/// in one pass.
-fn labels(values: &[Option<&str>]) -> StringArray {
-    let mut bytes = Vec::with_capacity(4 * values.len());
-    let offsets = OffsetBuffer::from_lengths(values.iter().map(|v| {
-        let s = v.unwrap_or_default();
-        bytes.extend_from_slice(s.as_bytes());
-        s.len()
-    }));
-    let nulls = NullBuffer::from_iter(values.iter().map(Option::is_some));
-    let nulls = (nulls.null_count() > 0).then_some(nulls);
-    StringArray::new(offsets, bytes.into(), nulls)
 }
 
 /// Rows of `R` turned into record batches of [`BATCH_ROWS`] rows.

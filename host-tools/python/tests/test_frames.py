@@ -31,7 +31,9 @@ def assert_same_table(ours: pa.Table, theirs: pa.Table):
     assert ours.num_rows == theirs.num_rows
     for name in ours.column_names:
         a, b = ours.column(name), theirs.column(name)
-        assert a.type == b.type, name
+        # Text is held as Polars holds it; Parquet has no such type.
+        expected = pa.string_view() if b.type == pa.string() else b.type
+        assert a.type == expected, name
         assert a.to_pylist() == b.to_pylist(), name
 
 
