@@ -105,6 +105,9 @@ struct Handover<'o, O> {
     observer: &'o mut O,
     send: std::sync::mpsc::SyncSender<Handed>,
     batch: Vec<Record<'static>>,
+    /// Batches the builder is done with, to fill again: a few vectors go
+    /// back and forth instead of fresh memory for every batch.
+    emptied: std::sync::mpsc::Receiver<Vec<Record<'static>>>,
     has_utc: bool,
 }
 
@@ -118,8 +121,11 @@ impl<O: Observer> Handover<'_, O> {
         if let Some(owned) = row_record(record) {
             self.batch.push(owned);
             if self.batch.len() == RECORDS_PER_HANDOVER {
-                let full =
-                    std::mem::replace(&mut self.batch, Vec::with_capacity(RECORDS_PER_HANDOVER));
+                let empty = self
+                    .emptied
+                    .try_recv()
+                    .unwrap_or_else(|_| Vec::with_capacity(RECORDS_PER_HANDOVER));
+                let full = std::mem::replace(&mut self.batch, empty);
                 if self.send.send(Handed::Records(full)).is_err() {
                     // The builder stopped (Ctrl-C).
                     return ControlFlow::Break(());
@@ -142,6 +148,7 @@ impl<O: Observer> Handover<'_, O> {
 /// batch as soon as [`BATCH_ROWS`] rows are complete.
 fn build(
     records: std::sync::mpsc::Receiver<Handed>,
+    emptied: std::sync::mpsc::Sender<Vec<Record<'static>>>,
     frames: FrameColumns,
     schema: &SchemaRef,
 ) -> Built {
@@ -153,7 +160,7 @@ fn build(
     };
     let mut since_check = 0;
     for handed in &records {
-        let batch = match handed {
+        let mut batch = match handed {
             Handed::Records(batch) => batch,
             Handed::Restart => {
                 built.frames.restart();
@@ -173,6 +180,9 @@ fn build(
         // Python runs signal handlers on its main thread only: the one that
         // called, this one.
         since_check += batch.len();
+        batch.clear();
+        // A decoder that has finished takes none back.
+        let _ = emptied.send(batch);
         if since_check >= RECORDS_PER_SIGNAL_CHECK {
             since_check = 0;
             if let Err(e) = Python::attach(|py| py.check_signals()) {
@@ -206,11 +216,13 @@ pub fn walk(
     let schema = schema(columns);
     let (walked, has_utc, built) = std::thread::scope(|scope| {
         let (send, records) = std::sync::mpsc::sync_channel(8);
+        let (give_back, emptied) = std::sync::mpsc::channel();
         let decoder = scope.spawn(move || {
             let handover = RefCell::new(Handover {
                 observer,
                 send,
                 batch: Vec::with_capacity(RECORDS_PER_HANDOVER),
+                emptied,
                 has_utc: false,
             });
             let walked = read_log_restarting(
@@ -225,7 +237,7 @@ pub fn walk(
         });
         // The rows are built on this thread, the caller's, where Python
         // looks for Ctrl-C.
-        let built = build(records, frames, &schema);
+        let built = build(records, give_back, frames, &schema);
         let (walked, has_utc) = match decoder.join() {
             Ok(done) => done,
             Err(panic) => std::panic::resume_unwind(panic),
