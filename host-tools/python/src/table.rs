@@ -52,7 +52,7 @@ fn array(values: Values) -> ArrayRef {
     match values {
         Values::Number(v) => Arc::new(Float64Array::new(v.into(), None)),
         Values::OptNumber(v, present) => Arc::new(Float64Array::new(v.into(), nulls(present))),
-        Values::Label(v) => Arc::new(StringViewArray::from_iter(v)),
+        Values::Label(v) => Arc::new(labels(&v)),
         Values::Text(v) => Arc::new(StringViewArray::from_iter(v)),
         Values::Utc(v, present) => {
             Arc::new(TimestampMicrosecondArray::new(v.into(), nulls(present)).with_timezone("UTC"))
@@ -60,6 +60,31 @@ fn array(values: Values) -> ArrayRef {
         Values::Integer(v, present) => Arc::new(Int64Array::new(v.into(), nulls(present))),
         Values::Bool(v, present) => Arc::new(BooleanArray::new(v.into(), nulls(present))),
     }
+}
+
+/// Longest text a string view holds in itself.
+const INLINE_VIEW_LEN: usize = 12;
+
+/// Names from a small set (`2d`, `3d`, ...) as string views: a name short
+/// enough lives in its view, so each row's view is made without the
+/// builder's per-row bookkeeping; longer names go through the builder.
+fn labels(values: &[Option<&str>]) -> StringViewArray {
+    let inline = |name: &str| {
+        let mut view = [0u8; 16];
+        view[..4].copy_from_slice(&(name.len() as u32).to_le_bytes());
+        view[4..4 + name.len()].copy_from_slice(name.as_bytes());
+        u128::from_le_bytes(view)
+    };
+    let built = || StringViewArray::from_iter(values.iter().copied());
+    let short = |v: &Option<&str>| v.is_none_or(|name| name.len() <= INLINE_VIEW_LEN);
+    if !values.iter().all(short) {
+        return built();
+    }
+    let views: Vec<u128> = values.iter().map(|v| v.map_or(0, inline)).collect();
+    let nulls = NullBuffer::from_iter(values.iter().map(Option::is_some));
+    let nulls = (nulls.null_count() > 0).then_some(nulls);
+    // Valid by construction; the builder, should Arrow think otherwise.
+    StringViewArray::try_new(views.into(), Vec::new(), nulls).unwrap_or_else(|_| built())
 }
 
 /// Rows of `R` turned into record batches of [`BATCH_ROWS`] rows.

@@ -7,8 +7,6 @@
 //! [`GPS_WAIT_US`] so such a fix still fills them. A UTC sync pair is
 //! stamped the same way.
 
-use std::collections::VecDeque;
-
 use wobble_core::format::{Frame, Record, UtcSync};
 
 use super::GpsColumns;
@@ -43,7 +41,7 @@ pub struct Assembly {
     /// The rows, oldest first: `complete` complete ones, then the pending
     /// ones (whose times never decrease: time going back completes them
     /// all).
-    rows: VecDeque<RowParts>,
+    rows: Vec<RowParts>,
     complete: usize,
     /// The fix in force: its time and columns.
     fix: Option<(u64, GpsColumns)>,
@@ -86,13 +84,13 @@ impl Assembly {
 
     /// The rows still pending.
     fn pending(&mut self) -> impl Iterator<Item = &mut RowParts> {
-        self.rows.iter_mut().skip(self.complete)
+        self.rows[self.complete..].iter_mut()
     }
 
     fn frame(&mut self, frame: &Frame, out: &mut impl FnMut(&[RowParts])) {
         // Time going back starts a new segment: nothing waits across it,
         // and a fix from before it fills no row after it.
-        if self.rows.back().is_some_and(|r| frame.t_us < r.frame.t_us) {
+        if self.rows.last().is_some_and(|r| frame.t_us < r.frame.t_us) {
             self.finish(out);
             self.fix = None;
         }
@@ -107,7 +105,7 @@ impl Assembly {
             .sync
             .filter(|s| s.t_us <= frame.t_us)
             .and_then(|s| utc_us_at(s, frame.t_us));
-        self.rows.push_back(RowParts {
+        self.rows.push(RowParts {
             frame: *frame,
             gps,
             utc_us,
@@ -130,14 +128,11 @@ impl Assembly {
         self.hand_out(out);
     }
 
-    /// Hands out the complete rows (in two slices where the ring wraps).
+    /// Hands out the complete rows; the pending ones (a few dozen) move
+    /// to the front.
     fn hand_out(&mut self, out: &mut impl FnMut(&[RowParts])) {
-        let (first, second) = self.rows.as_slices();
-        let in_first = self.complete.min(first.len());
-        for run in [&first[..in_first], &second[..self.complete - in_first]] {
-            if !run.is_empty() {
-                out(run);
-            }
+        if self.complete > 0 {
+            out(&self.rows[..self.complete]);
         }
         self.rows.drain(..self.complete);
         self.complete = 0;
