@@ -50,18 +50,30 @@ def encode(directory, minutes, run=1):
     return log
 
 
-def best_of(n, work):
-    """The shortest wall-clock time of `n` runs of `work`, and the shortest
-    CPU time of this process (every thread) over them, s: on a loaded
-    machine the CPU time shows the work done, the wall time also the waits."""
-    times, cpu = [], []
+def timed(work):
+    """Wall-clock and CPU time of this process (every thread) of one run of
+    `work`, s: on a loaded machine the CPU time shows the work done, the
+    wall time also the waits."""
+    start, start_cpu = time.perf_counter(), time.process_time()
+    result = work()
+    elapsed = time.perf_counter() - start, time.process_time() - start_cpu
+    del result
+    return elapsed
+
+
+def alternated(n, works):
+    """`n` runs of each of `works`, taken in turn (so that neither gains
+    from the other's warm caches or a quiet spell of the machine): for each,
+    the shortest and the median wall time and the shortest CPU time, s."""
+    runs = [[] for _ in works]
     for _ in range(n):
-        start, start_cpu = time.perf_counter(), time.process_time()
-        result = work()
-        times.append(time.perf_counter() - start)
-        cpu.append(time.process_time() - start_cpu)
-        del result
-    return min(times), min(cpu)
+        for times, work in zip(runs, works):
+            times.append(timed(work))
+    figures = []
+    for times in runs:
+        wall = sorted(t for t, _ in times)
+        figures.append((wall[0], wall[len(wall) // 2], min(c for _, c in times)))
+    return figures
 
 
 def peak_rss_mib(code):
@@ -89,14 +101,20 @@ def main():
         df = wobblog.open(log).frames().to_polars()
         assert df.equals(pl.read_parquet(parquet))
         size_mib = df.estimated_size() / 2**20
-        (ours, ours_cpu) = best_of(5, lambda: wobblog.open(log).frames().to_polars())
-        (opening, _) = best_of(5, lambda: wobblog.open(log))
-        (theirs, theirs_cpu) = best_of(5, lambda: pl.read_parquet(parquet))
-        print(f"{df.height} frames ({args.minutes} min), DataFrame {size_mib:.1f} MiB")
-        print(f"wobblog.open(p).frames().to_polars(): {ours * 1e3:.0f} ms, CPU {ours_cpu * 1e3:.0f} ms "
-              f"(of which open, the decoding: {opening * 1e3:.0f} ms)")
-        print(f"polars.read_parquet:                  {theirs * 1e3:.0f} ms, CPU {theirs_cpu * 1e3:.0f} ms")
-        print(f"ratio: {ours / theirs:.2f} (CPU time: {ours_cpu / theirs_cpu:.2f})")
+        ours, opening, theirs = alternated(15, [
+            lambda: wobblog.open(log).frames().to_polars(),
+            lambda: wobblog.open(log),
+            lambda: pl.read_parquet(parquet),
+        ])
+        print(f"{df.height} frames ({args.minutes} min), DataFrame {size_mib:.1f} MiB; "
+              "best and median of 15 runs taken in turn")
+        print(f"wobblog.open(p).frames().to_polars(): {ours[0] * 1e3:.1f} ms, median "
+              f"{ours[1] * 1e3:.1f} ms, CPU {ours[2] * 1e3:.0f} ms (of which open, the decoding: "
+              f"{opening[0] * 1e3:.1f} ms)")
+        print(f"polars.read_parquet:                  {theirs[0] * 1e3:.1f} ms, median "
+              f"{theirs[1] * 1e3:.1f} ms, CPU {theirs[2] * 1e3:.0f} ms")
+        print(f"ratio: {ours[0] / theirs[0]:.2f}, of the medians {ours[1] / theirs[1]:.2f} "
+              f"(CPU time: {ours[2] / theirs[2]:.2f})")
         base = peak_rss_mib("import polars, wobblog")
         peak = peak_rss_mib(f"import polars, wobblog; "
                             f"df = wobblog.open({str(log)!r}).frames().to_polars()")
