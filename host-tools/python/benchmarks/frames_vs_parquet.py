@@ -2,7 +2,7 @@
 same frames from Parquet, in one process; prints times, ratios and peak
 memory. Usage (from the repository root, the package and polars installed):
 
-    python host-tools/python/benchmarks/frames_vs_parquet.py [--minutes 60] [--logs 20] [--scan-minutes 10]
+    python host-tools/python/benchmarks/frames_vs_parquet.py [--minutes 60] [--logs 20] [--scan-minutes 10] [--no-gps]
 
 The CLI (`WOBBLOG_CLI`, else the release build in the target directory)
 encodes a synthetic ride of that length and decodes it to Parquet first.
@@ -15,6 +15,7 @@ import subprocess
 import sys
 import tempfile
 import time
+from datetime import datetime, timedelta, timezone
 from pathlib import Path
 
 import polars as pl
@@ -31,19 +32,30 @@ def cli():
     return str(target / "release" / "wobblog")
 
 
-def encode(directory, minutes, run=1):
+def encode(directory, minutes, run=1, gps=True):
     """A ride of `minutes` at 100 Hz with every IMU channel moving (a
-    different weave per `run`, so no two logs are copies)."""
+    different weave per `run`, so no two logs are copies) and, with `gps`,
+    a 3D fix moving north every 50 ms (20 Hz, as the receiver sends them)
+    and UTC in every row, as outdoors."""
     csv = directory / f"ride{run}.csv"
     weave_hz = 0.6 + 0.01 * run
+    start = datetime(2026, 6, 1, 10, 0, tzinfo=timezone.utc)
     with csv.open("w") as f:
-        f.write("t_s,ax_g,ay_g,az_g,gx_dps,gy_dps,gz_dps,steer_deg,speed_mps\n")
+        gps_header = ",gps_lat_deg,gps_lon_deg,gps_speed_mps,gps_fix,utc" if gps else ""
+        f.write(f"t_s,ax_g,ay_g,az_g,gx_dps,gy_dps,gz_dps,steer_deg,speed_mps{gps_header}\n")
         for i in range(minutes * 60 * 100):
             t = i / 100
             s = math.sin(2 * math.pi * 6.4 * t)
             w = math.sin(2 * math.pi * weave_hz * t)
             f.write(f"{t:.2f},{0.01 * s:.4f},{0.1 * w:.4f},1.0,{5 * w:.3f},"
-                    f"{2 * s:.3f},{3 * w:.3f},{s + 2 * w:.2f},{4 + 0.5 * w:.3f}\n")
+                    f"{2 * s:.3f},{3 * w:.3f},{s + 2 * w:.2f},{4 + 0.5 * w:.3f}")
+            if gps:
+                fix_s = i // 5 * 0.05
+                utc = (start + timedelta(milliseconds=10 * i)).isoformat(timespec="milliseconds")
+                speed = 4 + 0.5 * math.sin(2 * math.pi * weave_hz * fix_s)
+                f.write(f",{52 + 4e-5 * fix_s:.7f},{4.5:.7f},{speed:.2f},3d,"
+                        f"{utc.replace('+00:00', 'Z')}")
+            f.write("\n")
     log = directory / f"RUN{run:05d}.WBL"
     subprocess.run([cli(), "encode", "--csv", csv, "-o", log], check=True)
     csv.unlink()
@@ -92,10 +104,12 @@ def main():
     parser.add_argument("--minutes", type=int, default=60)
     parser.add_argument("--logs", type=int, default=20)
     parser.add_argument("--scan-minutes", type=int, default=10)
+    parser.add_argument("--no-gps", action="store_true",
+                        help="rides without GPS or UTC (indoors, on rollers)")
     args = parser.parse_args()
     with tempfile.TemporaryDirectory() as tmp:
         directory = Path(tmp)
-        log = encode(directory, args.minutes)
+        log = encode(directory, args.minutes, gps=not args.no_gps)
         parquet = directory / "ride.parquet"
         subprocess.run([cli(), "decode", log, "-o", parquet], check=True)
         df = wobblog.open(log).frames().to_polars()
@@ -106,7 +120,8 @@ def main():
             lambda: wobblog.open(log),
             lambda: pl.read_parquet(parquet),
         ])
-        print(f"{df.height} frames ({args.minutes} min), DataFrame {size_mib:.1f} MiB; "
+        what = "IMU only" if args.no_gps else "IMU, 20 Hz GPS and UTC"
+        print(f"{df.height} frames ({args.minutes} min, {what}), DataFrame {size_mib:.1f} MiB; "
               "best and median of 15 runs taken in turn")
         print(f"wobblog.open(p).frames().to_polars(): {ours[0] * 1e3:.1f} ms, median "
               f"{ours[1] * 1e3:.1f} ms, CPU {ours[2] * 1e3:.0f} ms (of which open, the decoding: "
@@ -127,7 +142,7 @@ def main():
             card = directory / f"card{n}"
             card.mkdir()
             for run in range(n):
-                encode(card, args.scan_minutes, run)
+                encode(card, args.scan_minutes, run, gps=not args.no_gps)
             code = (f"import pyarrow as pa, wobblog; r = pa.RecordBatchReader.from_stream("
                     f"wobblog.scan({str(card)!r})); n = sum(b.num_rows for b in r)")
             peaks.append(peak_rss_mib(code) - base)

@@ -8,7 +8,7 @@ use std::sync::Arc;
 
 use arrow_array::{
     ArrayRef, BooleanArray, Float64Array, Int64Array, RecordBatch, StringViewArray,
-    TimestampMicrosecondArray,
+    TimestampMicrosecondArray, UInt32Array,
 };
 use arrow_buffer::NullBuffer;
 use arrow_schema::{ArrowError, DataType, Field, Schema, SchemaRef, TimeUnit};
@@ -45,14 +45,12 @@ pub fn schema<R>(columns: &[Column<R>]) -> SchemaRef {
 /// (text is laid out anew).
 fn array(values: Values) -> ArrayRef {
     // A validity bitmap only where a row lacks its value.
-    let nulls = |present: Vec<bool>| {
-        let nulls = NullBuffer::from(present);
-        (nulls.null_count() > 0).then_some(nulls)
-    };
+    let nulls =
+        |present: Vec<bool>| (!present.iter().all(|&p| p)).then(|| NullBuffer::from(present));
     match values {
         Values::Number(v) => Arc::new(Float64Array::new(v.into(), None)),
         Values::OptNumber(v, present) => Arc::new(Float64Array::new(v.into(), nulls(present))),
-        Values::Label(v) => Arc::new(labels(&v)),
+        Values::Label(v) => labels(&v),
         Values::Text(v) => Arc::new(StringViewArray::from_iter(v)),
         Values::Utc(v, present) => {
             Arc::new(TimestampMicrosecondArray::new(v.into(), nulls(present)).with_timezone("UTC"))
@@ -62,29 +60,34 @@ fn array(values: Values) -> ArrayRef {
     }
 }
 
-/// Longest text a string view holds in itself.
-const INLINE_VIEW_LEN: usize = 12;
-
-/// Names from a small set (`2d`, `3d`, ...) as string views: a name short
-/// enough lives in its view, so each row's view is made without the
-/// builder's per-row bookkeeping; longer names go through the builder.
-fn labels(values: &[Option<&str>]) -> StringViewArray {
-    let inline = |name: &str| {
-        let mut view = [0u8; 16];
-        view[..4].copy_from_slice(&(name.len() as u32).to_le_bytes());
-        view[4..4 + name.len()].copy_from_slice(name.as_bytes());
-        u128::from_le_bytes(view)
+/// Names from a small set (`2d`, `3d`, ...) as string views: each name's
+/// view is made once, and each row's picked from those by its index (per
+/// row, only an index and a copy, not a string built and checked).
+fn labels<'a>(values: &[Option<&'a str>]) -> ArrayRef {
+    let mut names: Vec<&'a str> = Vec::new();
+    // Names are nearly always the same few `&'static str`s: their
+    // addresses are compared before their bytes.
+    let same = |a: &str, b: &str| std::ptr::eq(a, b) || a == b;
+    let mut index_of = |name: &'a str| match names.iter().position(|n| same(n, name)) {
+        Some(i) => i,
+        None => {
+            names.push(name);
+            names.len() - 1
+        }
     };
-    let built = || StringViewArray::from_iter(values.iter().copied());
-    let short = |v: &Option<&str>| v.is_none_or(|name| name.len() <= INLINE_VIEW_LEN);
-    if !values.iter().all(short) {
-        return built();
+    let indices: Vec<u32> = values
+        .iter()
+        // Fewer names than 2^32 in a column of fewer rows.
+        .map(|v| v.map_or(0, |name| index_of(name) as u32))
+        .collect();
+    if names.is_empty() {
+        return Arc::new(StringViewArray::new_null(values.len()));
     }
-    let views: Vec<u128> = values.iter().map(|v| v.map_or(0, inline)).collect();
-    let nulls = NullBuffer::from_iter(values.iter().map(Option::is_some));
-    let nulls = (nulls.null_count() > 0).then_some(nulls);
-    // Valid by construction; the builder, should Arrow think otherwise.
-    StringViewArray::try_new(views.into(), Vec::new(), nulls).unwrap_or_else(|_| built())
+    let nulls = (!values.iter().all(Option::is_some))
+        .then(|| NullBuffer::from_iter(values.iter().map(Option::is_some)));
+    let names = StringViewArray::from_iter_values(names);
+    arrow_select::take::take(&names, &UInt32Array::new(indices.into(), nulls), None)
+        .unwrap_or_else(|_| Arc::new(StringViewArray::from_iter(values.iter().copied())))
 }
 
 /// Rows of `R` turned into record batches of [`BATCH_ROWS`] rows.

@@ -60,31 +60,30 @@ impl Assembly {
                 if newer {
                     let columns = GpsColumns::from_fix(fix);
                     self.fix = columns.map(|c| (fix.t_us, c));
-                    for row in self.pending() {
+                    for row in self.pending_from(fix.t_us) {
                         let t = row.frame.t_us;
-                        if t >= fix.t_us {
-                            row.gps = columns.filter(|_| t - fix.t_us <= GPS_STALE_US);
-                        }
+                        row.gps = columns.filter(|_| t - fix.t_us <= GPS_STALE_US);
                     }
                 }
             }
             // Like a fix, a pair is stamped before frames written ahead of it.
             Record::UtcSync(sync) if self.sync.is_none_or(|s| sync.t_us >= s.t_us) => {
                 self.sync = Some(*sync);
-                for row in self.pending() {
-                    let t = row.frame.t_us;
-                    if t >= sync.t_us {
-                        row.utc_us = utc_us_at(*sync, t);
-                    }
+                for row in self.pending_from(sync.t_us) {
+                    row.utc_us = utc_us_at(*sync, row.frame.t_us);
                 }
             }
             _ => {}
         }
     }
 
-    /// The rows still pending.
-    fn pending(&mut self) -> impl Iterator<Item = &mut RowParts> {
-        self.rows[self.complete..].iter_mut()
+    /// The rows still pending from time `t_us` on, latest first (their
+    /// times never decrease: only those at the back are looked at).
+    fn pending_from(&mut self, t_us: u64) -> impl Iterator<Item = &mut RowParts> {
+        self.rows[self.complete..]
+            .iter_mut()
+            .rev()
+            .take_while(move |row| row.frame.t_us >= t_us)
     }
 
     fn frame(&mut self, frame: &Frame, out: &mut impl FnMut(&[RowParts])) {
