@@ -17,9 +17,6 @@ pub const TAG_FRAME: u8 = 0x01;
 /// Bytes of a frame after its time delta: six IMU words, steering, wheel
 /// count, edge age and speed (two bytes each), the status byte.
 const FRAME_FIXED_LEN: usize = 2 * 10 + 1;
-/// The fewest bytes a frame takes on the card (tag, a one-byte time
-/// delta, the fixed part): a log of `n` bytes holds at most `n / 23` frames.
-pub const FRAME_MIN_LEN: usize = 1 + 1 + FRAME_FIXED_LEN;
 /// Tag: GPS fix.
 pub const TAG_GPS: u8 = 0x02;
 /// Tag: UTC sync pair.
