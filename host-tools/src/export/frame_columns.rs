@@ -31,7 +31,7 @@ struct Complete {
     batch_rows: usize,
     /// Full batches not yet taken.
     full: Vec<Vec<Values>>,
-    /// Rows kept so far, and batches handed out.
+    /// Rows kept so far, and batches filled.
     kept: usize,
     batches: usize,
     /// Of every complete row, kept or not: the earliest and latest frame
@@ -118,7 +118,7 @@ impl FrameColumns {
         let complete = &mut self.complete;
         self.assembly.finish(&mut |rows| complete.take(rows));
         let mut c = self.complete;
-        if c.batch.len() > 0 || c.batches + c.full.len() == 0 {
+        if c.batch.len() > 0 || c.batches == 0 {
             c.full.push(c.batch.into_values());
         }
         Finished {
@@ -379,6 +379,19 @@ mod tests {
         let finished = columns.finish();
         assert_eq!(finished.rows, 400);
         let sizes: Vec<usize> = finished.batches.iter().map(|b| b[0].len()).collect();
+        assert_eq!(sizes, [100, 100]);
+    }
+
+    #[test]
+    fn rows_that_fill_whole_batches_leave_no_empty_batch_after_them() {
+        let mut columns = FrameColumns::new(&COLUMNS, TimeWindow::default(), 100).unwrap();
+        for i in 0..200u64 {
+            columns.push(&Record::Frame(Frame {
+                t_us: i * 10_000,
+                ..Frame::default()
+            }));
+        }
+        let sizes: Vec<usize> = columns.finish().batches.iter().map(|b| b[0].len()).collect();
         assert_eq!(sizes, [100, 100]);
     }
 
