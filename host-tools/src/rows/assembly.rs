@@ -130,9 +130,7 @@ impl Assembly {
     /// Hands out the complete rows; the pending ones (a few dozen) move
     /// to the front.
     fn hand_out(&mut self, out: &mut impl FnMut(&[RowParts])) {
-        if self.complete > 0 {
-            out(&self.rows[..self.complete]);
-        }
+        out(&self.rows[..self.complete]);
         self.rows.drain(..self.complete);
         self.complete = 0;
     }
