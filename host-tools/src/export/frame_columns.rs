@@ -391,7 +391,12 @@ mod tests {
                 ..Frame::default()
             }));
         }
-        let sizes: Vec<usize> = columns.finish().batches.iter().map(|b| b[0].len()).collect();
+        let sizes: Vec<usize> = columns
+            .finish()
+            .batches
+            .iter()
+            .map(|b| b[0].len())
+            .collect();
         assert_eq!(sizes, [100, 100]);
     }
 
