@@ -363,20 +363,28 @@ mod tests {
         }
     }
 
-    #[test]
-    fn rows_are_converted_in_runs_once_half_a_second_older_than_the_last_frame() {
+    /// `n` frames 10 ms apart into columns of 100-row batches, `after`
+    /// called after each (with its number), finished.
+    fn frames_every_10_ms(n: u64, mut after: impl FnMut(u64, &mut FrameColumns)) -> Finished {
         let mut columns = FrameColumns::new(&COLUMNS, TimeWindow::default(), 100).unwrap();
-        for i in 0..400u64 {
+        for i in 0..n {
             columns.push(&Record::Frame(Frame {
                 t_us: i * 10_000,
                 ..Frame::default()
             }));
+            after(i, &mut columns);
+        }
+        columns.finish()
+    }
+
+    #[test]
+    fn rows_are_converted_in_runs_once_half_a_second_older_than_the_last_frame() {
+        let finished = frames_every_10_ms(400, |i, columns| {
             // The frame at 3.06 s completes the rows up to 2.55 s: a run of
             // 256, two batches and some.
             let expected = if i == 306 { 2 } else { 0 };
             assert_eq!(columns.take_full().len(), expected, "frame {i}");
-        }
-        let finished = columns.finish();
+        });
         assert_eq!(finished.rows, 400);
         let sizes: Vec<usize> = finished.batches.iter().map(|b| b[0].len()).collect();
         assert_eq!(sizes, [100, 100]);
@@ -384,15 +392,7 @@ mod tests {
 
     #[test]
     fn rows_that_fill_whole_batches_leave_no_empty_batch_after_them() {
-        let mut columns = FrameColumns::new(&COLUMNS, TimeWindow::default(), 100).unwrap();
-        for i in 0..200u64 {
-            columns.push(&Record::Frame(Frame {
-                t_us: i * 10_000,
-                ..Frame::default()
-            }));
-        }
-        let sizes: Vec<usize> = columns
-            .finish()
+        let sizes: Vec<usize> = frames_every_10_ms(200, |_, _| {})
             .batches
             .iter()
             .map(|b| b[0].len())
